@@ -1,0 +1,1 @@
+"""FeaturePython document objects. No GUI imports here."""

@@ -1,0 +1,1 @@
+"""Everything GUI: commands, task panels, view providers. Imported only when FreeCAD.GuiUp."""

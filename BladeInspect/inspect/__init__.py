@@ -1,0 +1,1 @@
+"""The pipeline: registration stages, deviations, sections, reports, batches."""

@@ -1,0 +1,1 @@
+"""Measurement side: sensor model, four-axis kinematics, simulated rig, serial drivers, scan strategy."""
