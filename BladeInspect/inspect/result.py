@@ -1,0 +1,39 @@
+"""The registration result: everything result.json and deviations.csv are made of, as plain data
+that reports, batches, document objects and tests read without recomputing anything."""
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+
+@dataclass
+class RegistrationResult:
+    measured_to_cad: np.ndarray            # (4, 4) maps input points into the CAD frame
+    points_cad: np.ndarray                 # (N, 3) usable input points, input order, CAD frame
+    deviation: np.ndarray                  # (N,) signed distance to the CAD, + outside material
+    inlier: np.ndarray                     # (N,) bool: used by the fit (robust weight > 0)
+    closest: np.ndarray                    # (N, 3) closest CAD points
+    normal: np.ndarray                     # (N, 3) outward unit normals there
+    face: np.ndarray                       # (N,) index of the closest face in nominal.faces
+    snr: Optional[np.ndarray]              # (N,) or None when the input had none
+    columns: dict                          # extra input columns carried through (section, ...)
+    n_rows_skipped: int
+    rms_mm: float                          # RMS of the inliers' deviations
+    pose_covariance: np.ndarray            # (6, 6) translation mm, rotation rad, about `center`
+    center: np.ndarray                     # (3,) point the covariance's rotation is about
+    pose_uncertainty_mm: float             # 1 sigma at the worst corner of the CAD's bounding box
+    deviation_stats: dict                  # core.stats.deviation_statistics of all deviations
+    coarse: dict                           # measured_to_cad, eigenvalues, candidates, warning
+    timing_s: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    source: str = ""
+    cad_source: str = ""
+
+    @property
+    def n_points(self):
+        return int(len(self.deviation))
+
+    @property
+    def n_inliers(self):
+        return int(np.count_nonzero(self.inlier))
