@@ -1,0 +1,31 @@
+# FreeCAD runs this file (executed, not imported: no __file__) when the GUI starts.
+# Registration only: the commands are imported when the workbench is first activated.
+import FreeCADGui
+
+
+class BladeInspectWorkbench(FreeCADGui.Workbench):
+    MenuText = "BladeInspect"
+    ToolTip = "Register optical scans of turbine blades to their CAD and map the deviations"
+
+    def __init__(self):
+        # The module folder is found through the package, since this file has no __file__.
+        from BladeInspect.gui import resources
+        self.__class__.Icon = resources.icon_path("BladeInspect")
+
+    def Initialize(self):
+        from BladeInspect.gui import commands
+        self.appendToolbar("BladeInspect", commands.TOOLBAR)
+        self.appendMenu("BladeInspect", commands.MENU)
+        commands.register_preferences()
+
+    def Activated(self):
+        pass
+
+    def Deactivated(self):
+        pass
+
+    def GetClassName(self):
+        return "Gui::PythonWorkbench"
+
+
+FreeCADGui.addWorkbench(BladeInspectWorkbench())
