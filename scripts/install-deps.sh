@@ -14,4 +14,4 @@ SUDO=""
 echo "bladeinspect: installing ${missing[*]} (distribution packages)" >&2
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq >&2
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+$SUDO apt-get install -y -qq "${missing[@]}" >&2
