@@ -1,0 +1,230 @@
+"""SNR-weighted, robust ICP to an exact surface (paper 3.2) and the pose's covariance.
+
+The objective is  sum_i w_i d_i(T)^2  with d_i the signed distance of T p_i to the surface and
+w_i = a_i * rho_i:
+
+* a_i = SNR_i / mean(SNR) — the sensor's noise is sigma_i^2 = sigma_ref^2 SNR_ref / SNR_i
+  (DESIGN.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the mean makes
+  a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
+* rho_i in [0, 1] — a redescending robust weight of the standardised residual
+  z_i = d_i sqrt(a_i) / s, where s = 1.4826 * MAD(d sqrt(a)) is a robust scale re-estimated at
+  every iteration. rho = 1 for |z| <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
+  Flat in the core, so the good points are fitted by plain weighted least squares (the
+  efficient estimator, and the covariance formula below is exact for them); gross outliers and
+  real defects (many sigma away) weigh exactly 0. A point is an inlier when rho_i > 0.
+
+Iterations: Horn's closed form against the exact closest points first (robust from a coarse
+start, but point-to-point only slides slowly along a smooth surface), then Gauss-Newton steps
+of the point-to-plane linearisation d_i + n_i . (dt + dw x (p_i - c)). Because the gradient of
+the exact distance is the normal, the Gauss-Newton fixed point is a stationary point of the
+exact objective above, not of a surrogate.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+from .transforms import make_transform, rotation_from_vector, rotation_matrix_from_quaternion
+
+MAD_TO_SIGMA = 1.4826   # sigma of a normal distribution per unit of median absolute deviation
+# A last Gauss-Newton step smaller than this is applied to the residuals linearly.
+LINEAR_UPDATE_MM = 1e-4
+LINEAR_UPDATE_RAD = 1e-6
+
+
+@dataclass
+class ICPOptions:
+    max_iter: int = 60          # closest-point evaluations, Horn and Gauss-Newton together
+    horn_iters: int = 5         # point-to-point iterations before the Gauss-Newton steps
+    rot_tol: float = 1e-9       # rad: an update below both tolerances has converged
+    trans_tol: float = 1e-7     # mm
+    k_full: float = 3.0         # robust scales below which a point has full weight
+    k_zero: float = 4.5         # robust scales from which a point has no weight
+    min_scale: float = 1e-6     # mm: residuals below this are exact data, not noise to scale by
+
+
+@dataclass
+class ICPResult:
+    transform: np.ndarray       # (4,4) measured -> CAD
+    distances: np.ndarray       # (N,) signed residuals at `transform`
+    inlier: np.ndarray          # (N,) bool, robust weight > 0
+    weights: np.ndarray         # (N,) total weights a_i * rho_i
+    rms: float                  # RMS of the inliers' residuals, mm
+    sigma0: float               # residual scale of a unit-weight (mean-SNR) point, mm
+    iterations: int
+    converged: bool
+    covariance: np.ndarray      # (6,6) [translation mm, rotation rad] about `center`
+    center: np.ndarray          # (3,) weighted centroid of the points in the CAD frame
+
+
+def horn(target, source, weights=None):
+    """Horn (1987): rotation R and translation t minimising sum w |target - (R source + t)|^2,
+    R from the top eigenvector (a unit quaternion) of the symmetric 4x4 matrix N built from the
+    weighted cross-covariance of the centred sets."""
+    target = np.asarray(target, dtype=float)
+    source = np.asarray(source, dtype=float)
+    w = np.ones(len(source)) if weights is None else np.asarray(weights, dtype=float)
+    wsum = w.sum()
+    if wsum <= 0:
+        raise InputError("horn: the weights are all zero")
+    ct = w @ target / wsum
+    cs = w @ source / wsum
+    M = ((source - cs) * w[:, None]).T @ (target - ct)   # M[a, b] = sum w s_a t_b
+    (sxx, sxy, sxz), (syx, syy, syz), (szx, szy, szz) = M
+    N = np.array([
+        [sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
+        [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
+        [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
+        [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
+    ])
+    vals, vecs = np.linalg.eigh(N)
+    R = rotation_matrix_from_quaternion(vecs[:, np.argmax(vals)])
+    return R, ct - R @ cs
+
+
+def _snr_weights(snr, n):
+    if snr is None:
+        return np.ones(n)
+    snr = np.asarray(snr, dtype=float)
+    if snr.shape != (n,):
+        raise InputError("icp: snr has shape %s, expected (%d,)" % (snr.shape, n))
+    if not np.all(np.isfinite(snr)) or np.any(snr < 0) or snr.sum() <= 0:
+        raise InputError("icp: snr must be finite, non-negative and not all zero")
+    return snr / snr.mean()
+
+
+def robust_weights(distances, a, options):
+    """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point)."""
+    z = distances * np.sqrt(a)
+    usable = (a > 0) & np.isfinite(z)
+    if not usable.any():
+        return np.zeros(len(z)), np.nan
+    med = np.median(z[usable])
+    scale = max(MAD_TO_SIGMA * np.median(np.abs(z[usable] - med)), options.min_scale)
+    u = np.where(usable, np.abs(z) / scale, np.inf)
+    taper = (u - options.k_full) / (options.k_zero - options.k_full)
+    rho = np.where(u <= options.k_full, 1.0,
+                   np.where(u < options.k_zero, (1.0 - np.clip(taper, 0, 1) ** 2) ** 2, 0.0))
+    return rho, scale
+
+
+def _jacobian(points_cad, normals, center):
+    return np.hstack([normals, np.cross(points_cad - center, normals)])
+
+
+def pose_covariance(points_cad, normals, weights, residuals, center):
+    """C = s^2 (sum w_i J_i^T J_i)^-1, J_i = [n_i, (p_i - c) x n_i],
+    s^2 = sum w_i r_i^2 / (n_w - 6), n_w = number of points with w_i > 0.
+
+    With w = a * rho this is the weighted least-squares covariance of the points the robust
+    weight keeps: exact when rho is 0 or 1 (all but the few points in the taper band); s^2 is
+    the variance of a unit-weight residual, so the weights' normalisation cancels out.
+    Infinite when the points do not fix all six degrees of freedom (e.g. a sphere).
+    """
+    w = np.asarray(weights, dtype=float)
+    r = np.asarray(residuals, dtype=float)
+    keep = w > 0
+    dof = int(np.count_nonzero(keep)) - 6
+    if dof <= 0:
+        return np.full((6, 6), np.inf)
+    J = _jacobian(np.asarray(points_cad)[keep], np.asarray(normals)[keep], center)
+    H = (J * w[keep, None]).T @ J
+    s2 = float(np.sum(w[keep] * r[keep] ** 2)) / dof
+    # Conditioning judged on the matrix scaled to unit diagonal, so mm and rad do not mix.
+    d = np.sqrt(np.diag(H))
+    if np.any(d == 0) or np.linalg.cond(H / np.outer(d, d)) > 1e12:
+        return np.full((6, 6), np.inf)
+    return s2 * np.linalg.inv(H)
+
+
+def pose_uncertainty(cov, center, corners):
+    """1 sigma displacement at the worst corner: a corner x moves by dt + dw x (x - c), i.e.
+    J_x [dt, dw] with J_x = [I, -[x - c]_x]; its RMS is sqrt(trace(J_x C J_x^T))."""
+    cov = np.asarray(cov, dtype=float)
+    worst = 0.0
+    for x in np.asarray(corners, dtype=float):
+        v = x - np.asarray(center, dtype=float)
+        skew = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+        Jx = np.hstack([np.eye(3), -skew])
+        worst = max(worst, float(np.sqrt(np.trace(Jx @ cov @ Jx.T))))
+    return worst
+
+
+def _rotation_angle(R):
+    """Angle of a rotation, accurate near 0 (where arccos of the trace is not)."""
+    sin_angle = 0.5 * np.linalg.norm([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    return float(np.arctan2(sin_angle, 0.5 * (np.trace(R) - 1.0)))
+
+
+def _gauss_newton_step(points_cad, normals, distances, w, center):
+    """Small motion (dt, dw) about `center` minimising sum w (d + J [dt, dw])^2; the
+    least-squares solver leaves directions the surface does not fix (rank deficiency) alone."""
+    keep = w > 0
+    J = _jacobian(points_cad[keep], normals[keep], center)
+    sw = np.sqrt(w[keep])
+    x = np.linalg.lstsq(J * sw[:, None], -distances[keep] * sw, rcond=1e-12)[0]
+    return x[:3], x[3:]
+
+
+def icp(points, snr, closest_fn, init, options=None):
+    """Register `points` (measured frame) to the surface behind `closest_fn`, starting at `init`
+    (measured -> CAD). See the module docstring for the objective and the weights."""
+    options = options or ICPOptions()
+    points = np.asarray(points, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 3 or len(points) < 7:
+        raise InputError("icp: need at least 7 points of shape (N, 3), got %s"
+                         % (points.shape,))
+    a = _snr_weights(snr, len(points))
+    T = np.array(init, dtype=float)
+    converged = False
+    iterations = 0
+    last_step = None   # (moved, normals, distances, center, dt, dw) of the last Gauss-Newton step
+    while iterations < options.max_iter:
+        moved = points @ T[:3, :3].T + T[:3, 3]
+        closest, normals, distances = closest_fn(moved)
+        iterations += 1
+        rho, _ = robust_weights(distances, a, options)
+        w = a * rho
+        if np.count_nonzero(w) < 7:
+            last_step = None
+            break
+        center = w @ moved / w.sum()
+        if iterations <= options.horn_iters:
+            R, t = horn(closest, moved, w)
+            last_step = None
+            size = (np.linalg.norm(t + R @ center - center), _rotation_angle(R))
+            T = make_transform(R, t) @ T
+        else:
+            dt, dw = _gauss_newton_step(moved, normals, distances, w, center)
+            R = rotation_from_vector(dw)
+            last_step = (moved, normals, distances, center, dt, dw)
+            size = (np.linalg.norm(dt), np.linalg.norm(dw))
+            T = make_transform(R, center + dt - R @ center) @ T
+        if size[0] < options.trans_tol and size[1] < options.rot_tol:
+            converged = True
+            break
+
+    if last_step is not None and np.linalg.norm(last_step[4]) < LINEAR_UPDATE_MM \
+            and np.linalg.norm(last_step[5]) < LINEAR_UPDATE_RAD:
+        # The residuals at the returned pose to first order in the last small step: their
+        # error is curvature * step^2 (< 1e-7 mm), which saves a closest-point evaluation of
+        # the whole cloud.
+        moved_before, normals, distances, center, dt, dw = last_step
+        distances = distances + _jacobian(moved_before, normals, center) @ np.r_[dt, dw]
+        moved = points @ T[:3, :3].T + T[:3, 3]
+    else:
+        moved = points @ T[:3, :3].T + T[:3, 3]
+        _, normals, distances = closest_fn(moved)
+    rho, _ = robust_weights(distances, a, options)
+    w = a * rho
+    inlier = rho > 0
+    center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)
+    cov = pose_covariance(moved, normals, w, distances, center)
+    keep = w > 0
+    dof = max(int(np.count_nonzero(keep)) - 6, 1)
+    return ICPResult(
+        transform=T, distances=distances, inlier=inlier, weights=w,
+        rms=float(np.sqrt(np.mean(distances[inlier] ** 2))) if inlier.any() else float("nan"),
+        sigma0=float(np.sqrt(np.sum(w[keep] * distances[keep] ** 2) / dof)),
+        iterations=iterations, converged=converged, covariance=cov, center=center)
