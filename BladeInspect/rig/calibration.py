@@ -1,0 +1,282 @@
+"""Rotary-axis calibration with a reference sphere (issue 8, item 4).
+
+A sphere of calibrated diameter sits on the rotary table off the axis. At each of several
+rotary angles the sensor rasters the sphere's upper cap; each cap gives the sphere's centre in
+the MACHINE frame (stage positions and readings only, no table transform, so nothing assumed
+about the axis enters the centres). Turning the table moves the centre on a circle about the
+true axis: the circle's centre is a point of the axis, its normal the axis direction. The
+result is written as RIG.json through the kinematics, which every later scan reads.
+
+Why a sphere: its centre is the one point of a part that every viewing angle measures alike,
+and with the diameter known the centre follows from a cap seen from above alone.
+"""
+
+import numpy as np
+
+from ..core import fitting
+from ..core import transforms as tf
+from ..core.errors import InputError
+
+DEFAULT_DIAMETER = 25.0
+# Eight angles round the full turn: the centres then span the whole circle, which makes the
+# circle's normal (the axis direction) as well determined as a fixed sphere offset allows.
+DEFAULT_ANGLES = tuple(float(a) for a in range(0, 360, 45))
+# Where the sphere is mounted in the table frame: off the axis (the circle's radius sets how
+# well its normal is known) and along it, within a few mm; the first raster finds it exactly.
+DEFAULT_SPHERE_POSITION = (40.0, 30.0, 0.0)
+MIN_CAP_POINTS = 20
+# Raster half-width as a fraction of the radius: incidence up to about 35 deg keeps the SNR
+# high and the cap deep enough (about 2 mm) to separate centre depth from radius.
+CAP_FRACTION = 0.6
+RASTER_LINES = 15
+# Residuals beyond this many robust sigmas are gross sensor errors, not the sphere.
+OUTLIER_SIGMAS = 5.0
+MAX_RECENTRE_PASSES = 3
+RECENTRE_TOLERANCE_MM = 0.02
+
+
+class SpherePart:
+    """A sphere with an exact ray intersection, the part a SimulatedRig measures for
+    calibration (same raycast contract as cad.nominal.Nominal)."""
+
+    def __init__(self, radius, center=(0.0, 0.0, 0.0)):
+        if not radius > 0:
+            raise InputError("sphere: radius must be positive, got %r" % (radius,))
+        self.radius = float(radius)
+        self.center = np.asarray(center, dtype=float)
+        r = self.radius
+        self.bbox_corners = self.center + r * np.array(
+            [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+
+    def raycast(self, origins, directions):
+        """First intersection of each ray o + t d (t >= 0) with the sphere; NaN on a miss.
+        Directions need not be unit: t is in units of |d| like any ray parameter."""
+        o = np.atleast_2d(np.asarray(origins, dtype=float)) - self.center
+        d = np.atleast_2d(np.asarray(directions, dtype=float))
+        a = np.einsum("ij,ij->i", d, d)
+        b = np.einsum("ij,ij->i", o, d)
+        c = np.einsum("ij,ij->i", o, o) - self.radius ** 2
+        disc = b * b - a * c
+        hit = disc >= 0
+        sq = np.sqrt(np.where(hit, disc, 0.0))
+        near = (-b - sq) / a
+        far = (-b + sq) / a
+        # From outside the near root is the entry; from inside only the far root is ahead.
+        t = np.where(near >= 0, near, far)
+        t = np.where(hit & (t >= 0), t, np.nan)
+        points = o + t[:, None] * d
+        normal = points / self.radius
+        return t, np.zeros(len(t), dtype=int), normal
+
+
+def rotate_about_axis(points, angle_deg, axis_point, axis_direction):
+    """Turn points by angle_deg (right hand about the direction) about the axis line."""
+    u = np.asarray(axis_direction, dtype=float)
+    u = u / np.linalg.norm(u)
+    R = tf.rotation_from_vector(u * np.radians(angle_deg))
+    p = np.asarray(axis_point, dtype=float)
+    return (np.atleast_2d(points) - p) @ R.T + p
+
+
+def raster_path(center_xy, half_width, z, lines=RASTER_LINES):
+    """Serpentine raster of lines along X at fixed Y (the rig's scan direction): (K, 3)."""
+    offsets = np.linspace(-half_width, half_width, lines)
+    rows = []
+    for i, dy in enumerate(offsets):
+        xs = center_xy[0] + (offsets if i % 2 == 0 else offsets[::-1])
+        rows.append(np.column_stack([xs, np.full(lines, center_xy[1] + dy), np.full(lines, z)]))
+    return np.vstack(rows)
+
+
+def _fit_cap(points, snr, radius):
+    """Known-radius sphere fit with SNR weights, gross errors removed by a robust residual
+    scale (median absolute deviation) and the fit repeated on the rest."""
+    weights = None if snr is None else np.clip(snr, 1e-6, None)
+    fit = fitting.fit_sphere(points, radius=radius, weights=weights)
+    mad = np.median(np.abs(fit.residuals - np.median(fit.residuals)))
+    keep = np.abs(fit.residuals) <= OUTLIER_SIGMAS * max(1.4826 * mad, 1e-4)
+    if not keep.all() and keep.sum() >= MIN_CAP_POINTS:
+        fit = fitting.fit_sphere(points[keep], radius=radius,
+                                 weights=None if weights is None else weights[keep])
+    return fit, keep
+
+
+def measure_sphere_centre(rig, angle_deg, predicted_centre, radius, standoff,
+                          machine_point=None):
+    """Raster the cap above the predicted centre, fit the centre, re-centre the raster on it and
+    repeat until it stays put. Returns (centre (3,), SphereFit, cap points (K,3), info dict).
+
+    ``machine_point(stage_xyz, reading)`` maps readings to machine points (default: the
+    convention of rig.base, (X, Y, Z - d))."""
+    if machine_point is None:
+        def machine_point(stage, reading):
+            return stage - np.column_stack([np.zeros((len(stage), 2)), reading])
+    centre = np.asarray(predicted_centre, dtype=float)
+    half = CAP_FRACTION * radius
+    passes = []
+    for _ in range(MAX_RECENTRE_PASSES):
+        path = raster_path(centre[:2], half, centre[2] + radius + standoff)
+        readings = rig.scan_path(path, angle_deg)
+        valid = np.isfinite(readings.reading_mm)
+        if np.count_nonzero(valid) < MIN_CAP_POINTS:
+            raise InputError(
+                "calibration: sphere not found at A=%.1f deg: %d readings in a %.1f mm raster "
+                "around machine (%.2f, %.2f, %.2f) (check --sphere-diameter and its position)"
+                % (angle_deg, int(np.count_nonzero(valid)), 2 * half,
+                   centre[0], centre[1], centre[2]))
+        pts = machine_point(np.asarray(readings.stage_xyz, float)[valid],
+                            np.asarray(readings.reading_mm, float)[valid])
+        snr = np.asarray(readings.snr, float)[valid]
+        fit, keep = _fit_cap(pts, snr, radius)
+        shift = float(np.linalg.norm(fit.center[:2] - centre[:2]))
+        passes.append({"points": int(len(pts)), "rejected": int(np.count_nonzero(~keep)),
+                       "shift_mm": shift})
+        centre = fit.center
+        if shift < RECENTRE_TOLERANCE_MM:
+            break
+    rms = float(np.sqrt(np.mean(fit.residuals ** 2)))
+    return centre, fit, pts, {"passes": passes, "residual_rms_mm": rms}
+
+
+def axis_from_centres(centres, angles_deg):
+    """The rotary axis from the sphere centres measured at the given angles.
+
+    Returns a dict: ``point`` (where the axis crosses the machine plane y = 0, like the
+    nominal axis through the origin), ``direction`` (unit, oriented so that the measured
+    angles turn right-handed about it), ``circle`` (CircleFit of the centres), and
+    ``angle_model_residual_mm``: per angle, the distance between the measured centre and where
+    a rigid turn by that angle about the fitted axis puts the mean table position — the
+    circle fit ignores the angle values, so this checks the rotary's angles as well."""
+    centres = np.asarray(centres, dtype=float)
+    angles = np.asarray(angles_deg, dtype=float)
+    if len(centres) < 3 or len(np.unique(np.round(angles % 360.0, 6))) < 3:
+        raise InputError("calibration: at least 3 distinct rotary angles are needed, got %d"
+                         % len(np.unique(np.round(angles % 360.0, 6))))
+    circle = fitting.fit_circle_3d(centres)
+    o, n = circle.center, circle.normal
+    rel = centres - o
+    # Orientation: a right-handed turn by (a_j - a_i) about n takes centre i towards centre j.
+    sense = 0.0
+    for i in range(len(angles)):
+        for j in range(i + 1, len(angles)):
+            sense += np.sin(np.radians(angles[j] - angles[i])) * (np.cross(rel[i], rel[j]) @ n)
+    if sense < 0:
+        n = -n
+    if abs(n[1]) < 1e-6:
+        raise InputError("calibration: the fitted axis is not along Y (direction %s)"
+                         % np.array2string(n, precision=4))
+    point = o - (o[1] / n[1]) * n
+    table = np.array([rotate_about_axis(c, -a, point, n)[0] for c, a in zip(centres, angles)])
+    mean_table = table.mean(axis=0)
+    predicted = np.array([rotate_about_axis(mean_table, a, point, n)[0] for a in angles])
+    return {"point": point, "direction": n, "circle": circle,
+            "angle_model_residual_mm": np.linalg.norm(predicted - centres, axis=1)}
+
+
+def axis_angles_deg(direction):
+    """Tilts of an axis direction from +Y: about machine Z (towards X) and about X (towards Z),
+    in degrees — the figures a machine tool's axis alignment is stated in."""
+    d = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    return float(np.degrees(np.arctan2(d[0], d[1]))), float(np.degrees(np.arctan2(d[2], d[1])))
+
+
+# Largest difference between the given and the measured diameter: a wrong diameter moves every
+# fitted centre along the beam by the radius error, which shifts the axis by as much.
+DIAMETER_TOLERANCE_MM = 0.05
+
+
+def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_path=None,
+              sphere_position=DEFAULT_SPHERE_POSITION, kinematics=None, progress=None):
+    """Measure the reference sphere at each rotary angle, find the axis, write RIG.json.
+
+    ``kinematics`` is what is believed before calibration (default: the nominal RigKinematics);
+    it only predicts where to look for the sphere, and the result is a copy of it with the
+    measured axis. ``sphere_position`` is the sphere's approximate centre in the table frame.
+    Returns a dict of results (JSON-ready) with the new kinematics under ``kinematics``."""
+    from .kinematics import RigKinematics
+    if not (np.isfinite(sphere_diameter) and sphere_diameter > 0):
+        raise InputError("--sphere-diameter: must be a positive number of mm, got %r"
+                         % (sphere_diameter,))
+    angles = [float(a) for a in angles]
+    if len(angles) < 6:
+        raise InputError("calibration: at least 6 rotary angles are needed, got %d" % len(angles))
+    progress = progress or (lambda fraction, message: None)
+    prior = kinematics if kinematics is not None else RigKinematics()
+    radius = 0.5 * float(sphere_diameter)
+    standoff = float(rig.sensor.standoff)
+    axis_point0, axis_dir0 = _kinematics_axis(prior)
+    centres, per_angle, diameters = [], [], []
+    for i, a in enumerate(angles):
+        progress(i / len(angles), "calibration: sphere at A=%.1f deg" % a)
+        predicted = rotate_about_axis(np.asarray(sphere_position, float), a, axis_point0,
+                                      axis_dir0)[0]
+        centre, fit, pts, info = measure_sphere_centre(rig, a, predicted, radius, standoff,
+                                                       machine_point=_machine_point_fn(prior))
+        free = fitting.fit_sphere(pts)
+        diameters.append(2.0 * free.radius)
+        centres.append(centre)
+        per_angle.append({"angle_deg": a, "centre": centre.tolist(),
+                          "points": info["passes"][-1]["points"],
+                          "passes": len(info["passes"]),
+                          "residual_rms_mm": info["residual_rms_mm"],
+                          "free_fit_diameter_mm": 2.0 * free.radius})
+    measured_d = float(np.median(diameters))
+    if abs(measured_d - sphere_diameter) > DIAMETER_TOLERANCE_MM:
+        raise InputError("--sphere-diameter %g: the sphere measures %.3f mm across"
+                         % (sphere_diameter, measured_d))
+    axis = axis_from_centres(centres, angles)
+    calibrated = _with_axis(prior, axis["point"], axis["direction"])
+    if out_path is not None:
+        _write_atomically(out_path, calibrated)
+    progress(1.0, "calibration: axis through (%.4f, 0, %.4f), %.4f deg from +Y"
+             % (axis["point"][0], axis["point"][2],
+                np.degrees(np.arccos(np.clip(axis["direction"][1], -1, 1)))))
+    tilt_z, tilt_x = axis_angles_deg(axis["direction"])
+    return {
+        "axis_point": axis["point"].tolist(),
+        "axis_direction": axis["direction"].tolist(),
+        "axis_tilt_about_z_deg": tilt_z,
+        "axis_tilt_about_x_deg": tilt_x,
+        "circle_radius_mm": axis["circle"].radius,
+        "circle_residual_rms_mm": float(np.sqrt(np.mean(axis["circle"].residuals ** 2))),
+        "angle_model_residual_mm": axis["angle_model_residual_mm"].tolist(),
+        "sphere_diameter_mm": float(sphere_diameter),
+        "measured_diameter_mm": measured_d,
+        "angles": per_angle,
+        "simulated_s": float(rig.elapsed_s),
+        "rig_file": out_path,
+        "kinematics": calibrated,
+    }
+
+
+def _kinematics_axis(kinematics):
+    d = np.asarray(kinematics.axis_direction, dtype=float)
+    return np.asarray(kinematics.axis_point, dtype=float), d / np.linalg.norm(d)
+
+
+def _machine_point_fn(kinematics):
+    return kinematics.machine_point
+
+
+def _with_axis(kinematics, point, direction):
+    import copy
+    out = copy.deepcopy(kinematics)
+    out.axis_point = np.asarray(point, dtype=float)
+    out.axis_direction = np.asarray(direction, dtype=float)
+    return out
+
+
+def _write_atomically(path, kinematics):
+    import os
+    import tempfile
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise InputError("--out %s: folder %s does not exist" % (path, folder))
+    fd, tmp = tempfile.mkstemp(prefix=".rig-", suffix=".json", dir=folder)
+    os.close(fd)
+    try:
+        kinematics.to_json(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
