@@ -1,0 +1,104 @@
+"""SerialRig against the simulated rig served on a real pseudo-terminal: the same readings as
+the rig in process for the same seed, positions and limits, and GRBL's receive buffer kept."""
+import unittest
+
+import numpy as np
+
+from BladeInspect.core.errors import DeviceError, InputError
+from BladeInspect.rig.base import AxisLimits
+from BladeInspect.rig.serial_rig import SerialRig
+from BladeInspect.rig.simrig_device import SimRigDevice
+from tests.serial_support import FakeSimulatedRig, section_path
+
+
+def assert_same_readings(test, got, expected):
+    np.testing.assert_array_equal(got.stage_xyz, expected.stage_xyz)
+    test.assertEqual(got.angle_deg, expected.angle_deg)
+    np.testing.assert_array_equal(got.reading_mm, expected.reading_mm)   # NaN == NaN here
+    np.testing.assert_array_equal(got.snr, expected.snr)
+
+
+class SerialRigFakeTest(unittest.TestCase):
+    """Protocol behaviour with a stand-in rig whose readings depend on every coordinate,
+    the angle and the pass index."""
+
+    def open(self, two_ports=False, **device_options):
+        device = SimRigDevice(FakeSimulatedRig(seed=11), two_ports=two_ports, **device_options)
+        device.start()
+        self.addCleanup(device.stop)
+        rig = SerialRig(device.port_url, timeout_s=3)
+        self.addCleanup(rig.close)
+        return device, rig
+
+    def check_same_as_in_process(self, two_ports):
+        device, rig = self.open(two_ports)
+        reference = FakeSimulatedRig(seed=11)
+        rng = np.random.default_rng(5)
+        for k in (1, 2, 17, 400):
+            path = section_path(rng, k, y=rng.uniform(0, 200))
+            if k == 17:
+                path[5] = path[4]       # a repeated point still gets its own reading
+            angle = float(rng.uniform(-360, 360))
+            assert_same_readings(self, rig.scan_path(path, angle), reference.scan_path(path, angle))
+        self.assertEqual(device.passes, 4)
+        self.assertEqual(device.overflows, 0)
+
+    def test_same_readings_as_in_process_one_port(self):
+        self.check_same_as_in_process(two_ports=False)
+
+    def test_same_readings_as_in_process_two_ports(self):
+        self.check_same_as_in_process(two_ports=True)
+
+    def test_home_position_move(self):
+        device, rig = self.open()
+        self.assertIn("SimProbe", rig.sensor_identity["model"])
+        rig.home()
+        self.assertEqual(rig.position(), FakeSimulatedRig().position())
+        rig.move_to(x=12.345678901234567, a=-33.3)
+        rig.move_to(z=0.1 + 0.2)
+        self.assertEqual(rig.position(), (12.345678901234567, 150.0, 0.1 + 0.2, -33.3))
+        self.assertGreater(rig.elapsed_s, 0.0)
+
+    def test_first_motion_homes(self):
+        device, rig = self.open()
+        rig.move_to(x=1.0)
+        self.assertEqual(rig.position(), (1.0, 150.0, 100.0, 0.0))
+
+    def test_host_checks_limits_before_sending(self):
+        device, rig = self.open()
+        rig.home()
+        sent = device.lines_received
+        path = section_path(np.random.default_rng(0), 20)
+        path[7, 2] = 170.0
+        with self.assertRaisesRegex(DeviceError, "soft limit: Z=170.000"):
+            rig.scan_path(path, 0.0)
+        with self.assertRaisesRegex(DeviceError, "soft limit: X"):
+            rig.move_to(x=-500)
+        self.assertEqual(device.lines_received, sent)
+
+    def test_bad_path(self):
+        device, rig = self.open()
+        for path in (np.zeros((0, 3)), np.zeros((4, 2)), [[0, 0, np.nan]]):
+            with self.assertRaisesRegex(InputError, "scan_path"):
+                rig.scan_path(path, 0.0)
+
+    def test_stream_keeps_grbl_receive_buffer(self):
+        # The device counts bytes received but not yet answered; a host ignoring GRBL's
+        # 128 bytes must be caught by it, or the zero count proves nothing.
+        device, rig = self.open()
+        path = section_path(np.random.default_rng(1), 3000)
+        rig.scan_path(path, 0.0)
+        self.assertEqual(device.overflows, 0)
+        rig.rx_buffer = 4096
+        rig.scan_path(path, 0.0)
+        self.assertGreater(device.overflows, 0)
+
+    def test_one_line_of_two_port_urls(self):
+        with self.assertRaisesRegex(InputError, "MOTION_PORT,SENSOR_PORT"):
+            SerialRig("a,b,c")
+        with self.assertRaisesRegex(InputError, "timeout_s"):
+            SerialRig("loop://", timeout_s=0)
+
+
+if __name__ == "__main__":
+    unittest.main()
