@@ -1,0 +1,55 @@
+"""The workbench's settings in FreeCAD's parameters
+(User parameter:BaseApp/Preferences/Mod/BladeInspect), read by the GUI's preferences page, its
+commands and the document objects alike. Defaults follow the paper (Table 1) and DESIGN.md."""
+import FreeCAD
+
+PARAM_PATH = "User parameter:BaseApp/Preferences/Mod/BladeInspect"
+
+# name: (kind, default, label, unit, minimum, maximum)
+SETTINGS = {
+    "StandoffMm": ("float", 44.0, "Sensor standoff z_s", "mm", 1.0, 500.0),
+    "WorkingRangeMm": ("float", 8.0, "Sensor working range +-delta", "mm", 0.1, 100.0),
+    "EpsilonMm": ("float", 2.0, "Rescan stop criterion epsilon", "mm", 0.01, 50.0),
+    "SensorAccuracyMm": ("float", 0.006, "Sensor accuracy", "mm", 0.0, 1.0),
+    "PointsPerSecond": ("float", 9000.0, "Sensor rate", "points/s", 1.0, 1e6),
+    "Sections": ("int", 5, "Sections per scan", "", 1, 200),
+    "SectionSpacingMm": ("float", 0.0, "Section spacing (0 = spread over the span)", "mm", 0.0, 1000.0),
+    "Sides": ("choice", "both", "Sides to scan", "", ("both", "suction", "pressure"), None),
+    "ToleranceMm": ("float", 0.04, "Profile tolerance", "mm", 0.0001, 10.0),
+    "ColourLimitMm": ("float", 0.0, "Colour map limit (0 = the tolerance)", "mm", 0.0, 10.0),
+    "Seed": ("int", 0, "Random seed (simulated rig, registration)", "", 0, 2 ** 31 - 1),
+}
+
+
+def _group():
+    return FreeCAD.ParamGet(PARAM_PATH)
+
+
+def value(name):
+    kind, default = SETTINGS[name][:2]
+    group = _group()
+    if kind == "float":
+        return group.GetFloat(name, default)
+    if kind == "int":
+        return group.GetInt(name, default)
+    text = group.GetString(name, default)
+    return text if text in SETTINGS[name][4] else default
+
+
+def store(name, new_value):
+    kind = SETTINGS[name][0]
+    group = _group()
+    if kind == "float":
+        group.SetFloat(name, float(new_value))
+    elif kind == "int":
+        group.SetInt(name, int(new_value))
+    else:
+        if new_value not in SETTINGS[name][4]:
+            raise ValueError("%s: expected one of %s, got %r" % (name, SETTINGS[name][4], new_value))
+        group.SetString(name, new_value)
+
+
+def colour_limit():
+    """The deviation at which the colour map saturates: its own setting, else the tolerance."""
+    limit = value("ColourLimitMm")
+    return limit if limit > 0 else value("ToleranceMm")
