@@ -33,8 +33,11 @@ class _Port:
         try:
             self.serial = serial.serial_for_url(url, baudrate=baud, timeout=0, write_timeout=None)
         except (serial.SerialException, OSError, ValueError) as exc:
-            reason = getattr(exc, "strerror", None) or str(exc)
-            raise DeviceError("serial:%s: cannot open the %s port (%s)" % (url, label, reason))
+            # pyserial wraps the OSError whose strerror is the useful part.
+            cause = exc.__context__ if isinstance(exc.__context__, OSError) else exc
+            reason = getattr(cause, "strerror", None) or str(exc)
+            raise DeviceError("serial:%s: cannot open the %s port (%s)"
+                              % (url, label, reason)) from None
         try:
             self._fileno = self.serial.fileno()
         except Exception:

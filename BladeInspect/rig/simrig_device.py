@@ -195,6 +195,7 @@ class SimRigDevice:
                 return
             if fault.kind == "alarm" and self._state != "Alarm":
                 self._state = "Alarm"
+                self._alarm_latched = True
                 self._send(self._motion, "ALARM:%d" % fault.alarm)
                 self._send(self._motion, "[MSG:Reset to continue]")
             if fault.kind == "sensor_error" and not self._sensor_fault_sent:
@@ -209,8 +210,10 @@ class SimRigDevice:
     # -- controller ------------------------------------------------------------------------
 
     def _reset(self):
-        self._state = "Idle" if getattr(self, "_homed", False) else "Alarm"
+        # As in GRBL, a reset does not clear a limit alarm: only $H or $X do.
         self._homed = getattr(self, "_homed", False)
+        self._alarm_latched = getattr(self, "_alarm_latched", False)
+        self._state = "Idle" if self._homed and not self._alarm_latched else "Alarm"
         self._position = getattr(self, "_position", (0.0, 0.0, 0.0, 0.0))
         self._absolute = True
         self._motion_mode = 0
@@ -292,6 +295,7 @@ class SimRigDevice:
                 target[i] = axes[letter] if self._absolute else target[i] + axes[letter]
         if self.limits is not None and self._outside_limits(target):
             self._state = "Alarm"
+            self._alarm_latched = True
             self._reply("ALARM:2")
             return self._reply("[MSG:Reset to continue]")
         self._position = tuple(target)
@@ -313,9 +317,11 @@ class SimRigDevice:
             if hasattr(self.sim_rig, "position"):
                 self._position = tuple(float(v) for v in self.sim_rig.position())
             self._homed = True
+            self._alarm_latched = False
             self._state = "Idle"
             return self._reply("ok")
         if line == "$X":
+            self._alarm_latched = False
             self._state = "Idle"
             self._reply("[MSG:Caution: Unlocked]")
             return self._reply("ok")

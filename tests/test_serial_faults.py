@@ -1,0 +1,107 @@
+"""Every way the serial rig can fail ends in one DeviceError whose one-line message names the
+port and the failure: a missing port, the port vanishing mid-scan, silence, garbage, alarms,
+limits and sensor errors, injected by the simulated device over a real pseudo-terminal."""
+import unittest
+
+import numpy as np
+
+from BladeInspect.core.errors import DeviceError
+from BladeInspect.rig.base import AxisLimits
+from BladeInspect.rig.serial_rig import SerialRig
+from BladeInspect.rig.simrig_device import Fault, SimRigDevice
+from tests.serial_support import FakeSimulatedRig, section_path
+
+# Lines the driver sends before the first pass (ID; $H, G90G21) and around a pass's G1 blocks
+# (START, G0 A, G0 XYZ, F, M62, ..., M63, G4): a fault at CONNECT + HOME + 10 is mid-scan.
+CONNECT, HOME, MID_SCAN = 1, 2, 10
+
+
+class SerialFaultTest(unittest.TestCase):
+    def device(self, fault=None, **options):
+        device = SimRigDevice(FakeSimulatedRig(seed=2), fault=fault, **options).start()
+        self.addCleanup(device.stop)
+        return device
+
+    def scan_fails(self, device, pattern, timeout_s=2.0, k=60):
+        rig = SerialRig(device.port_url, timeout_s=timeout_s)
+        self.addCleanup(rig.close)
+        rig.home()
+        path = section_path(np.random.default_rng(4), k)
+        with self.assertRaises(DeviceError) as ctx:
+            rig.scan_path(path, 15.0)
+        message = str(ctx.exception)
+        self.assertRegex(message, pattern)
+        self.assertIn(device.port_url.split(",")[0], message)
+        self.assertNotIn("\n", message)
+        rig.close()     # closing after a failure must not raise
+        return message
+
+    def test_missing_port(self):
+        with self.assertRaisesRegex(DeviceError, r"serial:/dev/no-such-rig: cannot open the "
+                                                 r"motion port \(No such file or directory\)"):
+            SerialRig("/dev/no-such-rig")
+
+    def test_missing_sensor_port(self):
+        device = self.device()
+        with self.assertRaisesRegex(DeviceError, "cannot open the sensor port"):
+            SerialRig(device.port_url + ",/dev/no-such-sensor")
+
+    def test_port_vanishes_mid_scan(self):
+        self.scan_fails(self.device(Fault("close", CONNECT + HOME + MID_SCAN)), "motion port lost")
+
+    def test_sensor_port_vanishes(self):
+        device = self.device(Fault("close", CONNECT + 1 + HOME + MID_SCAN), two_ports=True)
+        self.scan_fails(device, "port lost")
+
+    def test_device_stops_answering(self):
+        message = self.scan_fails(self.device(Fault("silent", CONNECT + HOME + MID_SCAN)),
+                                  "timeout, no answer within 0.3 s", timeout_s=0.3)
+        self.assertIn("waiting for", message)
+
+    def test_nothing_answers_at_open(self):
+        # loop:// echoes the reset byte back: no controller greets.
+        with self.assertRaisesRegex(DeviceError, "timeout.*greeting"):
+            SerialRig("loop://", timeout_s=0.2)
+
+    def test_garbage(self):
+        self.scan_fails(self.device(Fault("garbage", CONNECT + HOME + MID_SCAN)),
+                        "garbage from the controller: '%%~ 0x3f garbage ~%%'")
+
+    def test_garbage_from_sensor(self):
+        # The START command (first line of the pass) is answered with noise.
+        self.scan_fails(self.device(Fault("garbage", CONNECT + HOME)), "garbage")
+
+    def test_hard_limit_alarm(self):
+        self.scan_fails(self.device(Fault("alarm", CONNECT + HOME + MID_SCAN, alarm=1)),
+                        r"hard limit: controller raised ALARM:1 \(hard limit triggered\)")
+
+    def test_controller_soft_limit(self):
+        # The controller's travel is shorter than the host believes: GRBL raises ALARM:2.
+        device = self.device(limits=AxisLimits(x=(-10.0, 10.0)))
+        self.scan_fails(device, r"soft limit: controller raised ALARM:2")
+
+    def test_sensor_error(self):
+        self.scan_fails(self.device(Fault("sensor_error", CONNECT + HOME + MID_SCAN)),
+                        r"sensor error LASER_FAULT \(laser fault\)")
+
+    def test_sensor_out_of_range_request(self):
+        device = self.device()
+        rig = SerialRig(device.port_url, timeout_s=2)
+        self.addCleanup(rig.close)
+        with self.assertRaisesRegex(DeviceError, "sensor error OUT_OF_RANGE"):
+            rig._sensor_command("START 0")
+
+    def test_motion_after_alarm_is_refused(self):
+        device = self.device(Fault("alarm", CONNECT + HOME + MID_SCAN))
+        self.scan_fails(device, "ALARM:1")
+        rig = SerialRig(device.port_url, timeout_s=2)
+        self.addCleanup(rig.close)
+        self.assertEqual(rig._query_status().state, "Alarm")    # a reset keeps a limit alarm
+        # Public motion would home first; a bare block meets the controller's lock-out.
+        with self.assertRaisesRegex(DeviceError, r"controller answered error:9 \(G-code locked "
+                                                 r"out during alarm\) to G0X1"):
+            rig._stream(["G0X1"])
+
+
+if __name__ == "__main__":
+    unittest.main()
