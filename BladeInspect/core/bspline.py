@@ -1,0 +1,297 @@
+"""A CAD face's surface as plain arrays: vectorised (rational) B-spline evaluation with first
+and second derivatives, and Newton projection of points onto it.
+
+The evaluation is the Cox-de Boor recurrence with derivatives (Piegl & Tiller, "The NURBS
+Book", algorithm A2.3) run on N parameter values at once: every scalar of the textbook
+algorithm becomes an (N,) array, the loops run over the degree only. Rational surfaces are
+evaluated in homogeneous coordinates and divided out with the quotient rule.
+
+Periodic surfaces are stored non-periodic (clamped knots over one period); ``closed_u`` /
+``closed_v`` tell the projection to wrap around the seam instead of stopping at it.
+"""
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .errors import InputError
+
+# Parameters are evaluated in chunks so the (chunk, p+1, q+1, 4) pole gathers stay small.
+CHUNK = 32768
+
+
+@dataclass
+class SurfaceData:
+    degree_u: int
+    degree_v: int
+    knots_u: np.ndarray            # flat, with multiplicity: len = n_poles_u + degree_u + 1
+    knots_v: np.ndarray
+    poles: np.ndarray              # (nu, nv, 3)
+    weights: Optional[np.ndarray]  # (nu, nv) or None when polynomial
+    u_range: np.ndarray            # (2,) the parameter box used (a face's bounds)
+    v_range: np.ndarray
+    closed_u: bool = False         # periodic in u: S(u_range[0], v) == S(u_range[1], v)
+    closed_v: bool = False
+
+    def __post_init__(self):
+        self.knots_u = np.asarray(self.knots_u, dtype=float)
+        self.knots_v = np.asarray(self.knots_v, dtype=float)
+        self.poles = np.asarray(self.poles, dtype=float)
+        self.u_range = np.asarray(self.u_range, dtype=float)
+        self.v_range = np.asarray(self.v_range, dtype=float)
+        nu, nv = self.poles.shape[:2]
+        if self.poles.ndim != 3 or self.poles.shape[2] != 3:
+            raise InputError("B-spline surface: poles must be (nu, nv, 3), got %s"
+                             % (self.poles.shape,))
+        if len(self.knots_u) != nu + self.degree_u + 1 or len(self.knots_v) != nv + self.degree_v + 1:
+            raise InputError("B-spline surface: %d x %d poles of degree %d x %d need %d x %d knots, "
+                             "got %d x %d" % (nu, nv, self.degree_u, self.degree_v,
+                                              nu + self.degree_u + 1, nv + self.degree_v + 1,
+                                              len(self.knots_u), len(self.knots_v)))
+        if self.weights is not None:
+            self.weights = np.asarray(self.weights, dtype=float)
+            if self.weights.shape != (nu, nv):
+                raise InputError("B-spline surface: weights must be (%d, %d)" % (nu, nv))
+            if np.all(self.weights == self.weights.flat[0]):
+                self.weights = None
+        self._homogeneous = None
+
+    @property
+    def rational(self):
+        return self.weights is not None
+
+    def homogeneous(self):
+        """(nu, nv, 4) poles times weight, then the weight (or 3 columns when polynomial)."""
+        if self._homogeneous is None:
+            if self.weights is None:
+                self._homogeneous = self.poles
+            else:
+                w = self.weights[..., None]
+                self._homogeneous = np.concatenate([self.poles * w, w], axis=2)
+        return self._homogeneous
+
+
+def find_span(knots, degree, t):
+    """Index i of the knot span [knots[i], knots[i+1]) holding each t, restricted to the spans
+    of the valid range so the end parameter uses the last span."""
+    n_poles = len(knots) - degree - 1
+    span = np.searchsorted(knots, t, side="right") - 1
+    return np.clip(span, degree, n_poles - 1)
+
+
+def basis_derivatives(knots, degree, span, t, n):
+    """Non-zero basis functions and their derivatives up to order n at each t.
+
+    Returns (N, n+1, degree+1): [:, k, r] is the k-th derivative of N_{span-degree+r}(t).
+    """
+    p = degree
+    m = len(t)
+    ndu = np.empty((p + 1, p + 1, m))
+    left = np.empty((p + 1, m))
+    right = np.empty((p + 1, m))
+    ndu[0, 0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = t - knots[span + 1 - j]
+        right[j] = knots[span + j] - t
+        saved = np.zeros(m)
+        for r in range(j):
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
+    ders = np.zeros((m, n + 1, p + 1))
+    for j in range(p + 1):
+        ders[:, 0, j] = ndu[j, p]
+    a = np.empty((2, p + 1, m))
+    for r in range(p + 1):
+        s1, s2 = 0, 1
+        a[0, 0] = 1.0
+        for k in range(1, n + 1):
+            d = np.zeros(m)
+            rk, pk = r - k, p - k
+            if r >= k:
+                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                d += a[s2, 0] * ndu[rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
+                d += a[s2, j] * ndu[rk + j, pk]
+            if r <= pk:
+                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                d += a[s2, k] * ndu[r, pk]
+            ders[:, k, r] = d
+            s1, s2 = s2, s1
+    factor = float(p)
+    for k in range(1, n + 1):
+        ders[:, k] *= factor
+        factor *= p - k
+    return ders
+
+
+def _evaluate_chunk(surf, u, v, order):
+    p, q = surf.degree_u, surf.degree_v
+    su = find_span(surf.knots_u, p, u)
+    sv = find_span(surf.knots_v, q, v)
+    Nu = basis_derivatives(surf.knots_u, p, su, u, order)
+    Nv = basis_derivatives(surf.knots_v, q, sv, v, order)
+    iu = su[:, None] - p + np.arange(p + 1)
+    iv = sv[:, None] - q + np.arange(q + 1)
+    block = surf.homogeneous()[iu[:, :, None], iv[:, None, :]]      # (N, p+1, q+1, 3|4)
+    # D[(k, l)] = d^(k+l) / du^k dv^l of the (homogeneous) surface.
+    D = {}
+    for k in range(order + 1):
+        tmp = np.einsum("na,nabc->nbc", Nu[:, k], block)
+        for l in range(order + 1 - k):
+            D[k, l] = np.einsum("nb,nbc->nc", Nv[:, l], tmp)
+    if not surf.rational:
+        out = [D[0, 0], D[1, 0], D[0, 1]]
+        if order >= 2:
+            out += [D[2, 0], D[1, 1], D[0, 2]]
+        return out
+    A = {kl: d[:, :3] for kl, d in D.items()}
+    w = {kl: d[:, 3:4] for kl, d in D.items()}
+    w0 = w[0, 0]
+    S = A[0, 0] / w0
+    Su = (A[1, 0] - w[1, 0] * S) / w0
+    Sv = (A[0, 1] - w[0, 1] * S) / w0
+    out = [S, Su, Sv]
+    if order >= 2:
+        Suu = (A[2, 0] - 2 * w[1, 0] * Su - w[2, 0] * S) / w0
+        Suv = (A[1, 1] - w[1, 0] * Sv - w[0, 1] * Su - w[1, 1] * S) / w0
+        Svv = (A[0, 2] - 2 * w[0, 1] * Sv - w[0, 2] * S) / w0
+        out += [Suu, Suv, Svv]
+    return out
+
+
+def evaluate(surf, u, v, order=1):
+    """Points and derivatives at N parameter pairs.
+
+    order=0 -> (S,), order=1 -> (S, Su, Sv), order=2 -> (S, Su, Sv, Suu, Suv, Svv); each (N, 3).
+    Parameters outside the knot range are extrapolated from the end spans (callers clamp).
+    """
+    if order not in (0, 1, 2):
+        raise ValueError("order must be 0, 1 or 2")
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    u, v = np.broadcast_arrays(u, v)
+    n_out = 1 if order == 0 else (3 if order == 1 else 6)
+    n = len(u)
+    if n <= CHUNK:
+        out = _evaluate_chunk(surf, u, v, max(order, 1))[:n_out]
+        return tuple(out)
+    out = [np.empty((n, 3)) for _ in range(n_out)]
+    for s in range(0, n, CHUNK):
+        part = _evaluate_chunk(surf, u[s:s + CHUNK], v[s:s + CHUNK], max(order, 1))
+        for o, pv in zip(out, part):
+            o[s:s + CHUNK] = pv
+    return tuple(out)
+
+
+def _wrap_or_clamp(t, lo, hi, closed):
+    if closed:
+        return lo + np.mod(t - lo, hi - lo)
+    return np.clip(t, lo, hi)
+
+
+def project_points(surf, points, u0, v0, max_iter=40, tol=1e-11):
+    """Foot points of `points` (N,3) on the surface patch over u_range x v_range by Newton's
+    method from the starts (u0, v0).
+
+    Minimises |S(u,v) - p|^2 / 2: gradient g = ((S-p).Su, (S-p).Sv), full Hessian with the
+    second derivatives. Where the Hessian is not positive definite (far on the concave side)
+    the Gauss-Newton matrix (first derivatives only, always PSD) takes its place, and steps that
+    do not reduce the distance are halved. A parameter at a bound whose gradient points out of
+    the box is held there (projected Newton), so the result is the closest point of the box
+    patch, possibly on its boundary. Closed directions wrap around the seam instead.
+
+    Returns (u, v, closest (N,3), converged (N,) bool); converged means the last 3D step was
+    below `tol` mm (Newton's quadratic convergence puts the error far below that).
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    n = len(points)
+    u = _wrap_or_clamp(np.asarray(u0, dtype=float).copy() * np.ones(n), *surf.u_range, surf.closed_u)
+    v = _wrap_or_clamp(np.asarray(v0, dtype=float).copy() * np.ones(n), *surf.v_range, surf.closed_v)
+    converged = np.zeros(n, dtype=bool)
+    closest = np.empty((n, 3))
+    active = np.arange(n)
+    (ulo, uhi), (vlo, vhi) = surf.u_range, surf.v_range
+    for _ in range(max_iter):
+        if len(active) == 0:
+            break
+        ua, va, pa = u[active], v[active], points[active]
+        S, Su, Sv, Suu, Suv, Svv = evaluate(surf, ua, va, order=2)
+        r = S - pa
+        f0 = np.einsum("ij,ij->i", r, r)
+        gu = np.einsum("ij,ij->i", r, Su)
+        gv = np.einsum("ij,ij->i", r, Sv)
+        a = np.einsum("ij,ij->i", Su, Su)
+        b = np.einsum("ij,ij->i", Su, Sv)
+        c = np.einsum("ij,ij->i", Sv, Sv)
+        hu = a + np.einsum("ij,ij->i", r, Suu)
+        hb = b + np.einsum("ij,ij->i", r, Suv)
+        hv = c + np.einsum("ij,ij->i", r, Svv)
+        # One-variable steps (the other held at a bound) use their own curvature when positive.
+        hu1 = np.where(hu > 0, hu, a)
+        hv1 = np.where(hv > 0, hv, c)
+        indefinite = (hu <= 0) | (hv <= 0) | (hu * hv - hb * hb <= 1e-12 * a * c)
+        hu = np.where(indefinite, a, hu)
+        hb = np.where(indefinite, b, hb)
+        hv = np.where(indefinite, c, hv)
+        # Bound constraints: a parameter held at its bound when the descent direction leaves
+        # the box there.
+        eps_u = 1e-14 * (uhi - ulo)
+        eps_v = 1e-14 * (vhi - vlo)
+        hold_u = np.zeros(len(active), bool) if surf.closed_u else \
+            ((ua <= ulo + eps_u) & (gu > 0)) | ((ua >= uhi - eps_u) & (gu < 0))
+        hold_v = np.zeros(len(active), bool) if surf.closed_v else \
+            ((va <= vlo + eps_v) & (gv > 0)) | ((va >= vhi - eps_v) & (gv < 0))
+        det = hu * hv - hb * hb
+        det = np.where(det == 0, 1e-300, det)
+        du = -(hv * gu - hb * gv) / det
+        dv = -(hu * gv - hb * gu) / det
+        only_v = hold_u & ~hold_v
+        only_u = hold_v & ~hold_u
+        both = hold_u & hold_v
+        du = np.where(only_v, 0.0, du)
+        dv = np.where(only_v, -gv / (hv1 + 1e-300), dv)
+        dv = np.where(only_u, 0.0, dv)
+        du = np.where(only_u, -gu / (hu1 + 1e-300), du)
+        du = np.where(both, 0.0, du)
+        dv = np.where(both, 0.0, dv)
+        # Backtracking on the distance: at most a few halvings, accepted when not worse.
+        step = np.ones(len(active))
+        un = _wrap_or_clamp(ua + du, ulo, uhi, surf.closed_u)
+        vn = _wrap_or_clamp(va + dv, vlo, vhi, surf.closed_v)
+        for _half in range(8):
+            (Sn,) = evaluate(surf, un, vn, order=0)
+            rn = Sn - pa
+            fn = np.einsum("ij,ij->i", rn, rn)
+            worse = fn > f0 * (1 + 1e-12) + 1e-24
+            if not np.any(worse):
+                break
+            step = np.where(worse, step * 0.5, step)
+            un = np.where(worse, _wrap_or_clamp(ua + step * du, ulo, uhi, surf.closed_u), un)
+            vn = np.where(worse, _wrap_or_clamp(va + step * dv, vlo, vhi, surf.closed_v), vn)
+        else:
+            un = np.where(worse, ua, un)
+            vn = np.where(worse, va, vn)
+            Sn = np.where(worse[:, None], S, Sn)
+        # Length in space of the parameter step actually taken (seam jumps excluded).
+        dua = un - ua
+        dva = vn - va
+        if surf.closed_u:
+            dua = np.where(np.abs(dua) > 0.5 * (uhi - ulo), 0.0, dua)
+        if surf.closed_v:
+            dva = np.where(np.abs(dva) > 0.5 * (vhi - vlo), 0.0, dva)
+        moved = np.linalg.norm(dua[:, None] * Su + dva[:, None] * Sv, axis=1)
+        u[active], v[active] = un, vn
+        closest[active] = Sn
+        done = moved <= tol
+        converged[active[done]] = True
+        active = active[~done]
+    if len(active):
+        (closest[active],) = evaluate(surf, u[active], v[active], order=0)
+    return u, v, closest, converged

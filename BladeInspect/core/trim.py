@@ -1,0 +1,103 @@
+"""A trimmed face's domain in its surface's (u, v): point-in-domain and distance to the boundary,
+vectorised over many parameter pairs.
+
+The boundary is a soup of segments (the face's discretised trimming curves, in any order and
+direction); inside is decided by the even-odd rule on a ray towards +u. Segments are bucketed
+in a uniform grid so each query meets only the few segments near it: rows of the grid for the
+crossing count, cells dilated by one cell for the distance, which is therefore exact up to one
+cell size and reported as that cell size beyond (a valid lower bound, all callers need).
+"""
+
+import numpy as np
+
+# Target number of segments per grid row / column.
+SEGMENTS_PER_BIN = 8
+
+
+def _csr(bin_ids, item_ids, n_bins):
+    order = np.argsort(bin_ids, kind="stable")
+    counts = np.bincount(bin_ids, minlength=n_bins)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    return starts, counts, item_ids[order]
+
+
+def _pairs(query_bins, starts, counts, members):
+    """(query index, member) for every member of each query's bin."""
+    cnt = counts[query_bins]
+    q = np.repeat(np.arange(len(query_bins)), cnt)
+    first = np.repeat(starts[query_bins], cnt)
+    offset = np.arange(len(q)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    return q, members[first + offset]
+
+
+class TrimDomain:
+    def __init__(self, segments):
+        """segments: (K, 2, 2) boundary pieces in (u, v)."""
+        self.segments = np.asarray(segments, dtype=float)
+        a, b = self.segments[:, 0], self.segments[:, 1]
+        lo = np.minimum(a, b)
+        hi = np.maximum(a, b)
+        span = np.maximum(hi.max(axis=0) - lo.min(axis=0), 1e-12)
+        g = int(np.clip(np.sqrt(len(self.segments) / SEGMENTS_PER_BIN) * 2, 4, 512))
+        self.cell = span / g
+        self.origin = lo.min(axis=0) - self.cell          # one dilation cell on each side
+        self.shape = (g + 2, g + 2)
+        k = np.arange(len(self.segments))
+        # Rows (v bands) each segment crosses, for the even-odd count.
+        r0 = self._index(lo[:, 1], 1)
+        r1 = self._index(hi[:, 1], 1)
+        rows_seg = np.repeat(k, r1 - r0 + 1)
+        rows = np.concatenate([np.arange(s, e + 1) for s, e in zip(r0, r1)])
+        self._rows = _csr(rows, rows_seg, self.shape[1])
+        # Cells of each segment's box dilated by one cell, for the distance.
+        c0u, c1u = self._index(lo[:, 0], 0) - 1, self._index(hi[:, 0], 0) + 1
+        c0v, c1v = self._index(lo[:, 1], 1) - 1, self._index(hi[:, 1], 1) + 1
+        c0u, c0v = np.maximum(c0u, 0), np.maximum(c0v, 0)
+        c1u, c1v = np.minimum(c1u, self.shape[0] - 1), np.minimum(c1v, self.shape[1] - 1)
+        ids, cells = [], []
+        for i in range(len(k)):
+            uu, vv = np.meshgrid(np.arange(c0u[i], c1u[i] + 1), np.arange(c0v[i], c1v[i] + 1),
+                                 indexing="ij")
+            cells.append((uu * self.shape[1] + vv).ravel())
+            ids.append(np.full(cells[-1].size, i))
+        self._cells = _csr(np.concatenate(cells), np.concatenate(ids), self.shape[0] * self.shape[1])
+        self.reach = float(self.cell.min())
+
+    def _index(self, x, axis):
+        return np.clip(((x - self.origin[axis]) / self.cell[axis]).astype(int), 0, self.shape[axis] - 1)
+
+    def query(self, uv):
+        """(inside (N,) bool, distance to the boundary (N,), capped at `reach`)."""
+        uv = np.asarray(uv, dtype=float).reshape(-1, 2)
+        n = len(uv)
+        a, b = self.segments[:, 0], self.segments[:, 1]
+        # Even-odd count of crossings of the ray from each point towards +u.
+        row = self._index(uv[:, 1], 1)
+        in_rows = (uv[:, 1] >= self.origin[1]) & (uv[:, 1] < self.origin[1] + self.shape[1] * self.cell[1])
+        q, s = _pairs(np.where(in_rows, row, 0), *self._rows)
+        keep = in_rows[q]
+        q, s = q[keep], s[keep]
+        ay, by = a[s, 1], b[s, 1]
+        py = uv[q, 1]
+        straddle = (ay > py) != (by > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_cross = a[s, 0] + (py - ay) * (b[s, 0] - a[s, 0]) / (by - ay)
+        hit = straddle & (uv[q, 0] < x_cross)
+        inside = np.bincount(q[hit], minlength=n) % 2 == 1
+        # Distance to the nearest segment among those registered in the point's cell.
+        dist = np.full(n, self.reach)
+        iu = ((uv[:, 0] - self.origin[0]) / self.cell[0]).astype(int)
+        iv = ((uv[:, 1] - self.origin[1]) / self.cell[1]).astype(int)
+        in_grid = (iu >= 0) & (iu < self.shape[0]) & (iv >= 0) & (iv < self.shape[1])
+        cell = np.where(in_grid, iu * self.shape[1] + iv, 0)
+        q, s = _pairs(cell, *self._cells)
+        keep = in_grid[q]
+        q, s = q[keep], s[keep]
+        if len(q):
+            ab = b[s] - a[s]
+            ap = uv[q] - a[s]
+            len2 = np.einsum("ij,ij->i", ab, ab)
+            t = np.clip(np.einsum("ij,ij->i", ap, ab) / np.where(len2 > 0, len2, 1.0), 0.0, 1.0)
+            d = np.linalg.norm(ap - t[:, None] * ab, axis=1)
+            np.minimum.at(dist, q, d)
+        return inside, dist
