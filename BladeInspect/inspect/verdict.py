@@ -1,0 +1,144 @@
+"""Pass or fail against a profile tolerance, per section and for the part, with the worst spots
+named by where they lie (paper 4.2-4.3).
+
+A measured point outside +-tolerance fails the part only when it belongs to a spot: a group of
+at least ``min_spot_points`` out-of-tolerance points each within ``spot_link_mm`` of another.
+A lone point out of tolerance is far more likely a sensor outlier (a speckle, a glint at
+grazing incidence) than a defect narrower than the point spacing; such points are counted and
+listed, not silently dropped. ``min_spot_points=1`` makes every point count.
+"""
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from ..core.errors import InputError
+from .sections import classify
+
+DEFAULT_TOLERANCE = 0.04
+SPOT_LINK_MM = 0.5
+MIN_SPOT_POINTS = 3
+
+_ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction side",
+              "pressure": "pressure side", "": "unknown side"}
+
+
+def _spots(xyz, link, min_points):
+    """Connected groups of points (each within ``link`` of another): (labels (n,), sizes)."""
+    n = len(xyz)
+    if n == 0:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+    pairs = cKDTree(xyz).query_pairs(link, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    return labels, np.bincount(labels)
+
+
+def _nearest_section(table, xyz):
+    heights = np.array([s.height_pct for s in table.sections])
+    pct = table.span_pct(xyz)
+    return np.argmin(np.abs(pct[:, None] - heights[None, :]), axis=1), pct
+
+
+def place_of(table, xyz):
+    """Where points lie, for people: (nearest section index, span %, zone) per point."""
+    xyz = np.atleast_2d(xyz)
+    if not table.sections:
+        return np.zeros(len(xyz), dtype=int), table.span_pct(xyz), np.full(len(xyz), "")
+    k, pct = _nearest_section(table, xyz)
+    zone = np.empty(len(xyz), dtype=object)
+    for i, sec in enumerate(table.sections):
+        sel = k == i
+        if sel.any():
+            zone[sel] = classify(sec.profile, xyz[sel], table.edge_fraction)
+    return k, pct, zone
+
+
+def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_link_mm=SPOT_LINK_MM,
+          min_spot_points=MIN_SPOT_POINTS, n_worst=5):
+    """The verdict as JSON-ready data: overall pass, per-section pass (optical, and CMM when
+    present), the out-of-tolerance spots worst first with their place, and a one-line summary."""
+    tolerance = float(tolerance)
+    if not np.isfinite(tolerance) or tolerance <= 0:
+        raise InputError("tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    if int(min_spot_points) < 1 or not spot_link_mm > 0:
+        raise InputError("verdict: min_spot_points >= 1 and spot_link_mm > 0 needed")
+    dev = np.asarray(result.deviation, dtype=float)
+    out_idx = np.flatnonzero(np.abs(dev) > tolerance)
+    labels, sizes = _spots(result.points_cad[out_idx], spot_link_mm, int(min_spot_points))
+    in_spot = np.zeros(len(dev), dtype=bool)
+    in_spot[out_idx] = sizes[labels] >= int(min_spot_points) if len(out_idx) else False
+    isolated = out_idx[~in_spot[out_idx]]
+
+    spots = []
+    for lab in np.flatnonzero(sizes >= int(min_spot_points)):
+        members = out_idx[labels == lab]
+        worst = members[np.argmax(np.abs(dev[members]))]
+        spots.append((abs(dev[worst]), worst, members))
+    spots.sort(key=lambda s: -s[0])
+    worst_points = [w for _, w, _ in spots[:n_worst]]
+    if worst_points:
+        k, pct, zone = place_of(table, result.points_cad[worst_points])
+    spot_out = []
+    for r, (_, worst, members) in enumerate(spots[:n_worst]):
+        sec = table.sections[k[r]] if table.sections else None
+        where = "%s at %.0f %% span" % (_ZONE_TEXT[zone[r] or ""], pct[r])
+        if sec is not None:
+            where += " (near section %s)" % sec.label
+        spot_out.append({
+            "deviation_mm": float(dev[worst]),
+            "n_points": int(len(members)),
+            "xyz": result.points_cad[worst].tolist(),
+            "span_pct": float(pct[r]),
+            "section": None if sec is None else sec.label,
+            "zone": zone[r] or None,
+            "where": where,
+            "text": "%+.4f mm over %d points, %s" % (dev[worst], len(members), where),
+        })
+
+    sections_out = []
+    for sec in table.sections:
+        idx = sec.point_index
+        counted = idx[~np.isin(idx, isolated)]
+        counted_dev = np.abs(dev[counted])
+        entry = {"label": sec.label, "n": int(len(idx)),
+                 "max_abs_mm": float(counted_dev.max()) if len(counted) else None,
+                 "n_isolated_out": int(len(idx) - len(counted)),
+                 "pass": bool(len(idx) > 0 and (counted_dev <= tolerance).all())}
+        if len(counted):
+            worst = counted[np.argmax(counted_dev)]
+            entry["worst_zone"] = sec.zone[np.flatnonzero(idx == worst)[0]] or None
+            entry["worst_deviation_mm"] = float(dev[worst])
+        if sec.cmm is not None:
+            cmm_abs = np.abs(sec.cmm_deviation)
+            entry["cmm_max_abs_mm"] = float(cmm_abs.max()) if len(cmm_abs) else None
+            entry["cmm_pass"] = bool(len(cmm_abs) > 0 and (cmm_abs <= tolerance).all())
+        sections_out.append(entry)
+
+    passed = bool(not spots and all(s["pass"] for s in sections_out))
+    n_out = int(len(out_idx))
+    if passed:
+        summary = "PASS: within +-%.3f mm" % tolerance
+        if len(isolated):
+            summary += " except %d isolated point(s) treated as sensor outliers" % len(isolated)
+    else:
+        failing = [s["label"] for s in sections_out if not s["pass"]]
+        summary = "FAIL: %d spot(s) outside +-%.3f mm" % (len(spots), tolerance)
+        if failing:
+            summary += "; sections %s out of tolerance or unmeasured" % ", ".join(failing)
+        if spot_out:
+            summary += "; worst %s" % spot_out[0]["text"]
+    return {
+        "tolerance_mm": tolerance,
+        "pass": passed,
+        "summary": summary,
+        "n_points_out": n_out,
+        "pct_points_out": 100.0 * n_out / max(len(dev), 1),
+        "n_spots": len(spots),
+        "n_isolated_out": int(len(isolated)),
+        "spot_link_mm": float(spot_link_mm),
+        "min_spot_points": int(min_spot_points),
+        "worst_spots": spot_out,
+        "sections": sections_out,
+    }
