@@ -1,0 +1,423 @@
+"""The workbench's commands (BladeInspect_<Verb>). Each gathers its inputs from the document
+and the selection, runs a pipeline stage with progress and cancel (gui.progress.run), and
+stores the outcome as document objects through the app layer's make_* functions, which remove
+what they made if anything fails."""
+import inspect as pyinspect
+import os
+import tempfile
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtCore, QtGui
+
+from ..app import objects, settings
+from ..core.errors import InputError
+from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
+from .session import RIG
+
+POINT_FILTER = "Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)"
+CAD_FILTER = "CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)"
+
+
+# ---------------------------------------------------------------- file dialogs (tests replace)
+
+def ask_open_file(title, filters):
+    path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), title, "", filters)
+    return path or None
+
+
+def ask_directory(title):
+    path = QtGui.QFileDialog.getExistingDirectory(FreeCADGui.getMainWindow(), title)
+    return path or None
+
+
+def open_in_browser(path):
+    QtGui.QDesktopServices.openUrl(QtCore.QUrl.fromLocalFile(path))
+
+
+# ---------------------------------------------------------------- document helpers
+
+def active_document(create=True):
+    doc = FreeCAD.ActiveDocument
+    if doc is None and create:
+        doc = FreeCAD.newDocument("Inspection")
+    return doc
+
+
+def _selected():
+    return [s for s in FreeCADGui.Selection.getSelection()] if FreeCAD.GuiUp else []
+
+
+def find_input(type_names):
+    """The selected object of one of these BladeInspect types, else the newest in the active
+    document, else None."""
+    doc = FreeCAD.ActiveDocument
+    if doc is None:
+        return None
+    for obj in _selected():
+        if objects.proxy_type(obj) in type_names:
+            return obj
+    for obj in reversed(doc.Objects):
+        if objects.proxy_type(obj) in type_names:
+            return obj
+    return None
+
+
+def find_nominal():
+    """A nominal: a DemoBlade or CadModel object, else a selected Part feature with faces."""
+    obj = find_input((objects.DemoBlade.Type, objects.CadModel.Type))
+    if obj is not None:
+        return obj
+    for sel in _selected():
+        shape = getattr(sel, "Shape", None)
+        if shape is not None and not shape.isNull() and shape.Faces:
+            return sel
+    return None
+
+
+def fit_view():
+    if FreeCADGui.ActiveDocument is not None:
+        view = FreeCADGui.ActiveDocument.ActiveView
+        if hasattr(view, "viewIsometric"):
+            view.viewIsometric()
+            view.fitAll()
+
+
+def _recompute_gui(doc):
+    doc.recompute()
+    fit_view()
+
+
+# ---------------------------------------------------------------- commands
+
+class _Command:
+    name = ""
+    menu = ""
+    tip = ""
+
+    def GetResources(self):
+        return {"Pixmap": resources.icon_path(self.name), "MenuText": self.menu,
+                "ToolTip": self.tip}
+
+    def IsActive(self):
+        return not progress.busy() and self.ready()
+
+    def ready(self):
+        return True
+
+
+class DemoBlade(_Command):
+    name = "BladeInspect_DemoBlade"
+    menu = "Demo blade"
+    tip = "Build the parametric demo blade as the nominal CAD (parameters in a task panel)"
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(taskpanels.DemoBladePanel(self.build))
+
+    def build(self, params):
+        doc = active_document()
+        obj = progress.run("Demo blade", lambda p: objects.make_demo_blade(doc, params))
+        if obj is not None:
+            _recompute_gui(doc)
+        return obj
+
+
+class LoadCad(_Command):
+    name = "BladeInspect_LoadCad"
+    menu = "Load CAD..."
+    tip = "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)"
+
+    def Activated(self):
+        path = ask_open_file("Nominal CAD", CAD_FILTER)
+        if path:
+            self.load(path)
+
+    def load(self, path):
+        doc = active_document()
+        obj = progress.run("Load CAD", lambda p: objects.make_cad_model(doc, path))
+        if obj is not None:
+            _recompute_gui(doc)
+        return obj
+
+
+class ConnectRig(_Command):
+    name = "BladeInspect_ConnectRig"
+    menu = "Connect rig..."
+    tip = "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port"
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
+
+    def connect(self, spec, seed):
+        from ..rig.scan import open_rig
+
+        def job(p):
+            nominal_obj = find_nominal()
+            if spec == "sim" and nominal_obj is None:
+                raise InputError("simulated rig: load a CAD or build the demo blade first")
+            nominal = objects.nominal_of(nominal_obj) if nominal_obj is not None else None
+            p(0.5, "opening %s" % spec)
+            RIG.connect(open_rig(spec, nominal, seed), spec)
+            return RIG.rig
+        rig = progress.run("Connect rig", job)
+        if rig is not None:
+            FreeCAD.Console.PrintMessage("BladeInspect: rig connected (%s)\n" % spec)
+        return rig
+
+
+class Scan(_Command):
+    name = "BladeInspect_Scan"
+    menu = "Scan..."
+    tip = "Scan the blade section by section with the connected rig (progress and abort)"
+
+    def ready(self):
+        return RIG.connected
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(taskpanels.ScanPanel(self.scan))
+
+    def scan(self, options):
+        from ..rig.scan import scan_to_dir
+        from ..inspect.pipeline import load_points
+        doc = active_document()
+        out_dir = scan_folder(doc)
+        accepted = pyinspect.signature(scan_to_dir).parameters
+
+        def job(p):
+            kwargs = {k: v for k, v in options.items() if k in accepted and k != "n_sections"}
+            if "spacing" in kwargs and not kwargs["spacing"]:
+                del kwargs["spacing"]
+            scan_to_dir(out_dir, RIG.rig, options["n_sections"], progress=p, **kwargs)
+            path = os.path.join(out_dir, "points.csv")
+            pointset = load_points(path)
+            return objects.make_measurement(doc, pointset, name="Scan", source_file=path)
+        obj = progress.run("Scan", job)
+        if obj is not None:
+            _recompute_gui(doc)
+        return obj
+
+
+def scan_folder(doc):
+    """Where a scan's points.csv goes: beside the saved document, else a new temporary folder."""
+    if doc.FileName:
+        base = os.path.splitext(doc.FileName)[0] + "_scans"
+        os.makedirs(base, exist_ok=True)
+        return tempfile.mkdtemp(prefix="scan-", dir=base)
+    return tempfile.mkdtemp(prefix="bladeinspect-scan-")
+
+
+class ImportPoints(_Command):
+    name = "BladeInspect_ImportPoints"
+    menu = "Import points..."
+    tip = "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)"
+
+    def Activated(self):
+        path = ask_open_file("Measured points", POINT_FILTER)
+        if path:
+            self.load(path)
+
+    def load(self, path):
+        from ..inspect.pipeline import load_points
+        doc = active_document()
+
+        def job(p):
+            p(0.1, "reading %s" % os.path.basename(path))
+            name = os.path.splitext(os.path.basename(path))[0]
+            return objects.make_measurement(doc, load_points(path), name="Measurement",
+                                            source_file=path)
+        obj = progress.run("Import points", job)
+        if obj is not None:
+            obj.Label = os.path.splitext(os.path.basename(path))[0]
+            _recompute_gui(doc)
+        return obj
+
+
+class Reconstruct(_Command):
+    name = "BladeInspect_Reconstruct"
+    menu = "Reconstruct"
+    tip = "Fit cubic B-spline section curves to the measurement and loft them into surfaces"
+
+    def ready(self):
+        return find_input((objects.Measurement.Type,)) is not None
+
+    def Activated(self):
+        self.reconstruct(find_input((objects.Measurement.Type,)))
+
+    def reconstruct(self, measurement):
+        from ..cad.loft import reconstruct
+        doc = measurement.Document
+
+        def job(p):
+            p(0.1, "fitting section curves")
+            recon = reconstruct(objects.pointset_of(measurement))
+            p(0.9, "storing %d curves, %d surfaces" % (len(recon.curves), len(recon.surfaces)))
+            return objects.make_reconstruction(doc, measurement, recon)
+        obj = progress.run("Reconstruct", job)
+        if obj is not None:
+            _recompute_gui(doc)
+        return obj
+
+
+class Register(_Command):
+    name = "BladeInspect_Register"
+    menu = "Register"
+    tip = ("Register the measurement to the nominal with no starting pose (PCA, then "
+           "SNR-weighted ICP) and show the pose with its uncertainty")
+
+    def ready(self):
+        return find_input((objects.Measurement.Type,)) is not None and find_nominal() is not None
+
+    def Activated(self):
+        obj = self.register(find_input((objects.Measurement.Type,)), find_nominal())
+        if obj is not None:
+            self.show(obj)
+
+    def register(self, measurement, nominal_obj, seed=None):
+        from ..inspect.pipeline import register
+        doc = measurement.Document
+        seed = settings.value("Seed") if seed is None else seed
+
+        def job(p):
+            p(0.0, "sampling the nominal")
+            nominal = objects.nominal_of(nominal_obj)
+            result = register(nominal, objects.pointset_of(measurement), seed=seed, progress=p)
+            result.cad_source = nominal_obj.Label
+            return objects.make_registration(doc, result, measurement, nominal_obj, seed)
+        obj = progress.run("Register", job)
+        if obj is not None:
+            doc.recompute()
+            for warning in obj.Warnings:
+                FreeCAD.Console.PrintWarning("BladeInspect: %s\n" % warning)
+        return obj
+
+    @staticmethod
+    def show(obj):
+        FreeCADGui.Control.closeDialog()
+        FreeCADGui.Control.showDialog(taskpanels.RegistrationPanel(obj))
+
+
+class DeviationMap(_Command):
+    name = "BladeInspect_DeviationMap"
+    menu = "Deviation map"
+    tip = "Colour the registered points by signed deviation (limits from the preferences)"
+
+    def ready(self):
+        return find_input((objects.Registration.Type,)) is not None
+
+    def Activated(self):
+        self.make(find_input((objects.Registration.Type,)))
+
+    def make(self, registration, limit=None):
+        doc = registration.Document
+        limit = settings.colour_limit() if limit is None else limit
+        obj = progress.run("Deviation map",
+                           lambda p: objects.make_deviation_map(doc, registration, limit))
+        if obj is not None:
+            measurement = registration.Measurement
+            if measurement is not None and measurement.ViewObject is not None:
+                measurement.ViewObject.Visibility = False
+            _recompute_gui(doc)
+        return obj
+
+
+class SectionAnalysis(_Command):
+    name = "BladeInspect_SectionAnalysis"
+    menu = "Section analysis"
+    tip = "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge"
+
+    def ready(self):
+        return find_input((objects.Registration.Type,)) is not None
+
+    def Activated(self):
+        rows = self.analyse(find_input((objects.Registration.Type,)))
+        if rows:
+            FreeCADGui.Control.closeDialog()
+            FreeCADGui.Control.showDialog(taskpanels.TablePanel("Section analysis", rows))
+
+    def analyse(self, registration):
+        from ..inspect.sections import section_table
+
+        def job(p):
+            if registration.Nominal is None:
+                raise InputError("%s: no nominal linked" % registration.Label)
+            nominal = objects.nominal_of(registration.Nominal)
+            p(0.2, "rebuilding the registration result")
+            result = objects.registration_result(registration, nominal)
+            p(0.5, "cutting sections")
+            return section_rows(section_table(result, nominal))
+        return progress.run("Section analysis", job)
+
+
+def section_rows(table):
+    """section_table's output as a list of plain dict rows."""
+    if isinstance(table, dict):
+        table = table.get("sections", table.get("rows", []))
+    rows = []
+    for row in table:
+        rows.append(row if isinstance(row, dict) else dict(vars(row)))
+    return rows
+
+
+class Report(_Command):
+    name = "BladeInspect_Report"
+    menu = "Report..."
+    tip = "Write the inspection report (HTML and PDF, result.json, deviations.csv) to a folder"
+
+    def ready(self):
+        reg = find_input((objects.Registration.Type,))
+        return reg is not None and reg.Measurement is not None and reg.Nominal is not None
+
+    def Activated(self):
+        out_dir = ask_directory("Report folder")
+        if out_dir:
+            summary = self.report(find_input((objects.Registration.Type,)), out_dir)
+            html = os.path.join(out_dir, "report.html")
+            if summary is not None and os.path.exists(html):
+                open_in_browser(html)
+
+    def report(self, registration, out_dir):
+        from ..inspect.report import run_report
+        from ..core.pointio import write_points_csv
+
+        def job(p):
+            work = tempfile.mkdtemp(prefix="bladeinspect-report-")
+            cad_path = getattr(registration.Nominal, "SourceFile", "")
+            if not cad_path:
+                cad_path = os.path.join(work, "nominal.brep")
+                registration.Nominal.Shape.exportBrep(cad_path)
+            points_path = registration.Measurement.SourceFile
+            if not points_path:
+                ps = objects.pointset_of(registration.Measurement)
+                points_path = os.path.join(work, "points.csv")
+                columns = dict(ps.columns)
+                if ps.snr is not None:
+                    columns["snr"] = ps.snr
+                write_points_csv(points_path, ps.xyz, columns)
+            return run_report(cad_path, points_path, out_dir,
+                              tolerance=settings.value("ToleranceMm"),
+                              seed=registration.Seed, progress=p)
+        return progress.run("Report", job)
+
+
+class Preferences(_Command):
+    name = "BladeInspect_Preferences"
+    menu = "Preferences..."
+    tip = "Sensor and rig parameters, tolerance and colour limits"
+
+    def Activated(self):
+        FreeCADGui.showPreferences("BladeInspect")
+
+
+COMMANDS = [DemoBlade(), LoadCad(), ConnectRig(), Scan(), ImportPoints(), Reconstruct(),
+            Register(), DeviationMap(), SectionAnalysis(), Report(), Preferences()]
+TOOLBAR = [c.name for c in COMMANDS if c.name != Preferences.name]
+MENU = [c.name for c in COMMANDS]
+BY_NAME = {c.name: c for c in COMMANDS}
+
+for _command in COMMANDS:
+    FreeCADGui.addCommand(_command.name, _command)
+
+
+def register_preferences():
+    from .preferences import PreferencesPage
+    FreeCADGui.addPreferencePage(PreferencesPage, "BladeInspect")

@@ -1,0 +1,115 @@
+"""The deviation legend drawn over the 3D view: a colour bar with its tick values, in screen
+space (its own orthographic camera), left out of the scene's bounding box so "fit all" frames
+the blade, not the legend. It draws the values and colours the DeviationMap object computed."""
+from pivy import coin
+
+# Legend geometry in the camera's normalised units: the view spans y in [-1, 1].
+BAR_X = (-0.97, -0.90)
+BAR_Y = (-0.75, 0.75)
+
+
+def _skip_bounding_group():
+    """FreeCAD's SoSkipBoundingGroup keeps its children out of view-all's bounding box."""
+    node_type = coin.SoType.fromName("SoSkipBoundingGroup")
+    if node_type.isBad():
+        return coin.SoSeparator()
+    node = coin.cast(node_type.createInstance(), "SoGroup")
+    return node
+
+
+def legend_node(values, colours, title="Deviation [mm]", font_size=14):
+    """values (ascending, mm) with their colours (r, g, b in 0..1) -> a Coin node to add to a
+    view provider's root."""
+    group = _skip_bounding_group()
+    hud = coin.SoAnnotation()
+    group.addChild(hud)
+    camera = coin.SoOrthographicCamera()
+    camera.height = 2.0
+    camera.position = (0.0, 0.0, 5.0)
+    camera.nearDistance = 1.0
+    camera.farDistance = 10.0
+    hud.addChild(camera)
+    reset = coin.SoResetTransform()
+    reset.whatToReset = coin.SoResetTransform.TRANSFORM
+    hud.addChild(reset)
+    light = coin.SoLightModel()
+    light.model = coin.SoLightModel.BASE_COLOR
+    hud.addChild(light)
+    # The host view provider may draw its geometry as points (a point cloud's display mode):
+    # the legend's quads must be filled whatever it chose.
+    style = coin.SoDrawStyle()
+    style.style = coin.SoDrawStyle.FILLED
+    hud.addChild(style)
+    pick = coin.SoPickStyle()
+    pick.style = coin.SoPickStyle.UNPICKABLE
+    hud.addChild(pick)
+    if len(values) < 2:
+        return group
+
+    n = len(values)
+    x0, x1 = BAR_X
+    ys = [BAR_Y[0] + (BAR_Y[1] - BAR_Y[0]) * i / (n - 1) for i in range(n)]
+    hud.addChild(_backing((x0 - 0.03, BAR_Y[0] - 0.06), (x1 + 0.30, BAR_Y[1] + 0.12)))
+    material = coin.SoMaterial()
+    material.diffuseColor.setValues(0, 2 * n, [tuple(c) for c in colours for _ in (0, 1)])
+    hud.addChild(material)
+    binding = coin.SoMaterialBinding()
+    binding.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
+    hud.addChild(binding)
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, 2 * n, [(x, y, 0.0) for y in ys for x in (x0, x1)])
+    hud.addChild(coords)
+    faces = coin.SoIndexedFaceSet()
+    index = []
+    for i in range(n - 1):
+        index += [2 * i, 2 * i + 1, 2 * i + 3, 2 * i + 2, -1]
+    faces.coordIndex.setValues(0, len(index), index)
+    faces.materialIndex.setValues(0, len(index), index)
+    hud.addChild(faces)
+
+    overall = coin.SoMaterialBinding()
+    overall.value = coin.SoMaterialBinding.OVERALL
+    hud.addChild(overall)
+    text_colour = coin.SoBaseColor()
+    text_colour.rgb = (0.0, 0.0, 0.0)
+    hud.addChild(text_colour)
+    font = coin.SoFont()
+    font.size = font_size
+    hud.addChild(font)
+    digits = 3 if max(abs(v) for v in values) < 1.0 else 2
+    for value, y in zip(values, ys):
+        label = "%+.*f" % (digits, value) if abs(value) > 1e-12 else "%.*f" % (digits, 0.0)
+        hud.addChild(_text((x1 + 0.02, y - 0.015, 0.0), label))
+    hud.addChild(_text((x0, BAR_Y[1] + 0.06, 0.0), title))
+    return group
+
+
+def _backing(lower_left, upper_right):
+    """A pale panel behind the legend so its labels read on any background."""
+    sep = coin.SoSeparator()
+    binding = coin.SoMaterialBinding()
+    binding.value = coin.SoMaterialBinding.OVERALL   # not the host's per-point colours
+    sep.addChild(binding)
+    colour = coin.SoBaseColor()
+    colour.rgb = (0.97, 0.97, 0.97)
+    sep.addChild(colour)
+    (xa, ya), (xb, yb) = lower_left, upper_right
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, 4, [(xa, ya, -0.01), (xb, ya, -0.01), (xb, yb, -0.01),
+                                  (xa, yb, -0.01)])
+    sep.addChild(coords)
+    face = coin.SoFaceSet()
+    face.numVertices.setValue(4)
+    sep.addChild(face)
+    return sep
+
+
+def _text(position, text):
+    sep = coin.SoSeparator()
+    move = coin.SoTranslation()
+    move.translation = position
+    sep.addChild(move)
+    label = coin.SoText2()
+    label.string = text
+    sep.addChild(label)
+    return sep

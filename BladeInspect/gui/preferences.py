@@ -1,0 +1,45 @@
+"""The BladeInspect page of FreeCAD's preferences: sensor and rig parameters, tolerance and
+colour limits, stored in User parameter:BaseApp/Preferences/Mod/BladeInspect (app.settings)."""
+from PySide import QtGui
+
+from ..app import settings
+
+
+class PreferencesPage:
+    def __init__(self, parent=None):
+        self.form = QtGui.QWidget(parent)
+        self.form.setWindowTitle("BladeInspect")
+        layout = QtGui.QFormLayout(self.form)
+        self.widgets = {}
+        for name, (kind, default, label, unit, lo, hi) in settings.SETTINGS.items():
+            if kind == "choice":
+                widget = QtGui.QComboBox()
+                widget.addItems(list(lo))
+            elif kind == "int":
+                widget = QtGui.QSpinBox()
+                widget.setRange(int(lo), int(hi))
+            else:
+                widget = QtGui.QDoubleSpinBox()
+                widget.setDecimals(4)
+                widget.setRange(lo, hi)
+                if unit:
+                    widget.setSuffix(" " + unit)
+            widget.setObjectName(name)
+            self.widgets[name] = widget
+            layout.addRow(label, widget)
+        self.loadSettings()
+
+    def loadSettings(self):
+        for name, widget in self.widgets.items():
+            value = settings.value(name)
+            if isinstance(widget, QtGui.QComboBox):
+                widget.setCurrentText(value)
+            else:
+                widget.setValue(value)
+
+    def saveSettings(self):
+        for name, widget in self.widgets.items():
+            if isinstance(widget, QtGui.QComboBox):
+                settings.store(name, widget.currentText())
+            else:
+                settings.store(name, widget.value())

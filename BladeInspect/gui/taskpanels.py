@@ -1,0 +1,236 @@
+"""Task panels: the parameters of a command before it runs, and what a result says after.
+Panels collect input and show output; the work is done by the commands' pipeline calls."""
+import dataclasses
+import math
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtGui
+
+from ..app import settings
+
+
+def _spin(value, minimum, maximum, decimals=3, suffix=""):
+    if isinstance(value, int) and not isinstance(value, bool):
+        box = QtGui.QSpinBox()
+        box.setRange(int(minimum), int(maximum))
+    else:
+        box = QtGui.QDoubleSpinBox()
+        box.setDecimals(decimals)
+        box.setRange(minimum, maximum)
+        box.setSingleStep(10 ** -(decimals - 1) if decimals > 1 else 1.0)
+    box.setValue(value)
+    if suffix:
+        box.setSuffix(" " + suffix)
+    return box
+
+
+class _Panel:
+    title = ""
+
+    def __init__(self):
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle(self.title)
+        self.layout = QtGui.QFormLayout(self.form)
+
+    def reject(self):
+        FreeCADGui.Control.closeDialog()
+        return True
+
+
+class DemoBladePanel(_Panel):
+    """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
+    title = "Demo blade"
+
+    def __init__(self, on_accept):
+        super().__init__()
+        from ..cad.demo_blade import BladeParams
+        self.on_accept = on_accept
+        self.params_type = BladeParams
+        self.boxes = {}
+        defaults = BladeParams()
+        for field in dataclasses.fields(BladeParams):
+            value = getattr(defaults, field.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                continue
+            box = _spin(value, -1e4, 1e4)
+            self.boxes[field.name] = box
+            self.layout.addRow(field.name.replace("_", " "), box)
+
+    def params(self):
+        return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())
+                                   for name, box in self.boxes.items()})
+
+    def accept(self):
+        params = self.params()   # read before closing: closing deletes the widgets
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(params)
+        return True
+
+
+class ConnectRigPanel(_Panel):
+    """Simulated rig, or a serial port picked from the ports pyserial finds."""
+    title = "Connect rig"
+
+    def __init__(self, on_accept):
+        super().__init__()
+        self.on_accept = on_accept
+        self.kind = QtGui.QComboBox()
+        self.kind.addItems(["Simulated rig", "Serial port"])
+        self.port = QtGui.QComboBox()
+        self.port.setEditable(True)
+        for port in self._ports():
+            self.port.addItem(port)
+        self.seed = _spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.layout.addRow("Rig", self.kind)
+        self.layout.addRow("Port", self.port)
+        self.layout.addRow("Seed (simulated)", self.seed)
+        self.kind.currentIndexChanged.connect(self._update)
+        self._update()
+
+    @staticmethod
+    def _ports():
+        try:
+            from serial.tools import list_ports
+        except ImportError:
+            return []
+        return [p.device for p in list_ports.comports()]
+
+    def _update(self, *_):
+        serial = self.kind.currentIndex() == 1
+        self.port.setEnabled(serial)
+        self.seed.setEnabled(not serial)
+
+    def spec(self):
+        if self.kind.currentIndex() == 0:
+            return "sim"
+        return "serial:" + self.port.currentText().strip()
+
+    def accept(self):
+        spec, seed = self.spec(), self.seed.value()
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(spec, seed)
+        return True
+
+
+class ScanPanel(_Panel):
+    """Scan parameters, defaults from the preferences."""
+    title = "Scan"
+
+    def __init__(self, on_accept):
+        super().__init__()
+        self.on_accept = on_accept
+        self.sections = _spin(settings.value("Sections"), 1, 200)
+        self.spacing = _spin(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm")
+        self.spacing.setToolTip("Distance between sections; 0 spreads them over the span")
+        self.sides = QtGui.QComboBox()
+        self.sides.addItems(list(settings.SETTINGS["Sides"][4]))
+        self.sides.setCurrentText(settings.value("Sides"))
+        self.seed = _spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.layout.addRow("Sections", self.sections)
+        self.layout.addRow("Section spacing", self.spacing)
+        self.layout.addRow("Sides", self.sides)
+        self.layout.addRow("Seed", self.seed)
+
+    def options(self):
+        return {"n_sections": self.sections.value(), "spacing": self.spacing.value(),
+                "sides": self.sides.currentText(), "seed": self.seed.value()}
+
+    def accept(self):
+        options = self.options()
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(options)
+        return True
+
+
+def registration_html(obj):
+    """The pose, its uncertainty and the deviation statistics of a Registration, as a table."""
+    pose = obj.Pose
+    axis, angle = pose.Rotation.Axis, math.degrees(pose.Rotation.Angle)
+    t, ts, rs = pose.Base, obj.TranslationSigmaMm, obj.RotationSigmaDeg
+    rows = [
+        ("Translation", "%.4f, %.4f, %.4f mm" % (t.x, t.y, t.z)),
+        ("Rotation", "%.4f&deg; about (%.4f, %.4f, %.4f)" % (angle, axis.x, axis.y, axis.z)),
+        ("Pose uncertainty (1&sigma;, worst corner)", "%.3f &micro;m"
+         % (obj.PoseUncertaintyMm * 1000.0)),
+        ("Translation 1&sigma;", "%.3f, %.3f, %.3f &micro;m"
+         % (ts.x * 1000, ts.y * 1000, ts.z * 1000)),
+        ("Rotation 1&sigma;", "%.2f, %.2f, %.2f arcsec"
+         % (rs.x * 3600, rs.y * 3600, rs.z * 3600)),
+        ("RMS (inliers)", "%.4f mm" % obj.RmsMm),
+        ("Points / inliers", "%d / %d" % (obj.NPoints, obj.NInliers)),
+        ("Deviation min / max", "%.4f / %.4f mm" % (obj.DeviationMinMm, obj.DeviationMaxMm)),
+        ("Mean &plusmn; std", "%.4f &plusmn; %.4f mm" % (obj.DeviationMeanMm, obj.DeviationStdMm)),
+        ("Within 1&sigma; / 3&sigma;", "%.1f %% / %.1f %%"
+         % (obj.PctWithin1Sigma, obj.PctWithin3Sigma)),
+    ]
+    html = "<table cellspacing='4'>" + "".join(
+        "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
+    if obj.Warnings:
+        html += "<p><b>Warnings</b><br>" + "<br>".join(
+            w.replace("&", "&amp;").replace("<", "&lt;") for w in obj.Warnings) + "</p>"
+    return html
+
+
+class RegistrationPanel:
+    """What a registration found: the pose and how well it is known."""
+
+    def __init__(self, obj):
+        self.obj = obj
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle("Registration: " + obj.Label)
+        layout = QtGui.QVBoxLayout(self.form)
+        self.text = QtGui.QTextBrowser()
+        self.text.setHtml(registration_html(obj))
+        self.text.setMinimumHeight(320)
+        layout.addWidget(self.text)
+
+    def getStandardButtons(self):
+        return int(QtGui.QDialogButtonBox.Close)
+
+    def reject(self):
+        FreeCADGui.Control.closeDialog()
+        if FreeCADGui.ActiveDocument is not None and FreeCADGui.ActiveDocument.getInEdit():
+            FreeCADGui.ActiveDocument.resetEdit()
+        return True
+
+
+class TablePanel:
+    """A list of rows (dicts) as a table: the section analysis."""
+
+    def __init__(self, title, rows, note=""):
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle(title)
+        layout = QtGui.QVBoxLayout(self.form)
+        columns = [k for k, v in rows[0].items() if _is_scalar(v)] if rows else []
+        self.table = QtGui.QTableWidget(len(rows), len(columns))
+        self.table.setHorizontalHeaderLabels(columns)
+        for r, row in enumerate(rows):
+            for c, key in enumerate(columns):
+                self.table.setItem(r, c, QtGui.QTableWidgetItem(_format(row.get(key))))
+        self.table.resizeColumnsToContents()
+        self.table.setMinimumHeight(260)
+        layout.addWidget(self.table)
+        if note:
+            label = QtGui.QLabel(note)
+            label.setWordWrap(True)
+            layout.addWidget(label)
+
+    def getStandardButtons(self):
+        return int(QtGui.QDialogButtonBox.Close)
+
+    def reject(self):
+        FreeCADGui.Control.closeDialog()
+        return True
+
+
+def _is_scalar(value):
+    return value is None or isinstance(value, (int, float, str, bool))
+
+
+def _format(value):
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return "%.4f" % value
+    return str(value)

@@ -1,0 +1,137 @@
+"""View providers of BladeInspect's document objects: icons, display modes, the deviation legend
+and the task panels opened by double-click. They show what the objects hold and compute nothing.
+Importing this module registers them with the app layer's objects."""
+import FreeCAD
+import FreeCADGui
+
+from ..app import objects
+from . import legend, resources
+
+
+class ViewProvider:
+    icon = "BladeInspect"
+
+    def __init__(self, vobj):
+        vobj.Proxy = self
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+
+    def configure(self, vobj):
+        """Display defaults for an object just made (not applied to restored ones' choices)."""
+
+    def getIcon(self):
+        return resources.icon_path(self.icon)
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+
+class ViewProviderNominal(ViewProvider):
+    icon = "BladeInspect_DemoBlade"
+
+    def configure(self, vobj):
+        vobj.Transparency = 40
+
+
+class ViewProviderCadModel(ViewProviderNominal):
+    icon = "BladeInspect_LoadCad"
+
+
+class ViewProviderMeasurement(ViewProvider):
+    icon = "BladeInspect_ImportPoints"
+
+    def configure(self, vobj):
+        vobj.PointSize = 2
+        vobj.ShapeColor = (0.1, 0.1, 0.4)
+
+
+class ViewProviderReconstruction(ViewProvider):
+    icon = "BladeInspect_Reconstruct"
+
+    def configure(self, vobj):
+        vobj.LineColor = (0.9, 0.45, 0.1)
+        vobj.LineWidth = 2
+        vobj.ShapeColor = (0.95, 0.7, 0.4)
+        vobj.Transparency = 50
+
+
+class ViewProviderRegistration(ViewProvider):
+    icon = "BladeInspect_Register"
+
+    def setEdit(self, vobj, mode=0):
+        if mode != 0:
+            return None
+        from .taskpanels import RegistrationPanel
+        FreeCADGui.Control.showDialog(RegistrationPanel(vobj.Object))
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        FreeCADGui.Control.closeDialog()
+        return True
+
+    def doubleClicked(self, vobj):
+        FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name)
+        return True
+
+
+class ViewProviderDeviationMap(ViewProvider):
+    icon = "BladeInspect_DeviationMap"
+
+    def attach(self, vobj):
+        super().attach(vobj)
+        self.legend = None
+        self.show_legend(vobj)
+
+    def configure(self, vobj):
+        vobj.DisplayMode = "Color"
+        vobj.PointSize = 4
+
+    def show_legend(self, vobj):
+        root = vobj.RootNode
+        if self.legend is not None:
+            root.removeChild(self.legend)
+            self.legend = None
+        obj = vobj.Object
+        if len(obj.LegendValues) >= 2 and vobj.Visibility:
+            self.legend = legend.legend_node(list(obj.LegendValues),
+                                             [c[:3] for c in obj.LegendColors])
+            root.addChild(self.legend)
+
+    def updateData(self, obj, prop):
+        if prop in ("LegendValues", "LegendColors"):
+            self.show_legend(obj.ViewObject)
+
+    def onChanged(self, vobj, prop):
+        if prop == "Visibility" and hasattr(self, "legend"):
+            self.show_legend(vobj)
+
+
+VIEW_PROVIDERS = {
+    objects.DemoBlade.Type: ViewProviderNominal,
+    objects.CadModel.Type: ViewProviderCadModel,
+    objects.Measurement.Type: ViewProviderMeasurement,
+    objects.Reconstruction.Type: ViewProviderReconstruction,
+    objects.Registration.Type: ViewProviderRegistration,
+    objects.DeviationMap.Type: ViewProviderDeviationMap,
+}
+
+
+def attach_view_provider(obj):
+    """Give a BladeInspect object its view provider (new objects, and documents saved without a
+    GUI, whose objects have none)."""
+    cls = VIEW_PROVIDERS.get(objects.proxy_type(obj))
+    vobj = obj.ViewObject
+    if cls is None or vobj is None or isinstance(getattr(vobj, "Proxy", None), cls):
+        return
+    cls(vobj)
+    try:
+        cls.configure(vobj.Proxy, vobj)
+    except Exception as exc:  # a display default that does not apply is not worth failing for
+        FreeCAD.Console.PrintLog("BladeInspect: %s: %s\n" % (obj.Name, exc))
+
+
+objects.set_view_provider_hook(attach_view_provider)

@@ -1,0 +1,326 @@
+"""Driven by tests/test_gui.py inside a real FreeCAD GUI (under Xvfb): activates the workbench,
+runs its commands, checks objects, colours and panels, saves screenshots, writes a JSON of
+its checks to $BI_GUI_OUT/checks.json and exits. Not a test module itself (FreeCAD's GUI must
+be running), hence no test_ prefix."""
+import json
+import os
+import sys
+import time
+import traceback
+
+import numpy as np
+
+import FreeCAD
+import FreeCADGui as Gui
+from PySide import QtCore, QtGui
+
+OUT = os.environ["BI_GUI_OUT"]
+REPO = os.environ["BI_REPO"]
+CHECKS = []
+STEPS = {}
+
+
+def check(name, ok, detail=""):
+    CHECKS.append({"name": name, "ok": bool(ok), "detail": str(detail)})
+
+
+def step(name):
+    """Run a scenario step, recording its time and any exception as a failed check."""
+    def wrap(fn):
+        t0 = time.time()
+        try:
+            fn()
+            STEPS[name] = {"status": "ran", "seconds": round(time.time() - t0, 2)}
+        except _Skip as exc:
+            STEPS[name] = {"status": "skipped", "reason": str(exc)}
+        except Exception:
+            STEPS[name] = {"status": "error", "seconds": round(time.time() - t0, 2)}
+            check(name + ": no exception", False, traceback.format_exc())
+        return fn
+    return wrap
+
+
+class _Skip(Exception):
+    pass
+
+
+def need(module):
+    try:
+        __import__(module)
+    except ImportError as exc:
+        raise _Skip("%s not available: %s" % (module, exc))
+
+
+def settle(seconds=0.2):
+    end = time.time() + seconds
+    while time.time() < end:
+        QtGui.QApplication.processEvents()
+        time.sleep(0.02)
+
+
+def view_shot(name):
+    view = Gui.activeDocument().activeView()
+    view.viewIsometric()
+    view.fitAll()
+    settle()
+    path = os.path.join(OUT, name + ".png")
+    view.saveImage(path, 1000, 750, "Current")
+    return path
+
+
+def window_shot(name):
+    settle(0.3)
+    path = os.path.join(OUT, name + ".png")
+    Gui.getMainWindow().grab().save(path)
+    return path
+
+
+def colours_of(obj):
+    return np.array(obj.Color)[:, :3]
+
+
+def run():
+    sys.path.insert(0, REPO)
+    window = Gui.getMainWindow()
+    window.resize(1280, 1000)
+    combo = [d for d in window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"]
+    if combo:
+        window.resizeDocks(combo, [430], QtCore.Qt.Horizontal)
+    Gui.activateWorkbench("BladeInspectWorkbench")
+    from BladeInspect.app import objects
+    from BladeInspect.gui import commands, progress, viewproviders
+    progress.SHOW_DIALOGS = False   # dialogs would wait for a click; messages are checked
+    names = [c for c in Gui.listCommands() if c.startswith("BladeInspect_")]
+    check("all commands registered", set(commands.MENU) <= set(names), names)
+    check("workbench active", Gui.activeWorkbench().name() == "BladeInspectWorkbench",
+          Gui.activeWorkbench().name())
+    check("scan greyed out without a rig", not commands.BY_NAME["BladeInspect_Scan"].IsActive())
+    check("register greyed out without inputs",
+          not commands.BY_NAME["BladeInspect_Register"].IsActive())
+    doc = FreeCAD.newDocument("Inspection")
+    state = {}
+
+    @step("demo blade through its task panel")
+    def _():
+        need("BladeInspect.cad.demo_blade")
+        Gui.runCommand("BladeInspect_DemoBlade")
+        settle(0.5)
+        panel = _active_panel()
+        check("demo blade task panel open", panel is not None)
+        window_shot("task_panel_demo_blade")
+        panel.boxes["span"].setValue(60.0)
+        panel.accept()
+        settle()
+        blade = objects.find_objects(doc, "BladeInspect::DemoBlade")
+        check("demo blade made", len(blade) == 1)
+        check("demo blade has the panel's span",
+              abs(blade[0].Shape.BoundBox.ZLength - 60.0) < 1e-6, blade[0].Shape.BoundBox)
+        state["blade"] = blade[0]
+        check("register still greyed out: a blade but no points",
+              not commands.BY_NAME["BladeInspect_Register"].IsActive())
+        view_shot("demo_blade")
+
+    @step("load CAD error is a message, not a traceback, and adds nothing")
+    def _():
+        before = len(doc.Objects)
+        commands.ask_open_file = lambda *a: os.path.join(OUT, "missing.step")
+        Gui.runCommand("BladeInspect_LoadCad")
+        settle()
+        check("missing CAD reported", progress.MESSAGES and "no such CAD file"
+              in progress.MESSAGES[-1][1], progress.MESSAGES[-1:])
+        check("missing CAD adds no object", len(doc.Objects) == before)
+
+    @step("cancel leaves the document as it was")
+    def _():
+        before = [o.Name for o in doc.Objects]
+
+        def job(p):
+            with objects.building(doc, "cancelled"):
+                objects.make_measurement(doc, _FakePoints(np.random.rand(20, 3)))
+                bars = Gui.getMainWindow().statusBar().findChildren(QtGui.QPushButton)
+                [b for b in bars if b.text() == "Cancel"][-1].click()
+                p(0.5, "working")
+        value = progress.run("Cancel test", job)
+        check("cancelled job returns nothing", value is None)
+        check("cancel reported", progress.MESSAGES[-1] == ("Cancel test", "cancelled"))
+        check("cancel leaves no objects", [o.Name for o in doc.Objects] == before)
+        settle()
+        check("no progress widgets left", not Gui.getMainWindow().statusBar().findChildren(
+            QtGui.QProgressBar, "BladeInspectProgress"))
+
+    @step("real pipeline: rig, scan, reconstruct, register, deviation map, sections, report")
+    def _():
+        for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
+                       "BladeInspect.rig.scan", "BladeInspect.cad.loft"):
+            need(module)
+        blade = state["blade"]
+        Gui.Selection.clearSelection()
+        commands.BY_NAME["BladeInspect_ConnectRig"].connect("sim", 0)
+        check("rig connected", commands.RIG.connected, progress.MESSAGES[-1:])
+        check("scan active with a rig", commands.BY_NAME["BladeInspect_Scan"].IsActive())
+        Gui.runCommand("BladeInspect_Scan")
+        settle(0.3)
+        panel = _active_panel()
+        panel.sections.setValue(3)
+        window_shot("task_panel_scan")
+        panel.accept()
+        scans = objects.find_objects(doc, "BladeInspect::Measurement")
+        check("scan made a measurement", len(scans) == 1, progress.MESSAGES[-1:])
+        meas = scans[0]
+        check("scan measurement has SNR", len(meas.SNR) == meas.NPoints > 100, meas.NPoints)
+        recon = commands.BY_NAME["BladeInspect_Reconstruct"].reconstruct(meas)
+        check("reconstruction made", recon is not None and recon.NCurves > 0,
+              progress.MESSAGES[-1:])
+        reg = commands.BY_NAME["BladeInspect_Register"].register(meas, blade)
+        check("registration made", reg is not None, progress.MESSAGES[-1:])
+        check("registration rms small", reg.RmsMm < 0.02, reg.RmsMm)
+        check("registration uncertainty stated", 0 < reg.PoseUncertaintyMm < 0.05,
+              reg.PoseUncertaintyMm)
+        commands.Register.show(reg)
+        window_shot("task_panel_registration")
+        Gui.Control.closeDialog()
+        dmap = commands.BY_NAME["BladeInspect_DeviationMap"].make(reg)
+        check("deviation map of every point", dmap.NPoints == reg.NPoints)
+        state["real_map"] = dmap.Name
+        view_shot("deviation_map_scan")
+        rows = commands.BY_NAME["BladeInspect_SectionAnalysis"].analyse(reg)
+        check("section analysis rows", bool(rows), progress.MESSAGES[-1:])
+        if rows:
+            Gui.Control.showDialog(commands.taskpanels.TablePanel("Section analysis", rows))
+            window_shot("task_panel_sections")
+            Gui.Control.closeDialog()
+        need("BladeInspect.inspect.report")
+        out = os.path.join(OUT, "report")
+        summary = commands.BY_NAME["BladeInspect_Report"].report(reg, out)
+        check("report written", summary is not None and
+              os.path.exists(os.path.join(out, "result.json")), progress.MESSAGES[-1:])
+
+    @step("deviation map of a known result, legend, save and reopen")
+    def _():
+        blade = state.get("blade")
+        if blade is None:
+            raise _Skip("no demo blade")
+        from BladeInspect.core.colormap import deviation_colors
+        result = _known_result(blade.Shape)
+        reg = objects.make_registration(doc, result, name="KnownRegistration")
+        Gui.Selection.clearSelection()
+        Gui.Selection.addSelection(reg)
+        check("deviation map command active", commands.BY_NAME["BladeInspect_DeviationMap"]
+              .IsActive())
+        Gui.runCommand("BladeInspect_DeviationMap")
+        settle()
+        dmap = [o for o in objects.find_objects(doc, "BladeInspect::DeviationMap")
+                if o.Registration == reg][0]
+        limit = dmap.Limit
+        check("colours follow deviations", np.allclose(
+            colours_of(dmap), deviation_colors(result.deviation, limit), atol=1e-6))
+        vobj = dmap.ViewObject
+        check("display mode Color", vobj.DisplayMode == "Color", vobj.DisplayMode)
+        check("legend in the scene", vobj.Proxy.legend is not None)
+        for other in doc.Objects:
+            if other not in (dmap, blade) and other.ViewObject is not None:
+                other.ViewObject.Visibility = False
+        blade.ViewObject.Visibility = True
+        blade.ViewObject.Transparency = 70
+        Gui.Selection.clearSelection()
+        view_shot("deviation_map_known")
+        path = os.path.join(OUT, "inspection.FCStd")
+        doc.saveAs(path)
+        name = dmap.Name
+        FreeCAD.closeDocument(doc.Name)
+        settle()
+        doc2 = FreeCAD.openDocument(path)
+        settle(0.5)
+        dmap2 = doc2.getObject(name)
+        check("reopened colours intact", np.allclose(
+            colours_of(dmap2), deviation_colors(result.deviation, limit), atol=0.5 / 255 + 1e-9))
+        check("reopened display mode Color", dmap2.ViewObject.DisplayMode == "Color")
+        check("reopened view provider and legend", isinstance(
+            dmap2.ViewObject.Proxy, viewproviders.ViewProviderDeviationMap)
+            and dmap2.ViewObject.Proxy.legend is not None)
+        reg2 = doc2.getObject("KnownRegistration")
+        check("reopened pose intact", np.allclose(
+            objects.matrix_array(reg2.MeasuredToCad), result.measured_to_cad, atol=1e-12))
+        view_shot("deviation_map_reopened")
+        Gui.ActiveDocument.setEdit(reg2.Name)
+        settle(0.3)
+        check("registration panel on double-click", _active_panel() is not None)
+        window_shot("task_panel_registration_known")
+        Gui.Control.closeDialog()
+
+    @step("preferences page reads and writes the parameters")
+    def _():
+        from BladeInspect.app import settings
+        from BladeInspect.gui.preferences import PreferencesPage
+        page = PreferencesPage()
+        page.widgets["ToleranceMm"].setValue(0.05)
+        page.widgets["Sides"].setCurrentText("suction")
+        page.saveSettings()
+        group = FreeCAD.ParamGet(settings.PARAM_PATH)
+        check("tolerance saved", abs(group.GetFloat("ToleranceMm") - 0.05) < 1e-12)
+        check("sides saved", group.GetString("Sides") == "suction")
+        check("colour limit falls back to tolerance", abs(settings.colour_limit() - 0.05) < 1e-12)
+        page.form.show()
+        page.form.resize(520, 420)
+        settle(0.3)
+        page.form.grab().save(os.path.join(OUT, "preferences.png"))
+
+    check("no tracebacks reached the user", not any(
+        "Traceback" in text for _, text in progress.MESSAGES), progress.MESSAGES)
+
+
+def _active_panel():
+    from BladeInspect.gui import taskpanels
+    for obj in __import__("gc").get_objects():
+        if isinstance(obj, (taskpanels._Panel, taskpanels.RegistrationPanel)) and \
+                obj.form.isVisible():
+            return obj
+    return None
+
+
+class _FakePoints:
+    def __init__(self, xyz):
+        self.xyz, self.snr, self.columns = xyz, None, {}
+        self.n_rows_skipped, self.source = 0, "fake"
+
+
+def _known_result(shape):
+    """Points on the blade's faces moved along their normals by a known deviation field
+    (a smooth wave over the span, both signs, beyond the colour limit at its peaks)."""
+    from BladeInspect.core.stats import deviation_statistics
+    from BladeInspect.inspect.result import RegistrationResult
+    pts, nrm = [], []
+    for face in shape.Faces:
+        if "Plane" in type(face.Surface).__name__:
+            continue   # hub and tip caps: trimmed planes, their parameter box is not the face
+        u0, u1, v0, v1 = face.ParameterRange
+        for u in np.linspace(u0, u1, 70):
+            for v in np.linspace(v0, v1, 40):
+                p = face.valueAt(u, v)
+                n = face.normalAt(u, v)
+                pts.append((p.x, p.y, p.z))
+                nrm.append((n.x, n.y, n.z))
+    pts, nrm = np.array(pts), np.array(nrm)
+    span = max(pts[:, 2].max() - pts[:, 2].min(), 1.0)
+    dev = 0.06 * np.sin(2 * np.pi * pts[:, 2] / span) * np.cos(np.pi * pts[:, 0] / span)
+    points = pts + dev[:, None] * nrm
+    n = len(points)
+    return RegistrationResult(
+        measured_to_cad=np.eye(4), points_cad=points, deviation=dev,
+        inlier=np.ones(n, bool), closest=pts, normal=nrm, face=np.zeros(n, int),
+        snr=None, columns={}, n_rows_skipped=0, rms_mm=float(np.sqrt(np.mean(dev ** 2))),
+        pose_covariance=np.eye(6) * 1e-8, center=pts.mean(axis=0), pose_uncertainty_mm=1e-4,
+        deviation_stats=deviation_statistics(dev), coarse={}, warnings=[])
+
+
+def main():
+    try:
+        run()
+    except Exception:
+        check("scenario ran", False, traceback.format_exc())
+    with open(os.path.join(OUT, "checks.json"), "w") as fh:
+        json.dump({"checks": CHECKS, "steps": STEPS}, fh, indent=1)
+    os._exit(0)
+
+
+QtCore.QTimer.singleShot(300, main)

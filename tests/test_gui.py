@@ -1,0 +1,78 @@
+"""The workbench in a real FreeCAD GUI under Xvfb: tests/gui_macro.py drives it (commands, task
+panels, colours, legend, save and reopen) in a subprocess and writes its checks as JSON, which
+this test asserts. Screenshots go to a temporary folder and are copied to
+/tmp/bladeinspect-screens for people to look at."""
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+from tests.helpers import REPO
+
+SCREENS = "/tmp/bladeinspect-screens"
+TIMEOUT_S = 150
+
+
+@unittest.skipUnless(shutil.which("xvfb-run") and shutil.which("freecad"),
+                     "xvfb-run or freecad missing: the GUI cannot be started headless")
+class TestWorkbenchGui(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="bi-gui-")
+        # A private home: FreeCAD's user settings stay untouched, and the workbench is installed
+        # there the way users install it (a link in the user Mod folder).
+        home = os.path.join(cls.tmp, "home")
+        env = dict(os.environ, HOME=home, QTWEBENGINE_DISABLE_SANDBOX="1",
+                   BI_GUI_OUT=cls.tmp, BI_REPO=REPO, FREECAD_USER_MOD=os.path.join(
+                       home, ".local", "share", "FreeCAD", "Mod"))
+        for key in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
+            env.pop(key, None)
+        subprocess.run([os.path.join(REPO, "scripts", "install-workbench.sh")], env=env,
+                       check=True, capture_output=True)
+        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
+               os.path.join(REPO, "tests", "gui_macro.py")]
+        with open(os.path.join(cls.tmp, "freecad.log"), "w") as log:
+            subprocess.run(cmd, env=env, stdout=log, stderr=subprocess.STDOUT,
+                           timeout=TIMEOUT_S, cwd=cls.tmp)
+        path = os.path.join(cls.tmp, "checks.json")
+        cls.report = json.load(open(path)) if os.path.exists(path) else None
+        os.makedirs(SCREENS, exist_ok=True)
+        for name in os.listdir(cls.tmp):
+            if name.endswith(".png"):
+                shutil.copy(os.path.join(cls.tmp, name), SCREENS)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_macro_ran_to_the_end(self):
+        log = open(os.path.join(self.tmp, "freecad.log")).read()[-3000:]
+        self.assertIsNotNone(self.report, "the GUI macro wrote no checks; log tail:\n" + log)
+
+    def test_every_check_passed(self):
+        self.assertIsNotNone(self.report)
+        failed = [c for c in self.report["checks"] if not c["ok"]]
+        self.assertEqual(failed, [], json.dumps(failed, indent=1))
+        self.assertGreater(len(self.report["checks"]), 15)
+
+    def test_scenario_steps_ran_or_say_why_not(self):
+        self.assertIsNotNone(self.report)
+        steps = self.report["steps"]
+        for name, info in steps.items():
+            print("  gui step %-80s %s" % (name, info))
+        for must in ("demo blade through its task panel",
+                     "deviation map of a known result, legend, save and reopen",
+                     "cancel leaves the document as it was"):
+            self.assertEqual(steps[must]["status"], "ran", steps[must])
+
+    def test_screenshots_saved(self):
+        for name in ("demo_blade", "task_panel_demo_blade", "deviation_map_known",
+                     "deviation_map_reopened", "task_panel_registration_known"):
+            path = os.path.join(self.tmp, name + ".png")
+            self.assertTrue(os.path.exists(path) and os.path.getsize(path) > 5000, name)
+
+
+if __name__ == "__main__":
+    unittest.main()
