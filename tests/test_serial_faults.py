@@ -11,9 +11,9 @@ from BladeInspect.rig.serial_rig import SerialRig
 from BladeInspect.rig.simrig_device import Fault, SimRigDevice
 from tests.serial_support import FakeSimulatedRig, section_path
 
-# Lines the driver sends before the first pass (ID; $H, G90G21) and around a pass's G1 blocks
-# (START, G0 A, G0 XYZ, F, M62, ..., M63, G4): a fault at CONNECT + HOME + 10 is mid-scan.
-CONNECT, HOME, MID_SCAN = 1, 2, 10
+# Lines the driver sends before the first pass ($I, ID; $H, G90G21) and around a pass's G1
+# blocks (START, G0 A, G0 XYZ, F, M62, ..., M63, G4): a fault at CONNECT + HOME + 10 is mid-scan.
+CONNECT, HOME, MID_SCAN = 2, 2, 10
 
 
 class SerialFaultTest(unittest.TestCase):

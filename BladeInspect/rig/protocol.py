@@ -10,6 +10,7 @@ these, so host and device can only disagree about the transport, never about the
 """
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,10 +86,14 @@ def format_number(value):
     value = float(value)
     if not math.isfinite(value):
         raise ProtocolError("coordinate %r is not a finite number" % value)
-    text = np.format_float_positional(value, unique=True, trim="-")
+    text = repr(value)      # shortest round-trip digits; fixed point unless tiny or huge
+    if "e" in text:
+        text = np.format_float_positional(value, unique=True, trim="-")
+    elif text.endswith(".0"):
+        text = text[:-2]
     if len(text) > _MAX_NUMBER_CHARS:
         text = ("%.*f" % (_FALLBACK_DECIMALS, value)).rstrip("0").rstrip(".")
-    return "0" if text == "-0" else text
+    return "0" if text in ("-0", "") else text
 
 
 def gcode_move(code, x=None, y=None, z=None, a=None, feed=None):
@@ -103,36 +108,27 @@ def gcode_move(code, x=None, y=None, z=None, a=None, feed=None):
     return line
 
 
+_COMMENTS = re.compile(r"\([^)]*\)|;.*")
+_WORD = re.compile(r"([A-Z])([-+]?[0-9]*\.?[0-9]*)")
+
+
 def parse_gcode(line):
     """A block's words as [(letter, value)], comments and spaces removed; ProtocolError carries
     the GRBL error number a controller would answer with."""
-    text = []
-    depth = 0
-    for ch in line:
-        if ch == "(":
-            depth += 1
-        elif ch == ")" and depth:
-            depth -= 1
-        elif ch == ";" and not depth:
-            break
-        elif not depth and not ch.isspace():
-            text.append(ch.upper())
-    text = "".join(text)
+    text = "".join(_COMMENTS.sub("", line).upper().split())
     words = []
-    i = 0
-    while i < len(text):
-        letter = text[i]
-        if not "A" <= letter <= "Z":
+    end = 0
+    for match in _WORD.finditer(text):
+        if match.start() != end:
             raise ProtocolError(1)
-        j = i + 1
-        while j < len(text) and (text[j].isdigit() or text[j] in ".+-"):
-            j += 1
+        letter, number = match.groups()
         try:
-            value = float(text[i + 1:j])
+            words.append((letter, float(number)))
         except ValueError:
             raise ProtocolError(2)
-        words.append((letter, value))
-        i = j
+        end = match.end()
+    if end != len(text):
+        raise ProtocolError(1 if not text[end].isdigit() and text[end] not in ".+-" else 2)
     return words
 
 
@@ -170,6 +166,19 @@ def parse_status(line):
                 raise ProtocolError("expected 4 axes X,Y,Z,A in %r" % line)
             return Status(state, values)
     raise ProtocolError("no MPos/WPos in %r" % line)
+
+
+def parse_build_options(info):
+    """The receive buffer size from ``$I``'s ``[OPT:<codes>,<blocks>,<rx bytes>,...]`` (GRBL 1.1
+    and grblHAL), or None when the line is not that or carries no size."""
+    if not info.startswith("OPT:"):
+        return None
+    fields = info[4:].split(",")
+    try:
+        size = int(fields[2])
+    except (IndexError, ValueError):
+        return None
+    return size if size > 0 else None
 
 
 def describe_error(code):

@@ -103,7 +103,7 @@ class SerialRig(Rig):
     (pty path, /dev/ttyUSB0, loop://, ...) carrying both protocols, or ``MOTION,SENSOR``."""
 
     def __init__(self, port_url, timeout_s=5, baud=115200, feed_mm_min=600.0,
-                 rx_buffer=pr.GRBL_RX_BUFFER, limits=None, sensor=None):
+                 rx_buffer=None, limits=None, sensor=None):
         if timeout_s is None or not timeout_s > 0:
             raise InputError("timeout_s: must be a positive number of seconds, got %r" % timeout_s)
         urls = [u.strip() for u in str(port_url).split(",")]
@@ -112,7 +112,11 @@ class SerialRig(Rig):
         self.port_url = port_url
         self.timeout_s = float(timeout_s)
         self.feed_mm_min = float(feed_mm_min)
-        self.rx_buffer = int(rx_buffer)
+        # Until $I reports the controller's receive buffer, assume GRBL 1.1's.
+        self.rx_buffer = pr.GRBL_RX_BUFFER
+        self._rx_buffer_forced = rx_buffer is not None
+        if rx_buffer is not None:
+            self.rx_buffer = int(rx_buffer)
         if limits is not None:
             self.limits = limits
         if sensor is not None:
@@ -246,6 +250,7 @@ class SerialRig(Rig):
         self._connecting = False
         # A reset by the port opening (DTR) may greet a second time: a status answer comes after.
         self._query_status()
+        self._stream(["$I"])
         if not self._shared:
             self._sensor_flushing = True
             self._sensor_command("STOP")
@@ -349,7 +354,11 @@ class SerialRig(Rig):
             if self._banner is not None and self._status is not None:
                 raise DeviceError("serial:%s: controller reset itself (%s)" % (self.port_url, line))
             self._banner = payload
-        # INFO lines ([MSG:...]) carry nothing the driver acts on.
+        elif kind == pr.INFO:
+            size = pr.parse_build_options(payload)
+            if size is not None and not self._rx_buffer_forced:
+                self.rx_buffer = size
+        # Other INFO lines ([MSG:...], [VER:...]) carry nothing the driver acts on.
 
     def _answered(self, channel, line):
         """Retire the oldest unanswered line of the channel; an answer nobody asked for is

@@ -67,12 +67,15 @@ class SimRigDevice:
     """Serves ``sim_rig`` (anything with measure(stage_xyz, angle_deg, pass_index) ->
     (reading, snr); limits, home() and position() are used when present) on one pty, or on
     two (motion, sensor) with ``two_ports``. ``limits`` overrides the controller's soft limits
-    (a controller set up tighter than the host believes)."""
+    (a controller set up tighter than the host believes). ``rx_buffer`` is the receive buffer
+    it reports in ``$I`` and holds the host to: 128 bytes as GRBL 1.1, 1024 as grblHAL."""
 
-    def __init__(self, sim_rig, two_ports=False, fault=None, limits=None):
+    def __init__(self, sim_rig, two_ports=False, fault=None, limits=None,
+                 rx_buffer=pr.GRBL_RX_BUFFER):
         self.sim_rig = sim_rig
         self.fault = fault
         self.limits = limits if limits is not None else getattr(sim_rig, "limits", None)
+        self.rx_buffer = int(rx_buffer)
         self.lines_received = 0
         self.overflows = 0          # bytes beyond the controller's RX buffer: a host bug
         self.passes = 0
@@ -167,7 +170,7 @@ class SimRigDevice:
                     self._send(pty, pr.format_status(self._state, self._position))
                 data = data.replace(b"?", b"")
             self._rx_pending += len(data)
-            if self._rx_pending > pr.GRBL_RX_BUFFER:
+            if self._rx_pending > self.rx_buffer:
                 self.overflows += 1
         pty.inbox += data
         *lines, pty.inbox = pty.inbox.split(b"\n")
@@ -319,6 +322,10 @@ class SimRigDevice:
             self._homed = True
             self._alarm_latched = False
             self._state = "Idle"
+            return self._reply("ok")
+        if line == "$I":
+            self._reply("[VER:1.1h.20190825:BladeInspect simulated rig]")
+            self._reply("[OPT:V,15,%d]" % self.rx_buffer)
             return self._reply("ok")
         if line == "$X":
             self._alarm_latched = False
