@@ -100,5 +100,43 @@ class SerialRigFakeTest(unittest.TestCase):
             SerialRig("loop://", timeout_s=0)
 
 
+class SerialRigSimulatedTest(unittest.TestCase):
+    """The real SimulatedRig (ray cast onto a part at a random fixture pose, sensor model,
+    noise per pass) behind the pty gives what it gives in process, pass for pass."""
+
+    def make_rig(self):
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        from tests.rig_parts import Sphere
+        pose = random_fixture_pose(np.random.default_rng(8), cad_center=(0, 60.0, 0))
+        return SimulatedRig(Sphere(40.0, center=[0, 60.0, 0]), pose, seed=21)
+
+    def test_scan_passes_identical_to_in_process(self):
+        device = SimRigDevice(self.make_rig()).start()
+        self.addCleanup(device.stop)
+        rig = SerialRig(device.port_url, timeout_s=3)
+        self.addCleanup(rig.close)
+        reference = self.make_rig()
+        self.assertEqual(rig.sensor.standoff, reference.sensor.standoff)
+        self.assertEqual(rig.sensor.half_range, reference.sensor.half_range)
+        rig.home()
+        reference.home()
+        self.assertEqual(rig.position(), reference.position())
+        rng = np.random.default_rng(2)
+        hits = 0
+        for angle in (0.0, 37.5, -90.0, 181.25):
+            path = np.column_stack([np.linspace(-30, 30, 250) + rng.uniform(-0.1, 0.1),
+                                    np.full(250, rng.uniform(40, 80)),
+                                    np.full(250, 80.0) + rng.normal(0, 0.5, 250)])
+            got, expected = rig.scan_path(path, angle), reference.scan_path(path, angle)
+            assert_same_readings(self, got, expected)
+            self.assertEqual(got.meta["pass_index"], expected.meta["pass_index"])
+            hits += np.isfinite(got.reading_mm).sum()
+        self.assertGreater(hits, 300)     # the comparison is about real surface readings
+        # A resumed scan numbers its passes as the uninterrupted one did.
+        rig.set_pass_index(1)
+        reference.set_pass_index(1)
+        assert_same_readings(self, rig.scan_path(path, 5.0), reference.scan_path(path, 5.0))
+
+
 if __name__ == "__main__":
     unittest.main()

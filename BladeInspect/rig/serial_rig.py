@@ -133,6 +133,7 @@ class SerialRig(Rig):
         self._inflight_bytes = 0
         self._sensor_answers = collections.deque()
         self._pass = None
+        self.pass_index = 0
         self.sensor_identity = None
         self._motion = _Port(urls[0], baud, "motion")
         try:
@@ -192,10 +193,12 @@ class SerialRig(Rig):
                 port.close()
 
     def set_pass_index(self, index):
-        """Sets the noise stream of a simulated sensor (docs/protocol.md, PASS), so a resumed
-        scan measures as the uninterrupted one would; a real sensor has no such thing and
-        answers BAD_COMMAND, which is ignored."""
-        self._sensor_command("PASS %d" % int(index), allow_errors=("BAD_COMMAND",))
+        """Numbers the next pass; a simulated sensor also takes it as its noise stream
+        (docs/protocol.md, PASS) so that a resumed scan measures as the uninterrupted one
+        would. A real sensor has no such thing and answers BAD_COMMAND, which is ignored."""
+        with self._timed():
+            self._sensor_command("PASS %d" % int(index), allow_errors=("BAD_COMMAND",))
+        self.pass_index = int(index)
 
     @contextlib.contextmanager
     def _timed(self):
@@ -239,8 +242,10 @@ class SerialRig(Rig):
                               % (self.port_url, state["count"], k))
         self._pass = None
         self._target = tuple(path[-1]) + (angle,)
+        index = self.pass_index
+        self.pass_index += 1
         return Readings(stage_xyz=path.copy(), angle_deg=angle, reading_mm=state["reading"],
-                        snr=state["snr"], meta={"port": self.port_url})
+                        snr=state["snr"], meta={"pass_index": index, "port": self.port_url})
 
     # -- transport ------------------------------------------------------------------------
 
@@ -256,6 +261,8 @@ class SerialRig(Rig):
             self._sensor_command("STOP")
             self._sensor_flushing = False
         self._sensor_command("ID")
+        if self.sensor is None:
+            self.sensor = _sensor_model(self.sensor_identity)
 
     def _ensure_homed(self):
         if not self._homed:
@@ -416,3 +423,16 @@ class SerialRig(Rig):
         state["count"] += 1
         state["reading"][index] = distance
         state["snr"][index] = snr if np.isfinite(distance) else 0.0
+
+
+def _sensor_model(identity):
+    """The planning model of the sensor, with what it says of itself in place of the defaults."""
+    from .sensor import SensorModel
+    known = {}
+    for key, field in (("standoff_mm", "standoff"), ("range_mm", "half_range"),
+                       ("rate_hz", "rate_hz")):
+        try:
+            known[field] = float(identity[key])
+        except (KeyError, ValueError):
+            pass    # an unknown or unreadable field keeps the model's default
+    return SensorModel(**known)
