@@ -90,5 +90,87 @@ class TestAxisFromCentres(unittest.TestCase):
             cal.axis_from_centres(np.eye(3)[:2], [0.0, 90.0])
 
 
+def simulated_sphere_rig(seed, offset_mm=0.2, tilt_deg=0.1, stage_scale=(0.0, 0.0, 0.0),
+                         position_error=2.0):
+    """A SimulatedRig whose TRUE axis is off the nominal by the given offset (in a random
+    direction across it) and tilt (in a random direction), the sphere mounted within
+    position_error of where calibrate() is told to look."""
+    from BladeInspect.core import transforms as tf
+    from BladeInspect.rig.kinematics import RigKinematics
+    from BladeInspect.rig.simulated import SimulatedRig
+    rng = np.random.default_rng(seed)
+    lean = rng.uniform(0, 2 * np.pi)
+    direction = tilted_axis(tilt_deg * np.cos(lean), tilt_deg * np.sin(lean))
+    shift = rng.uniform(0, 2 * np.pi)
+    point = offset_mm * np.array([np.cos(shift), 0.0, np.sin(shift)])
+    truth = RigKinematics(axis_point=point, axis_direction=direction, stage_scale=stage_scale)
+    mount = np.asarray(cal.DEFAULT_SPHERE_POSITION) + rng.uniform(-1, 1, 3) * position_error
+    rig = SimulatedRig(cal.SpherePart(12.5), tf.make_transform(np.eye(3), -mount),
+                       kinematics=truth, seed=seed)
+    return rig, truth
+
+
+class TestCalibrateOnSimulatedRig(unittest.TestCase):
+    def test_recovers_injected_offset_and_tilt(self):
+        for seed in range(4):
+            rig, truth = simulated_sphere_rig(seed)
+            result = cal.calibrate(rig, 25.0)
+            # The nominal axis passes through the origin, so the truth's point is where it
+            # crosses y = 0 as well: compare like with like.
+            self.assertLess(np.linalg.norm(np.subtract(result["axis_point"], truth.axis_point)),
+                            0.002, seed)
+            angle = np.degrees(np.arccos(np.clip(np.dot(result["axis_direction"],
+                                                        truth.axis_direction), -1, 1)))
+            self.assertLess(angle, 0.001, seed)
+            self.assertAlmostEqual(result["measured_diameter_mm"], 25.0, delta=0.01)
+
+    def test_rig_json_round_trip(self):
+        from BladeInspect.rig.kinematics import RigKinematics
+        rig, truth = simulated_sphere_rig(7)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "RIG.json")
+            result = cal.calibrate(rig, 25.0, out_path=path)
+            loaded = RigKinematics.from_json(path)
+            np.testing.assert_allclose(loaded.axis_point, result["axis_point"], atol=1e-12)
+            np.testing.assert_allclose(loaded.axis_direction, result["axis_direction"], atol=1e-12)
+            self.assertEqual(os.listdir(tmp), ["RIG.json"])
+            json.dumps({k: v for k, v in result.items() if k != "kinematics"})
+
+    def test_residual_returns_to_noise_with_calibration(self):
+        from BladeInspect.rig.kinematics import RigKinematics
+        rig, truth = simulated_sphere_rig(3)
+        calibrated = cal.calibrate(rig, 25.0)["kinematics"]
+        angles = (0.0, 60.0, 120.0, 180.0, 240.0, 300.0)
+        before = cal.sphere_residual(rig, RigKinematics(), angles=angles)
+        after = cal.sphere_residual(rig, calibrated, angles=angles)
+        # The sensor's own noise at these readings (head-on to ~35 deg): sigma(SNR).
+        noise = rig.sensor.sigma(rig.sensor.snr(np.full(1, 44.0), np.radians([20.0])))[0]
+        self.assertGreater(before["rms_mm"], 10 * after["rms_mm"])
+        self.assertLess(abs(after["rms_mm"] - noise), 0.2 * noise)
+
+    def test_stage_error_shows_in_the_circle_residual(self):
+        clean = cal.calibrate(simulated_sphere_rig(5)[0], 25.0)
+        scaled = cal.calibrate(simulated_sphere_rig(5, stage_scale=(2e-4, 0.0, -2e-4))[0], 25.0)
+        self.assertGreater(scaled["circle_residual_rms_mm"], 5 * clean["circle_residual_rms_mm"])
+
+    def test_sphere_not_found(self):
+        rig, _ = simulated_sphere_rig(1)
+        with self.assertRaises(InputError) as ctx:
+            cal.calibrate(rig, 25.0, sphere_position=(60.0, 100.0, 0.0))
+        message = str(ctx.exception)
+        self.assertIn("sphere not found", message)
+        self.assertNotIn("\n", message)
+
+    def test_wrong_diameter_and_too_few_angles(self):
+        rig, _ = simulated_sphere_rig(2)
+        with self.assertRaises(InputError) as ctx:
+            cal.calibrate(rig, 24.0)
+        self.assertIn("--sphere-diameter", str(ctx.exception))
+        with self.assertRaises(InputError):
+            cal.calibrate(rig, 25.0, angles=(0, 90, 180))
+        with self.assertRaises(InputError):
+            cal.calibrate(rig, -1.0)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -14,21 +14,21 @@ and with the diameter known the centre follows from a cap seen from above alone.
 import numpy as np
 
 from ..core import fitting
-from ..core import transforms as tf
 from ..core.errors import InputError
+from .kinematics import RigKinematics
 
 DEFAULT_DIAMETER = 25.0
-# Eight angles round the full turn: the centres then span the whole circle, which makes the
+# Twelve angles round the full turn: the centres then span the whole circle, which makes the
 # circle's normal (the axis direction) as well determined as a fixed sphere offset allows.
-DEFAULT_ANGLES = tuple(float(a) for a in range(0, 360, 45))
+DEFAULT_ANGLES = tuple(float(a) for a in range(0, 360, 30))
 # Where the sphere is mounted in the table frame: off the axis (the circle's radius sets how
 # well its normal is known) and along it, within a few mm; the first raster finds it exactly.
-DEFAULT_SPHERE_POSITION = (40.0, 30.0, 0.0)
+DEFAULT_SPHERE_POSITION = (60.0, 30.0, 0.0)
 MIN_CAP_POINTS = 20
 # Raster half-width as a fraction of the radius: incidence up to about 35 deg keeps the SNR
 # high and the cap deep enough (about 2 mm) to separate centre depth from radius.
 CAP_FRACTION = 0.6
-RASTER_LINES = 15
+RASTER_LINES = 21
 # Residuals beyond this many robust sigmas are gross sensor errors, not the sphere.
 OUTLIER_SIGMAS = 5.0
 MAX_RECENTRE_PASSES = 3
@@ -69,15 +69,6 @@ class SpherePart:
         return t, np.zeros(len(t), dtype=int), normal
 
 
-def rotate_about_axis(points, angle_deg, axis_point, axis_direction):
-    """Turn points by angle_deg (right hand about the direction) about the axis line."""
-    u = np.asarray(axis_direction, dtype=float)
-    u = u / np.linalg.norm(u)
-    R = tf.rotation_from_vector(u * np.radians(angle_deg))
-    p = np.asarray(axis_point, dtype=float)
-    return (np.atleast_2d(points) - p) @ R.T + p
-
-
 def raster_path(center_xy, half_width, z, lines=RASTER_LINES):
     """Serpentine raster of lines along X at fixed Y (the rig's scan direction): (K, 3)."""
     offsets = np.linspace(-half_width, half_width, lines)
@@ -106,11 +97,10 @@ def measure_sphere_centre(rig, angle_deg, predicted_centre, radius, standoff,
     """Raster the cap above the predicted centre, fit the centre, re-centre the raster on it and
     repeat until it stays put. Returns (centre (3,), SphereFit, cap points (K,3), info dict).
 
-    ``machine_point(stage_xyz, reading)`` maps readings to machine points (default: the
-    convention of rig.base, (X, Y, Z - d))."""
+    ``machine_point(stage_xyz, reading)`` maps readings to machine points (default: nominal
+    stages, (X, Y, Z - d))."""
     if machine_point is None:
-        def machine_point(stage, reading):
-            return stage - np.column_stack([np.zeros((len(stage), 2)), reading])
+        machine_point = RigKinematics().machine_point
     centre = np.asarray(predicted_centre, dtype=float)
     half = CAP_FRACTION * radius
     passes = []
@@ -166,9 +156,10 @@ def axis_from_centres(centres, angles_deg):
         raise InputError("calibration: the fitted axis is not along Y (direction %s)"
                          % np.array2string(n, precision=4))
     point = o - (o[1] / n[1]) * n
-    table = np.array([rotate_about_axis(c, -a, point, n)[0] for c, a in zip(centres, angles)])
+    fitted = RigKinematics(axis_point=point, axis_direction=n)
+    table = np.array([fitted.table_point(c, a)[0] for c, a in zip(centres, angles)])
     mean_table = table.mean(axis=0)
-    predicted = np.array([rotate_about_axis(mean_table, a, point, n)[0] for a in angles])
+    predicted = np.array([fitted.machine_point_of_table(mean_table, a)[0] for a in angles])
     return {"point": point, "direction": n, "circle": circle,
             "angle_model_residual_mm": np.linalg.norm(predicted - centres, axis=1)}
 
@@ -193,7 +184,6 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
     it only predicts where to look for the sphere, and the result is a copy of it with the
     measured axis. ``sphere_position`` is the sphere's approximate centre in the table frame.
     Returns a dict of results (JSON-ready) with the new kinematics under ``kinematics``."""
-    from .kinematics import RigKinematics
     if not (np.isfinite(sphere_diameter) and sphere_diameter > 0):
         raise InputError("--sphere-diameter: must be a positive number of mm, got %r"
                          % (sphere_diameter,))
@@ -204,14 +194,12 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
     prior = kinematics if kinematics is not None else RigKinematics()
     radius = 0.5 * float(sphere_diameter)
     standoff = float(rig.sensor.standoff)
-    axis_point0, axis_dir0 = _kinematics_axis(prior)
     centres, per_angle, diameters = [], [], []
     for i, a in enumerate(angles):
         progress(i / len(angles), "calibration: sphere at A=%.1f deg" % a)
-        predicted = rotate_about_axis(np.asarray(sphere_position, float), a, axis_point0,
-                                      axis_dir0)[0]
+        predicted = prior.machine_point_of_table(np.asarray(sphere_position, float), a)[0]
         centre, fit, pts, info = measure_sphere_centre(rig, a, predicted, radius, standoff,
-                                                       machine_point=_machine_point_fn(prior))
+                                                       machine_point=prior.machine_point)
         free = fitting.fit_sphere(pts)
         diameters.append(2.0 * free.radius)
         centres.append(centre)
@@ -249,15 +237,6 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
     }
 
 
-def _kinematics_axis(kinematics):
-    d = np.asarray(kinematics.axis_direction, dtype=float)
-    return np.asarray(kinematics.axis_point, dtype=float), d / np.linalg.norm(d)
-
-
-def _machine_point_fn(kinematics):
-    return kinematics.machine_point
-
-
 def _with_axis(kinematics, point, direction):
     import copy
     out = copy.deepcopy(kinematics)
@@ -280,3 +259,32 @@ def _write_atomically(path, kinematics):
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
+
+
+def sphere_residual(rig, kinematics, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES,
+                    sphere_position=DEFAULT_SPHERE_POSITION):
+    """How well a kinematics joins readings from several rotary angles: the sphere's cap is
+    scanned at each angle, all points are turned into the table frame by ``kinematics`` and one
+    sphere of the known diameter is fitted to them together. With the true axis the caps
+    coincide and the residual is the sensor's noise; with a wrong axis each angle's cap sits
+    elsewhere and the residual grows. Returns {rms_mm, n_points, centre_table}."""
+    radius = 0.5 * float(sphere_diameter)
+    standoff = float(rig.sensor.standoff)
+    table_pts, weights = [], []
+    for a in angles:
+        predicted = kinematics.machine_point_of_table(np.asarray(sphere_position, float), a)[0]
+        centre, _, _, _ = measure_sphere_centre(rig, a, predicted, radius, standoff,
+                                                machine_point=kinematics.machine_point)
+        path = raster_path(centre[:2], CAP_FRACTION * radius, centre[2] + radius + standoff)
+        readings = rig.scan_path(path, a)
+        valid = np.isfinite(readings.reading_mm)
+        machine = kinematics.machine_point(np.asarray(readings.stage_xyz)[valid],
+                                           np.asarray(readings.reading_mm)[valid])
+        table_pts.append(kinematics.table_point(machine, a))
+        weights.append(np.asarray(readings.snr)[valid])
+    pts, snr = np.vstack(table_pts), np.concatenate(weights)
+    # No outlier rejection here: it would hide exactly the misfit this figure is meant to show
+    # (the raster stays below 35 deg incidence, where the sensor gives no gross errors).
+    fit = fitting.fit_sphere(pts, radius=radius, weights=snr)
+    return {"rms_mm": float(np.sqrt(np.mean(fit.residuals ** 2))),
+            "n_points": int(len(pts)), "centre_table": fit.center.tolist()}
