@@ -148,6 +148,93 @@ def run():
         check("no progress widgets left", not Gui.getMainWindow().statusBar().findChildren(
             QtGui.QProgressBar, "BladeInspectProgress"))
 
+    @step("import simulated points, register, deviation map")
+    def _():
+        for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
+                       "BladeInspect.inspect.simulate"):
+            need(module)
+        from BladeInspect.core.pointio import write_points_csv
+        from BladeInspect.core import transforms as tf
+        from BladeInspect.inspect.simulate import simulate_measurement
+        blade = state["blade"]
+        nominal = objects.nominal_of(blade)
+        ps, truth, info, _ = simulate_measurement(nominal, n_points=3000, seed=3,
+                                                  section_heights=())
+        path = os.path.join(OUT, "simulated.csv")
+        write_points_csv(path, ps.xyz, {"snr": ps.snr})
+        commands.ask_open_file = lambda *a: path
+        Gui.runCommand("BladeInspect_ImportPoints")
+        meas = objects.find_objects(doc, "BladeInspect::Measurement")
+        check("points imported", len(meas) == 1 and meas[0].NPoints == len(ps.xyz),
+              progress.MESSAGES[-1:])
+        meas = meas[0]
+        check("register active with blade and points",
+              commands.BY_NAME["BladeInspect_Register"].IsActive())
+        Gui.Selection.clearSelection()
+        Gui.runCommand("BladeInspect_Register")
+        regs = objects.find_objects(doc, "BladeInspect::Registration")
+        check("registration made", len(regs) == 1, progress.MESSAGES[-1:])
+        reg = regs[0]
+        error = tf.corner_displacement(objects.matrix_array(reg.MeasuredToCad), truth,
+                                       nominal.bbox_corners)
+        check("registered pose matches the simulation's truth", error < 0.005, error)
+        check("uncertainty stated and consistent", 0 < reg.PoseUncertaintyMm < 0.005
+              and error < 5 * reg.PoseUncertaintyMm + 1e-4, (error, reg.PoseUncertaintyMm))
+        check("rms near the injected noise",
+              abs(reg.RmsMm - info["noise_rms_injected_mm"]) < 0.001,
+              (reg.RmsMm, info["noise_rms_injected_mm"]))
+        window_shot("task_panel_registration")
+        Gui.Control.closeDialog()
+        Gui.runCommand("BladeInspect_DeviationMap")
+        maps = objects.find_objects(doc, "BladeInspect::DeviationMap")
+        check("deviation map of every point", len(maps) == 1 and maps[0].NPoints == reg.NPoints
+              and len(maps[0].Color) == reg.NPoints, progress.MESSAGES[-1:])
+        blade.ViewObject.Transparency = 60
+        view_shot("deviation_map_simulated")
+        state["reg"], state["nominal"] = reg, nominal
+
+    @step("section analysis of the registration")
+    def _():
+        need("BladeInspect.cad.sections")
+        need("BladeInspect.inspect.report")
+        if "reg" not in state:
+            raise _Skip("no registration made")
+        reg = state["reg"]
+        table = commands.BY_NAME["BladeInspect_SectionAnalysis"].analyse(reg)
+        check("section analysis made", table is not None and len(table.sections) > 0,
+              progress.MESSAGES[-1:])
+        if table is not None:
+            commands.SectionAnalysis.show(table)
+            window_shot("task_panel_sections")
+            Gui.Control.closeDialog()
+
+    @step("report of the registration")
+    def _():
+        need("BladeInspect.inspect.report")
+        need("BladeInspect.inspect.document")
+        if "reg" not in state:
+            raise _Skip("no registration made")
+        reg, nominal = state["reg"], state["nominal"]
+        from BladeInspect.core import transforms as tf
+        out = os.path.join(OUT, "report")
+        summary = commands.BY_NAME["BladeInspect_Report"].report(reg, out)
+        check("report written", summary is not None and
+              os.path.exists(os.path.join(out, "result.json")), progress.MESSAGES[-1:])
+        if summary is not None:
+            with open(os.path.join(out, "result.json")) as fh:
+                T = np.array(json.load(fh)["measured_to_cad"])
+            check("report's pose is the document's", tf.corner_displacement(
+                T, objects.matrix_array(reg.MeasuredToCad), nominal.bbox_corners) < 1e-4)
+
+    @step("clear the imported measurement's objects")
+    def _():
+        for obj in list(doc.Objects):
+            if objects.proxy_type(obj) in ("BladeInspect::Measurement",
+                                           "BladeInspect::Registration",
+                                           "BladeInspect::DeviationMap") or \
+                    obj.Name.startswith("SectionProfiles"):
+                doc.removeObject(obj.Name)
+
     @step("real pipeline: rig, scan, reconstruct, register, deviation map, sections, report")
     def _():
         for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
@@ -177,19 +264,28 @@ def run():
         check("registration uncertainty stated", 0 < reg.PoseUncertaintyMm < 0.05,
               reg.PoseUncertaintyMm)
         commands.Register.show(reg)
-        window_shot("task_panel_registration")
+        window_shot("task_panel_registration_scan")
         Gui.Control.closeDialog()
         dmap = commands.BY_NAME["BladeInspect_DeviationMap"].make(reg)
         check("deviation map of every point", dmap.NPoints == reg.NPoints)
         state["real_map"] = dmap.Name
         view_shot("deviation_map_scan")
         rows = commands.BY_NAME["BladeInspect_SectionAnalysis"].analyse(reg)
-        check("section analysis rows", bool(rows), progress.MESSAGES[-1:])
+        check("section analysis rows", rows is not None, progress.MESSAGES[-1:])
         if rows:
-            Gui.Control.showDialog(commands.taskpanels.TablePanel("Section analysis", rows))
-            window_shot("task_panel_sections")
+            commands.SectionAnalysis.show(rows)
+            window_shot("task_panel_sections_scan")
             Gui.Control.closeDialog()
         need("BladeInspect.inspect.report")
+
+    @step("report of the registration")
+    def _():
+        need("BladeInspect.inspect.report")
+        need("BladeInspect.inspect.document")
+        if "reg" not in state:
+            raise _Skip("no registration made")
+        reg, nominal = state["reg"], state["nominal"]
+        from BladeInspect.core import transforms as tf
         out = os.path.join(OUT, "report")
         summary = commands.BY_NAME["BladeInspect_Report"].report(reg, out)
         check("report written", summary is not None and

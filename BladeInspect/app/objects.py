@@ -645,3 +645,35 @@ def registration_result(obj, nominal):
         coarse=json.loads(obj.CoarseJson or "{}"), warnings=list(obj.Warnings),
         source=obj.Measurement.SourceFile if obj.Measurement is not None else "",
         cad_source=obj.Nominal.Label if obj.Nominal is not None else "")
+
+
+def make_section_profiles(doc, table, registration=None, name="SectionProfiles"):
+    """The nominal section profiles of a section table (inspect.sections) as Part polylines, one
+    compound, for showing where the sections were cut. A snapshot: made again by the command."""
+    import Part
+    edges = []
+    labels = []
+    for section in table.sections:
+        if section.profile is None:
+            continue
+        for poly in section.profile.polylines:
+            poly = np.asarray(poly, dtype=float)
+            if len(poly) >= 2:
+                edges.append(Part.makePolygon([FreeCAD.Vector(*p) for p in poly]))
+        labels.append(section.label)
+    if not edges:
+        raise InputError("section analysis: no section plane cuts the nominal")
+    with building(doc, "Section profiles"):
+        obj = doc.addObject("Part::Feature", name)
+        obj.Shape = Part.Compound(edges)
+        obj.addProperty("App::PropertyStringList", "Sections", "Sections",
+                        "Labels of the sections cut")
+        obj.Sections = labels
+        if registration is not None:
+            obj.addProperty("App::PropertyLink", "Registration", "Sections",
+                            "Registration the sections were analysed for")
+            obj.Registration = registration
+        if obj.ViewObject is not None:
+            obj.ViewObject.LineColor = (0.8, 0.1, 0.1)
+            obj.ViewObject.LineWidth = 3
+    return obj

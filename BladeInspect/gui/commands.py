@@ -326,36 +326,44 @@ class SectionAnalysis(_Command):
     tip = "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge"
 
     def ready(self):
-        return find_input((objects.Registration.Type,)) is not None
+        reg = find_input((objects.Registration.Type,))
+        return reg is not None and reg.Nominal is not None
 
     def Activated(self):
-        rows = self.analyse(find_input((objects.Registration.Type,)))
-        if rows:
-            FreeCADGui.Control.closeDialog()
-            FreeCADGui.Control.showDialog(taskpanels.TablePanel("Section analysis", rows))
+        table = self.analyse(find_input((objects.Registration.Type,)))
+        if table is not None:
+            self.show(table)
 
     def analyse(self, registration):
+        """The section table of a registration (inspect.sections), its nominal profiles added
+        to the document; None when it failed (reported)."""
         from ..inspect.sections import section_table
+        doc = registration.Document
 
         def job(p):
             if registration.Nominal is None:
                 raise InputError("%s: no nominal linked" % registration.Label)
             nominal = objects.nominal_of(registration.Nominal)
-            p(0.2, "rebuilding the registration result")
+            p(0.2, "signed distances of the registered points")
             result = objects.registration_result(registration, nominal)
             p(0.5, "cutting sections")
-            return section_rows(section_table(result, nominal))
-        return progress.run("Section analysis", job)
+            table = section_table(result, nominal)
+            objects.make_section_profiles(doc, table, registration)
+            return table
+        table = progress.run("Section analysis", job)
+        if table is not None:
+            doc.recompute()
+            for warning in table.warnings:
+                FreeCAD.Console.PrintWarning("BladeInspect: %s\n" % warning)
+        return table
 
-
-def section_rows(table):
-    """section_table's output as a list of plain dict rows."""
-    if isinstance(table, dict):
-        table = table.get("sections", table.get("rows", []))
-    rows = []
-    for row in table:
-        rows.append(row if isinstance(row, dict) else dict(vars(row)))
-    return rows
+    @staticmethod
+    def show(table):
+        from ..inspect.report import section_rows
+        header, rows = section_rows(table)
+        FreeCADGui.Control.closeDialog()
+        FreeCADGui.Control.showDialog(taskpanels.TablePanel(
+            "Section analysis", header, rows, "; ".join(table.warnings)))
 
 
 class Report(_Command):
@@ -395,7 +403,8 @@ class Report(_Command):
                 write_points_csv(points_path, ps.xyz, columns)
             return run_report(cad_path, points_path, out_dir,
                               tolerance=settings.value("ToleranceMm"),
-                              seed=registration.Seed, progress=p)
+                              seed=registration.Seed, progress=p,
+                              nominal=objects.nominal_of(registration.Nominal))
         return progress.run("Report", job)
 
 

@@ -196,18 +196,17 @@ class RegistrationPanel:
 
 
 class TablePanel:
-    """A list of rows (dicts) as a table: the section analysis."""
+    """A table of text cells with its header: the section analysis."""
 
-    def __init__(self, title, rows, note=""):
+    def __init__(self, title, header, rows, note=""):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
-        columns = [k for k, v in rows[0].items() if _is_scalar(v)] if rows else []
-        self.table = QtGui.QTableWidget(len(rows), len(columns))
-        self.table.setHorizontalHeaderLabels(columns)
+        self.table = QtGui.QTableWidget(len(rows), len(header))
+        self.table.setHorizontalHeaderLabels(list(header))
         for r, row in enumerate(rows):
-            for c, key in enumerate(columns):
-                self.table.setItem(r, c, QtGui.QTableWidgetItem(_format(row.get(key))))
+            for c, cell in enumerate(row):
+                self.table.setItem(r, c, QtGui.QTableWidgetItem(str(cell)))
         self.table.resizeColumnsToContents()
         self.table.setMinimumHeight(260)
         layout.addWidget(self.table)
@@ -222,15 +221,3 @@ class TablePanel:
     def reject(self):
         FreeCADGui.Control.closeDialog()
         return True
-
-
-def _is_scalar(value):
-    return value is None or isinstance(value, (int, float, str, bool))
-
-
-def _format(value):
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return "%.4f" % value
-    return str(value)
