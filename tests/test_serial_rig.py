@@ -138,5 +138,35 @@ class SerialRigSimulatedTest(unittest.TestCase):
         assert_same_readings(self, rig.scan_path(path, 5.0), reference.scan_path(path, 5.0))
 
 
+class SimrigCommandTest(unittest.TestCase):
+    """``simrig_main`` in its own process, as ``./bladeinspect simrig --seed S`` runs it: the
+    printed port reaches a rig holding the demo blade, measuring as it does in process."""
+
+    def test_served_demo_blade_matches_in_process(self):
+        import os
+        import signal
+        import subprocess
+        import sys
+        from BladeInspect.rig.simrig_device import _load_nominal, simulated_rig_for
+        from tests.helpers import REPO
+        env = dict(os.environ, PYTHONPATH=REPO + ":/usr/lib/freecad-python3/lib")
+        server = subprocess.Popen(
+            ["/usr/bin/python3", "-c", "from BladeInspect.rig.simrig_device import simrig_main;"
+             " simrig_main(None, 3)"], cwd=REPO, env=env, stdout=subprocess.PIPE, text=True)
+        self.addCleanup(server.wait, 10)
+        self.addCleanup(server.send_signal, signal.SIGTERM)
+        first = server.stdout.readline()
+        self.assertRegex(first, r"^simulated rig \(seed 3\) on /dev/pts/\d+$")
+        rig = SerialRig(first.split()[-1], timeout_s=10)
+        self.addCleanup(rig.close)
+        reference = simulated_rig_for(_load_nominal(None), 3)
+        rig.home()
+        reference.home()
+        path = np.column_stack([np.linspace(-40, 40, 120), np.full(120, 60.0), np.full(120, 60.0)])
+        got, expected = rig.scan_path(path, 30.0), reference.scan_path(path, 30.0)
+        assert_same_readings(self, got, expected)
+        self.assertGreater(np.isfinite(got.reading_mm).sum(), 5)
+
+
 if __name__ == "__main__":
     unittest.main()

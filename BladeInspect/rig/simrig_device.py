@@ -396,24 +396,39 @@ class SimRigDevice:
         self._stage = []
 
 
+def simulated_rig_for(nominal, seed=0, **rig_options):
+    """A SimulatedRig of the nominal clamped at a random pose drawn from the seed: the span
+    (the bounding box's longest side) along the rotary axis, its centre near the axis."""
+    from .simulated import SimulatedRig, random_fixture_pose
+    corners = np.asarray(nominal.bbox_corners, dtype=float)
+    extent = corners.max(axis=0) - corners.min(axis=0)
+    span_axis = np.eye(3)[int(np.argmax(extent))]
+    centre = 0.5 * (corners.max(axis=0) + corners.min(axis=0))
+    pose = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=span_axis,
+                               cad_center=centre)
+    return SimulatedRig(nominal, pose, seed=seed, **rig_options)
+
+
 def run_simrig(nominal=None, seed=0, two_ports=False, stream=None, **rig_options):
     """Serve a SimulatedRig of ``nominal`` (None: the demo blade) on a pseudo-terminal, print
-    the port to give ``--rig serial:...`` and serve until interrupted (Ctrl-C)."""
-    from .simulated import SimulatedRig
+    the port to give ``--rig serial:...`` and serve until interrupted (Ctrl-C, SIGTERM)."""
+    import signal
     stream = stream or sys.stdout
     if nominal is None:
         nominal = _load_nominal(None)
-    device = SimRigDevice(SimulatedRig(nominal, seed=seed, **rig_options), two_ports=two_ports)
+    device = SimRigDevice(simulated_rig_for(nominal, seed, **rig_options), two_ports=two_ports)
     device.start()
     stream.write("simulated rig (seed %d) on %s\n" % (seed, device.port_url))
     stream.write("scan with: ./bladeinspect scan --rig serial:%s --out DIR\n" % device.port_url)
     stream.flush()
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         while device._thread.is_alive():
             time.sleep(0.2)
     except KeyboardInterrupt:
         pass
     finally:
+        signal.signal(signal.SIGTERM, previous)
         device.stop()
     return 0
 
