@@ -1,0 +1,559 @@
+"""The inspection report (paper 4.2-4.3, Tables 2-3, Figs 8-12): one self-contained report.html
+(figures embedded as base64 PNG) and the same content as a multi-page report.pdf.
+
+Contents: the verdict, the pose and its uncertainty, three views of the colour-mapped points
+with a legend, the deviation histogram with +-sigma and +-3 sigma, the Table 3 band table, the
+Table 2 section table (with CMM columns when a CMM file was given) and one whisker plot per
+section (nominal profile, deviations drawn along the normal, magnified).
+
+Figures are drawn once with matplotlib's Agg backend and saved to both files, so the HTML and
+the PDF cannot disagree. ``run_report`` is the whole `report` command.
+"""
+
+import base64
+import datetime
+import html
+import io
+import os
+import time
+
+import numpy as np
+
+from ..core import colormap
+from ..core.errors import InputError
+from . import sections as sections_mod
+from . import verdict as verdict_mod
+
+# Enough points for a faithful picture; more only costs time and PDF size.
+MAX_VIEW_POINTS = 60000
+MAX_WHISKERS = 1500
+DPI = 110
+PDF_DPI = 150
+
+PAGE_TITLES = ("Summary", "Deviation map", "Deviation histogram (Table 3)",
+               "Section profile errors (Table 2)")
+
+
+def _mpl():
+    import matplotlib
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap, Normalize
+    return plt, ListedColormap, Normalize
+
+
+def _cmap_and_norm(limit):
+    _, ListedColormap, Normalize = _mpl()
+    return ListedColormap(colormap.colormap_table(), name="bladeinspect"), \
+        Normalize(-limit, limit)
+
+
+def _add_legend(fig, ax_or_axes, limit, label="deviation (mm), + outside material", cax=None):
+    from matplotlib.cm import ScalarMappable
+    cmap, norm = _cmap_and_norm(limit)
+    mappable = ScalarMappable(norm=norm, cmap=cmap)
+    if cax is not None:
+        bar = fig.colorbar(mappable, cax=cax)
+    else:
+        bar = fig.colorbar(mappable, ax=ax_or_axes, fraction=0.035, pad=0.02)
+    values, _ = colormap.legend_ticks(limit)
+    bar.set_ticks(values)
+    bar.set_ticklabels(["%+.3f" % v if v else "0" for v in values])
+    bar.set_label(label)
+    return bar
+
+
+# ---------------------------------------------------------------- figures
+
+def _view_frame(result, table):
+    """Three orthonormal directions: span (hub->tip), chord of the mid-span section and the
+    direction from the pressure to the suction side, so the views face the blade squarely."""
+    span = table.span_axis
+    mid = None
+    with_profile = [s for s in table.sections if s.profile is not None]
+    if with_profile:
+        mid = with_profile[len(with_profile) // 2].profile
+    if mid is not None:
+        chord = mid.chord_dir - (mid.chord_dir @ span) * span
+    else:
+        d = result.points_cad - result.points_cad.mean(axis=0)
+        d -= np.outer(d @ span, span)
+        chord = np.linalg.svd(d, full_matrices=False)[2][0]
+    chord /= np.linalg.norm(chord)
+    across = np.cross(span, chord)
+    if mid is not None and mid.side_tree is not None:
+        suction = mid.side_label == "suction"
+        if suction.any() and (~suction).any():
+            cross_coord = mid.side_tree.data[:, 1]
+            to_suction = np.sign(cross_coord[suction].mean() - cross_coord[~suction].mean())
+            if (across @ mid.cross_dir) * to_suction < 0:
+                across = -across
+    return span, chord, across
+
+
+def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
+    """An orthographic z-buffered picture of coloured points: (RGBA image (H, W, 4), extent
+    (left, right, bottom, top) in mm). Each point covers a (2 splat + 1)^2 pixel square and
+    the point nearest the viewer wins a pixel, so the visible surface hides the far one; a
+    numpy sort, not a plotting call per point, so a full blade draws in a fraction of a
+    second."""
+    u, v, depth = xyz @ right, xyz @ up, xyz @ toward_viewer
+    pad = (splat + 1) / px_per_mm
+    u0, v1 = u.min() - pad, v.max() + pad
+    width = int(np.ceil((u.max() + pad - u0) * px_per_mm)) + 1
+    height = int(np.ceil((v1 - (v.min() - pad)) * px_per_mm)) + 1
+    col = np.floor((u - u0) * px_per_mm).astype(np.int64)
+    row = np.floor((v1 - v) * px_per_mm).astype(np.int64)
+    offsets = np.arange(-splat, splat + 1)
+    pix, dep, src = [], [], []
+    for dr in offsets:
+        for dc in offsets:
+            pix.append((row + dr) * width + (col + dc))
+            dep.append(depth)
+            src.append(np.arange(len(xyz)))
+    pix, dep, src = np.concatenate(pix), np.concatenate(dep), np.concatenate(src)
+    order = np.lexsort((dep, pix))
+    pix, src = pix[order], src[order]
+    last = np.r_[pix[1:] != pix[:-1], True]       # nearest point of each pixel
+    image = np.ones((height * width, 4))
+    image[:, 3] = 0.0
+    image[pix[last], :3] = colors[src[last]]
+    image[pix[last], 3] = 1.0
+    extent = (u0, u0 + width / px_per_mm, v1 - height / px_per_mm, v1)
+    return image.reshape(height, width, 4), extent
+
+
+def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS * 4, seed=0):
+    """Three orthographic views of the points coloured by deviation, with the colour legend."""
+    plt, _, _ = _mpl()
+    xyz = result.points_cad
+    dev = result.deviation
+    if len(xyz) > max_points:
+        keep = np.sort(np.random.default_rng(seed).choice(len(xyz), max_points, replace=False))
+        xyz, dev = xyz[keep], dev[keep]
+    span, chord, across = _view_frame(result, table)
+    colors = colormap.deviation_colors(dev, limit)
+    # (title, right, up, toward the viewer), each right-handed so no view is mirrored
+    views = (("suction side", -chord, span, across),
+             ("pressure side", chord, span, -across),
+             ("from the tip", chord, across, span))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 5.2),
+                             gridspec_kw={"width_ratios": [1, 1, 1.2]})
+    fig.subplots_adjust(left=0.04, right=0.88, bottom=0.1, top=0.88, wspace=0.25)
+    extent_mm = np.ptp(xyz @ np.column_stack([chord, span, across]), axis=0).max()
+    px_per_mm = 900.0 / max(extent_mm, 1e-6)
+    for ax, (title, right, up, toward_viewer) in zip(axes, views):
+        image, extent = raster_view(xyz, colors, right, up, toward_viewer, px_per_mm)
+        ax.imshow(image, extent=extent, interpolation="antialiased")
+        ax.set_title(title)
+        ax.set_xlabel("mm")
+        ax.tick_params(labelsize=8)
+    cax = fig.add_axes([0.91, 0.12, 0.015, 0.74])
+    _add_legend(fig, None, limit, cax=cax)
+    fig.suptitle("Deviation map: %d points, colours saturate at +-%.3f mm"
+                 % (len(result.deviation), limit))
+    return fig
+
+
+def figure_histogram(result, band_edges):
+    """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the Table 3
+    band edges."""
+    plt, _, _ = _mpl()
+    dev = result.deviation
+    stats = result.deviation_stats
+    mean, sigma = stats["mean"], stats["std"]
+    lo = min(np.percentile(dev, 0.05), mean - 4 * sigma, band_edges[0] * 1.2)
+    hi = max(np.percentile(dev, 99.95), mean + 4 * sigma, band_edges[-1] * 1.2)
+    bins = np.linspace(lo, hi, 121)
+    counts, edges = np.histogram(np.clip(dev, lo, hi), bins=bins)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    limit = max(abs(band_edges[0]), abs(band_edges[-1]))
+    fig, ax = plt.subplots(figsize=(10, 4.8))
+    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.12, top=0.9)
+    ax.bar(centres, counts, width=np.diff(edges), color=colormap.deviation_colors(centres, limit),
+           edgecolor="none")
+    top = counts.max() if len(counts) else 1
+    for k, style, name in ((1, "--", "sigma"), (3, ":", "3 sigma")):
+        for sign in (-1, 1):
+            ax.axvline(mean + sign * k * sigma, color="black", linestyle=style, linewidth=1.2)
+        pct = stats["pct_within_1sigma" if k == 1 else "pct_within_3sigma"]
+        ax.text(mean + k * sigma, top * (0.95 if k == 1 else 0.8),
+                " +-%s: %.2f %%" % (name, pct), fontsize=9, va="top")
+    for e in band_edges:
+        ax.axvline(e, color="0.6", linewidth=0.8)
+    ax.set_xlabel("signed deviation (mm), + outside material")
+    ax.set_ylabel("points")
+    ax.set_title("Deviation histogram: mean %+.4f mm, sigma %.4f mm, RMS %.4f mm "
+                 "(grey: Table 3 band edges; values beyond the axis are in the end bins)"
+                 % (mean, sigma, stats["rms"]), fontsize=10)
+    return fig
+
+
+def _nice_magnification(value):
+    steps = np.array([1, 2, 5])
+    exp = np.floor(np.log10(max(value, 1e-9)))
+    candidates = np.concatenate([steps * 10 ** (exp - 1), steps * 10 ** exp])
+    return float(candidates[candidates <= value].max()) if (candidates <= value).any() \
+        else float(candidates.min())
+
+
+def _offset(poly2d, distance):
+    t = np.gradient(poly2d, axis=0)
+    n = np.column_stack([t[:, 1], -t[:, 0]])
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+    return poly2d + distance * n
+
+
+def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_WHISKERS,
+                   seed=0):
+    """Nominal profile with each point's deviation drawn from its closest CAD point along the
+    outward normal, magnified (Figs 9-10); the tolerance band at the same magnification; CMM
+    points, when given, as black whiskers with round ends."""
+    plt, _, _ = _mpl()
+    from matplotlib.collections import LineCollection
+    chord = sec.profile.chord if sec.profile is not None else 50.0
+    if magnification is None:
+        # the tolerance is drawn as 2 % of the chord: whiskers readable, profile recognisable
+        magnification = _nice_magnification(0.02 * chord / tolerance)
+    fig, ax = plt.subplots(figsize=(11, 5.0))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.1, top=0.92)
+    if sec.profile is not None:
+        for poly in sec.profile.polylines:
+            p2 = sec.plane_coords(poly)
+            ax.plot(p2[:, 0], p2[:, 1], color="0.15", linewidth=1.0)
+            for sign in (-1, 1):
+                band = _offset(p2, sign * tolerance * magnification)
+                ax.plot(band[:, 0], band[:, 1], color="0.55", linewidth=0.6, linestyle="--")
+    idx = sec.point_index
+    if len(idx) > max_whiskers:
+        idx = np.sort(np.random.default_rng(seed).choice(idx, max_whiskers, replace=False))
+    if len(idx):
+        base = sec.plane_coords(result.closest[idx])
+        tip = base + sec.vectors_in_plane(result.normal[idx]) * \
+            (result.deviation[idx] * magnification)[:, None]
+        colors = colormap.deviation_colors(result.deviation[idx], tolerance)
+        # rasterized: thousands of vector whiskers make a PDF slow to write and to view
+        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors=colors,
+                                         linewidths=1.0, rasterized=True))
+        ax.scatter(tip[:, 0], tip[:, 1], c=colors, s=3, linewidths=0, rasterized=True)
+    if sec.cmm_xyz is not None and len(sec.cmm_xyz):
+        base = sec.plane_coords(sec.cmm_closest)
+        tip = base + sec.vectors_in_plane(sec.cmm_normal) * \
+            (sec.cmm_deviation * magnification)[:, None]
+        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors="black",
+                                         linewidths=0.8))
+        ax.scatter(tip[:, 0], tip[:, 1], facecolors="none", edgecolors="black", s=10,
+                   linewidths=0.6, label="CMM")
+        ax.legend(loc="upper right", fontsize=8)
+    if sec.profile is not None:
+        ax.annotate("LE", (0.0, 0.0), xytext=(-12, 0), textcoords="offset points",
+                    ha="right", va="center", fontweight="bold")
+        ax.annotate("TE", (sec.profile.chord, 0.0), xytext=(12, 0), textcoords="offset points",
+                    ha="left", va="center", fontweight="bold")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.set_xlabel("along the chord from the leading edge (mm)")
+    ax.set_ylabel("across (mm)")
+    o = sec.optical
+    figures = ("n %d, max |dev| %.4f mm, RMS %.4f mm" % (o["n"], o["max_abs_mm"], o["rms_mm"])
+               if o["n"] else "no measured points")
+    ax.set_title("Section %s at %.0f %% span: %s; deviations x%g, dashed: +-%.3f mm"
+                 % (sec.label, sec.height_pct, figures, magnification, tolerance), fontsize=10)
+    _add_legend(fig, ax, tolerance)
+    return fig
+
+
+# ---------------------------------------------------------------- tables as rows
+
+def _fmt(value, pattern="%.4f"):
+    return "-" if value is None else pattern % value
+
+
+def histogram_rows(result):
+    rows = []
+    for band in result.deviation_stats["histogram"]:
+        lo, hi = band["lo"], band["hi"]
+        name = ("< %.3f" % hi if lo is None else "> %.3f" % lo if hi is None
+                else "%.3f to %.3f" % (lo, hi))
+        rows.append([name, "%d" % band["count"], "%.3f" % band["pct"]])
+    return ["Deviation range (mm)", "Number of points", "Percentage (%)"], rows
+
+
+def section_rows(table):
+    with_cmm = table.cmm_source is not None
+    header = ["Section", "Span %", "Points"] + (["CMM points"] if with_cmm else []) + \
+        ["Max |dev| (mm)"] + (["CMM max"] if with_cmm else []) + \
+        ["RMS (mm)"] + (["CMM RMS"] if with_cmm else []) + \
+        ["%.2f mm (%%)" % table.within] + (["CMM %"] if with_cmm else []) + \
+        ["LE max |dev|", "TE max |dev|"] + (["CMM LE max", "CMM TE max"] if with_cmm else [])
+    rows = []
+    for s in table.sections:
+        o, c = s.optical, s.cmm or {}
+        cl, ct = c.get("le", {}), c.get("te", {})
+        row = [s.label, "%.1f" % s.height_pct, "%d" % o["n"]]
+        if with_cmm:
+            row.append("%d" % c.get("n", 0))
+        row.append(_fmt(o["max_abs_mm"]))
+        if with_cmm:
+            row.append(_fmt(c.get("max_abs_mm")))
+        row.append(_fmt(o["rms_mm"]))
+        if with_cmm:
+            row.append(_fmt(c.get("rms_mm")))
+        row.append(_fmt(o["pct_within"], "%.2f"))
+        if with_cmm:
+            row.append(_fmt(c.get("pct_within"), "%.2f"))
+        row += [_fmt(o["le"]["max_abs_mm"]), _fmt(o["te"]["max_abs_mm"])]
+        if with_cmm:
+            row += [_fmt(cl.get("max_abs_mm")), _fmt(ct.get("max_abs_mm"))]
+        rows.append(row)
+    return header, rows
+
+
+def pose_rows(result):
+    T = np.asarray(result.measured_to_cad)
+    cov = np.asarray(result.pose_covariance)
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    return [
+        ["Points (inliers)", "%d (%d)" % (result.n_points, result.n_inliers)],
+        ["Rows skipped", "%d" % result.n_rows_skipped],
+        ["Residual RMS of inliers", "%.4f mm" % result.rms_mm],
+        ["Pose uncertainty (1 sigma, worst bounding-box corner)",
+         "%.2f um" % (1000.0 * result.pose_uncertainty_mm)],
+        ["Translation 1 sigma (x, y, z)", "%.2f, %.2f, %.2f um" % tuple(1000.0 * sd[:3])],
+        ["Rotation 1 sigma (x, y, z)", "%.2f, %.2f, %.2f urad" % tuple(1e6 * sd[3:])],
+        ["measured_to_cad row 1", "  ".join("%.6f" % v for v in T[0])],
+        ["measured_to_cad row 2", "  ".join("%.6f" % v for v in T[1])],
+        ["measured_to_cad row 3", "  ".join("%.6f" % v for v in T[2])],
+    ]
+
+
+# ---------------------------------------------------------------- HTML
+
+_CSS = """
+body{font-family:sans-serif;max-width:1200px;margin:1em auto;color:#222}
+table{border-collapse:collapse;margin:0.5em 0 1.2em}
+td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}
+th{background:#eee} td:first-child{text-align:left}
+.pass{color:#fff;background:#2a7d2e;padding:4px 10px;font-weight:bold}
+.fail{color:#fff;background:#b3261e;padding:4px 10px;font-weight:bold}
+img{max-width:100%} .note{color:#555;font-size:0.9em}
+"""
+
+
+def _html_table(header, rows):
+    out = ["<table>"]
+    if header:
+        out.append("<tr>" + "".join("<th>%s</th>" % html.escape(h) for h in header) + "</tr>")
+    for row in rows:
+        out.append("<tr>" + "".join("<td>%s</td>" % html.escape(str(c)) for c in row) + "</tr>")
+    out.append("</table>")
+    return "\n".join(out)
+
+
+def _png(fig):
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    return buf.getvalue()
+
+
+def _img(png, alt):
+    return '<img alt="%s" src="data:image/png;base64,%s">' % (
+        html.escape(alt), base64.b64encode(png).decode("ascii"))
+
+
+def _verdict_lines(verdict, table):
+    lines = [verdict["summary"],
+             "Points outside +-%.3f mm: %d (%.3f %%), in %d spot(s); %d isolated point(s)"
+             % (verdict["tolerance_mm"], verdict["n_points_out"], verdict["pct_points_out"],
+                verdict["n_spots"], verdict["n_isolated_out"])]
+    lines += ["Spot %d: %s" % (k + 1, s["text"]) for k, s in enumerate(verdict["worst_spots"])]
+    for s in verdict["sections"]:
+        text = "Section %s: %s" % (s["label"], "pass" if s["pass"] else "FAIL")
+        if s.get("worst_deviation_mm") is not None:
+            text += ", worst %+.4f mm at the %s" % (s["worst_deviation_mm"],
+                                                    verdict_mod._ZONE_TEXT[s["worst_zone"] or ""])
+        if "cmm_pass" in s:
+            text += "; CMM %s" % ("pass" if s["cmm_pass"] else "FAIL")
+        lines.append(text)
+    return lines
+
+
+# ---------------------------------------------------------------- the report
+
+def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=None,
+                 magnification=None, title=None):
+    """report.html and report.pdf for a registration, its section table and verdict. Written
+    into ``output`` (an open pipeline.AtomicOutput) when given, else atomically into out_dir.
+    Returns {'html': name, 'pdf': name, 'pdf_pages': count}."""
+    from .pipeline import AtomicOutput
+    if output is None:
+        with AtomicOutput(out_dir) as out:
+            return write_report(out_dir, result, nominal, sections, verdict, tolerance,
+                                output=out, magnification=magnification, title=title)
+    plt, _, _ = _mpl()
+    from matplotlib.backends.backend_pdf import PdfPages
+    table = sections
+    tolerance = float(tolerance)
+    title = title or "BladeInspect inspection report"
+    band_edges = [b["lo"] for b in result.deviation_stats["histogram"][1:]]
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    verdict_lines = _verdict_lines(verdict, table)
+    h_header, h_rows = histogram_rows(result)
+    s_header, s_rows = section_rows(table)
+    p_rows = pose_rows(result)
+
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>%s</title>"
+             "<style>%s</style></head><body>" % (html.escape(title), _CSS),
+             "<h1>%s</h1>" % html.escape(title),
+             "<p class='note'>%s; points: %s; CAD: %s</p>" % (
+                 stamp, html.escape(result.source or "-"), html.escape(result.cad_source or "-")),
+             "<h2>Verdict</h2><p><span class='%s'>%s</span> profile tolerance +-%.3f mm</p>" % (
+                 "pass" if verdict["pass"] else "fail", "PASS" if verdict["pass"] else "FAIL",
+                 tolerance),
+             "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in verdict_lines) + "</ul>",
+             "<h2>Pose and its uncertainty</h2>", _html_table(["Quantity", "Value"], p_rows)]
+    for w in list(result.warnings) + list(table.warnings):
+        parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
+
+    pdf_path = output.path("report.pdf")
+    n_pages = 0
+    with PdfPages(pdf_path) as pdf:
+        fig = plt.figure(figsize=(8.27, 11.69))
+        fig.text(0.06, 0.95, title, fontsize=16, weight="bold")
+        fig.text(0.06, 0.925, "%s   points: %s" % (stamp, os.path.basename(result.source or "-")),
+                 fontsize=8)
+        fig.text(0.06, 0.89, "%s  (profile tolerance +-%.3f mm)"
+                 % ("PASS" if verdict["pass"] else "FAIL", tolerance), fontsize=14,
+                 color="#2a7d2e" if verdict["pass"] else "#b3261e", weight="bold")
+        y = 0.86
+        for line in verdict_lines[:24]:
+            fig.text(0.06, y, line, fontsize=8, wrap=True)
+            y -= 0.018
+        ax = fig.add_axes([0.06, 0.05, 0.88, max(0.1, y - 0.1)])
+        ax.axis("off")
+        ax.set_title("Pose and its uncertainty", fontsize=11, loc="left")
+        t = ax.table(cellText=p_rows, colLabels=["Quantity", "Value"], loc="upper left",
+                     cellLoc="left", colWidths=[0.45, 0.55])
+        t.auto_set_font_size(False)
+        t.set_fontsize(7.5)
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+
+        fig = figure_views(result, table, tolerance)
+        parts += ["<h2>Deviation map</h2>", _img(_png(fig), "deviation map, three views")]
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+
+        fig = figure_histogram(result, band_edges)
+        png = _png(fig)
+        parts += ["<h2>Deviation histogram (Table 3)</h2>", _img(png, "deviation histogram"),
+                  _html_table(h_header, h_rows),
+                  "<p>Within +-1 sigma: %.3f %%; within +-3 sigma: %.3f %% (sigma = %.4f mm "
+                  "about the mean %+.4f mm).</p>" % (
+                      result.deviation_stats["pct_within_1sigma"],
+                      result.deviation_stats["pct_within_3sigma"],
+                      result.deviation_stats["std"], result.deviation_stats["mean"])]
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+
+        fig = plt.figure(figsize=(11.69, 8.27))
+        ax = fig.add_axes([0.03, 0.52, 0.94, 0.42])
+        ax.axis("off")
+        ax.set_title("Table 2: section profile errors (points within +-%.2f mm of each plane "
+                     "or of the section column)" % table.band, fontsize=11, loc="left")
+        t = ax.table(cellText=s_rows or [["-"] * len(s_header)], colLabels=s_header,
+                     loc="upper center", cellLoc="right")
+        t.auto_set_font_size(False)
+        t.set_fontsize(7.5)
+        ax = fig.add_axes([0.03, 0.05, 0.94, 0.42])
+        ax.axis("off")
+        ax.set_title("Table 3: deviation bands", fontsize=11, loc="left")
+        t = ax.table(cellText=h_rows, colLabels=h_header, loc="upper center", cellLoc="right")
+        t.auto_set_font_size(False)
+        t.set_fontsize(8)
+        notes = ["LE/TE: points within %.0f %% of the chord of each end of the nominal profile."
+                 % (100 * table.edge_fraction)]
+        if table.cmm_source:
+            notes.append(sections_mod.CMM_COMPENSATION_NOTE)
+        fig.text(0.03, 0.02, "\n".join(notes), fontsize=7, wrap=True)
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+
+        parts += ["<h2>Section profile errors (Table 2)</h2>", _html_table(s_header, s_rows),
+                  "<p class='note'>%s</p>" % html.escape(notes[0])]
+        if table.cmm_source:
+            parts.append("<p>CMM: %s. %s</p>" % (html.escape(table.cmm_source),
+                                                 html.escape(sections_mod.CMM_COMPENSATION_NOTE)))
+        for sec in table.sections:
+            fig = figure_section(sec, result, tolerance, magnification=magnification)
+            parts += ["<h3>Section %s</h3>" % html.escape(sec.label),
+                      _img(_png(fig), "section %s whisker plot" % sec.label)]
+            pdf.savefig(fig, dpi=PDF_DPI)
+            plt.close(fig)
+            n_pages += 1
+        meta = pdf.infodict()
+        meta["Title"] = title
+        meta["Creator"] = "BladeInspect"
+
+    parts.append("</body></html>")
+    with open(output.path("report.html"), "w", encoding="utf-8") as fh:
+        fh.write("\n".join(parts))
+    return {"html": "report.html", "pdf": "report.pdf", "pdf_pages": n_pages}
+
+
+# ---------------------------------------------------------------- the `report` command
+
+def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
+               seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
+               nominal=None, document=True):
+    """Register, tabulate the sections, judge and write result.json, deviations.csv,
+    report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
+    made in a private folder beside out_dir and moved in only when every one is complete.
+    ``nominal`` skips loading the CAD (a batch loads it once). Returns a summary dict."""
+    from . import pipeline
+    progress = progress or (lambda f, m: None)
+    tolerance = float(tolerance)
+    if not np.isfinite(tolerance) or tolerance <= 0:
+        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    timing = {}
+    t0 = time.perf_counter()
+    if nominal is None:
+        nominal = pipeline.load_nominal(cad_path)
+    timing["load_cad"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    points = pipeline.load_points(points_path)
+    cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
+    timing["load_points"] = time.perf_counter() - t0
+    result = pipeline.register(nominal, points, seed=seed,
+                               progress=lambda f, m: progress(0.8 * f, m))
+    result.timing_s = dict(timing, **result.timing_s)
+    result.cad_source = cad_path or "built-in demo blade"
+
+    t0 = time.perf_counter()
+    progress(0.82, "section table")
+    table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
+    verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    result.timing_s["sections"] = time.perf_counter() - t0
+    with pipeline.AtomicOutput(out_dir) as out:
+        t0 = time.perf_counter()
+        progress(0.86, "report")
+        files = write_report(out_dir, result, nominal, table, verdict, tolerance, output=out)
+        result.timing_s["report"] = time.perf_counter() - t0
+        if document:
+            t0 = time.perf_counter()
+            progress(0.95, "FreeCAD document")
+            from .document import write_inspection_document
+            write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
+                                      tolerance=tolerance)
+            result.timing_s["document"] = time.perf_counter() - t0
+        pipeline.write_register_outputs(out_dir, result, extra={
+            "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance},
+            output=out)
+    progress(1.0, verdict["summary"])
+    return {"out_dir": os.path.abspath(out_dir), "result": result, "sections": table,
+            "verdict": verdict, "files": sorted(os.listdir(out_dir)),
+            "pdf_pages": files["pdf_pages"]}
