@@ -1,0 +1,417 @@
+"""Measurement paths planned from the CAD once the part's pose on the table is known (issue 8,
+item 2; paper 3.2 and 5: registration unifies the part and machine frames "to plan the
+measurement path and find the section curve accurately").
+
+A nominal section is the CAD cut by a plane across the span. Its points are brought into the
+machine by the registration pose (table -> CAD, inverted) and the rotary angle; each point gets
+the rotary angle that turns its surface normal towards the beam (+Z of the machine) well inside
+the sensor's angular coverage, and stage setpoints that put the surface at the standoff on the
+beam (X, Y = the point's x, y; Z = z + standoff, since a reading d gives the point (X, Y, Z - d)).
+Points share a few angles per section (each rotation costs time and repeatability), chosen by a
+greedy cover, and every planned point is checked for line of sight (exact ray cast on the CAD),
+clearance of the sensor body, and the stages' soft limits.
+"""
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import pca
+from ..core import transforms as tf
+from ..core.errors import DeviceError, InputError
+from .kinematics import RigKinematics
+
+# Planned incidence stays within this angle of the beam where any angle allows it: the SNR
+# falls with incidence, and the coverage's 85 deg limit is where readings stop, not where they
+# are good. Points whose normal leans along the axis more than this get their best angle.
+MAX_INCIDENCE_DEG = 40.0
+# The last few degrees of the coverage are left as margin for the pose's own uncertainty.
+COVERAGE_MARGIN_DEG = 10.0
+ANGLE_STEP_DEG = 5.0
+ANGLES = np.arange(0.0, 360.0, ANGLE_STEP_DEG)
+# Sensor body: a cylinder about the beam from this far below the lens upwards.
+BODY_RADIUS_MM = 20.0
+BODY_CLEARANCE_MM = 3.0
+BODY_CELL_MM = 2.0
+# A ray that hits the CAD this much before the target is blocked by another part of the blade.
+LINE_OF_SIGHT_TOLERANCE_MM = 0.01
+# Alternating projections onto the surface and the plane put each section point on both;
+# the angle between a blade surface and a cross-section plane makes them converge in a few.
+SECTION_PROJECTIONS = 8
+SECTION_TOLERANCE_MM = 1e-6
+# Consecutive section points farther apart than this many spacings start a new path.
+PATH_GAP_SPACINGS = 3.0
+
+
+@dataclass
+class PlannedSection:
+    """One nominal section and its planned readings (arrays of length K, contour order)."""
+    index: int
+    height_pct: float
+    plane_point: np.ndarray          # (3,) CAD frame
+    plane_normal: np.ndarray         # (3,) CAD frame, the span axis
+    target_cad: np.ndarray           # (K, 3) on the CAD surface and the plane
+    normal_cad: np.ndarray           # (K, 3) outward surface normals
+    angle_deg: np.ndarray            # (K,) rotary angle for each reading
+    stage_xyz: np.ndarray            # (K, 3) X, Y, Z setpoints
+    expected_standoff_mm: np.ndarray  # (K,) distance along the beam to the nominal surface
+    incidence_deg: np.ndarray        # (K,) between the beam and the surface normal
+    expected_snr: np.ndarray         # (K,) the sensor model's SNR at that standoff and incidence
+
+    @property
+    def n_points(self):
+        return int(len(self.target_cad))
+
+    def to_dict(self):
+        return {"index": self.index, "height_pct": self.height_pct,
+                "plane": {"point": self.plane_point.tolist(),
+                          "normal": self.plane_normal.tolist()},
+                "n_points": self.n_points,
+                "target_cad": np.round(self.target_cad, 6).tolist(),
+                "normal_cad": np.round(self.normal_cad, 6).tolist(),
+                "angle_deg": np.round(self.angle_deg, 6).tolist(),
+                "stage_xyz": np.round(self.stage_xyz, 6).tolist(),
+                "expected_standoff_mm": np.round(self.expected_standoff_mm, 6).tolist(),
+                "incidence_deg": np.round(self.incidence_deg, 3).tolist(),
+                "expected_snr": np.round(self.expected_snr, 3).tolist()}
+
+
+@dataclass
+class PlannedPath:
+    """One pass of the rig: a rotary angle and the stage positions read along it in order."""
+    section: int                     # index into Plan.sections
+    angle_deg: float
+    points: np.ndarray               # (K,) indices into that section's arrays, in path order
+
+    def to_dict(self):
+        return {"section": self.section, "angle_deg": self.angle_deg,
+                "points": self.points.tolist()}
+
+
+@dataclass
+class Plan:
+    sections: list                   # PlannedSection per requested height, in height order
+    paths: list                      # PlannedPath in execution order
+    table_to_cad: np.ndarray         # (4, 4) the pose planned with
+    span_axis: np.ndarray            # (3,) CAD frame, hub to tip
+    span_range: tuple                # (lo, hi) of the blade faces along the span axis
+    axis_point: np.ndarray           # rotary axis the angles turn about, machine frame
+    axis_direction: np.ndarray
+    standoff_mm: float
+    spacing_mm: float
+    info: dict = field(default_factory=dict)
+
+    @property
+    def n_points(self):
+        return int(sum(s.n_points for s in self.sections))
+
+    def path_stage_xyz(self, path):
+        return self.sections[path.section].stage_xyz[path.points]
+
+    def to_dict(self):
+        return {"n_points": self.n_points, "n_paths": len(self.paths),
+                "table_to_cad": np.asarray(self.table_to_cad).tolist(),
+                "span_axis": self.span_axis.tolist(), "span_range": list(self.span_range),
+                "rotary_axis": {"point": self.axis_point.tolist(),
+                                "direction": self.axis_direction.tolist()},
+                "standoff_mm": self.standoff_mm, "spacing_mm": self.spacing_mm,
+                "info": self.info,
+                "sections": [s.to_dict() for s in self.sections],
+                "paths": [p.to_dict() for p in self.paths]}
+
+    def to_json(self, path=None):
+        """The plan as JSON text (DIR/plan.json); written to ``path`` when given."""
+        text = json.dumps(self.to_dict(), indent=1)
+        if path is not None:
+            with open(path, "w") as fh:
+                fh.write(text)
+        return text
+
+
+# ---------------------------------------------------------------- geometry helpers
+
+def _blade_faces(nominal):
+    """Faces that make the airfoil: the roles when known, else every non-planar face (the
+    hub and tip caps of a blade are planes)."""
+    roles = nominal.roles or {}
+    names = ("suction", "pressure", "leading_edge", "trailing_edge")
+    faces = sorted({i for name in names for i in roles.get(name, [])})
+    if faces:
+        return faces
+    faces = [i for i, f in enumerate(nominal.faces)
+             if "Plane" not in type(f.Surface).__name__]
+    return faces or list(range(len(nominal.faces)))
+
+
+def span_axis_of(nominal, span_axis=None):
+    """(axis (3,) unit, origin (3,), lo, hi): the span direction and the CAD's extent along
+    it. Default: the longest principal axis of the blade faces' area-weighted
+    samples, pointing from the hub towards the tip when the CAD marks them."""
+    s = nominal.samples
+    mask = np.isin(s.face, _blade_faces(nominal))
+    xyz, w = s.xyz[mask], s.weight[mask]
+    if span_axis is None:
+        axes = pca.principal_axes(xyz, w)
+        axis = np.asarray(axes.axes[:, 0], dtype=float)
+        origin = axes.centroid
+    else:
+        axis = np.asarray(span_axis, dtype=float)
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) == 0:
+            raise InputError("span axis: expected a non-zero 3-vector, got %r" % (span_axis,))
+        origin = np.average(xyz, axis=0, weights=w)
+    axis = axis / np.linalg.norm(axis)
+    roles = nominal.roles or {}
+    hub, tip = roles.get("hub"), roles.get("tip")
+    if span_axis is None:
+        if hub and tip:
+            hub_c = s.xyz[np.isin(s.face, hub)].mean(axis=0)
+            tip_c = s.xyz[np.isin(s.face, tip)].mean(axis=0)
+            if (tip_c - hub_c) @ axis < 0:
+                axis = -axis
+        elif axis[np.argmax(np.abs(axis))] < 0:
+            axis = -axis
+    # The extent comes from every face's samples: samples sit at cell centres, so the blade
+    # faces alone fall short of their ends, while planar hub and tip caps lie exactly on them.
+    h = (s.xyz - origin) @ axis
+    return axis, origin, float(h.min()), float(h.max())
+
+
+def _resample(chain, closed, spacing):
+    pts = np.vstack([chain, chain[:1]]) if closed else chain
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    if arc[-1] < spacing:
+        return pts[:1]
+    n = int(np.floor(arc[-1] / spacing)) + (0 if closed else 1)
+    # Even spacing that fits the length exactly, so a closed contour has no short last step.
+    t = np.linspace(0.0, arc[-1], n, endpoint=not closed)
+    return np.column_stack([np.interp(t, arc, pts[:, k]) for k in range(3)])
+
+
+def nominal_section(nominal, plane_point, plane_normal, spacing):
+    """Points every ``spacing`` mm along the CAD's cut by the plane, each exactly on the CAD and
+    on the plane, with outward normals, in contour order. Returns (points, normals, contours),
+    contours a list of (first index, end index, closed). InputError when the plane misses."""
+    from ..cad.sections import cut
+    n = np.asarray(plane_normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    o = np.asarray(plane_point, dtype=float)
+    pts, contours, start = [], [], 0
+    for line in cut(nominal.shape, o, n):
+        closed = len(line) > 2 and np.linalg.norm(line[0] - line[-1]) < 1e-9
+        p = _resample(line[:-1] if closed else line, closed, spacing)
+        contours.append((start, start + len(p), closed))
+        start += len(p)
+        pts.append(p)
+    if start < 2:
+        raise InputError("section plane through %s: the cut of the CAD is shorter than the "
+                         "point spacing" % np.round(o, 3).tolist())
+    p = np.vstack(pts)
+    for _ in range(SECTION_PROJECTIONS):
+        res = nominal.signed_distance(p)
+        off_plane = (res.closest - o) @ n
+        if np.max(np.abs(off_plane)) < SECTION_TOLERANCE_MM:
+            break
+        p = res.closest - np.outer(off_plane, n)
+    return res.closest, res.normal, contours
+
+
+# ---------------------------------------------------------------- angles
+
+def _incidence_table(normals_table, angles_deg, kinematics):
+    """cos(incidence) of every normal at every candidate angle, (A, K): the machine normal's
+    Z component after turning the table by the angle."""
+    cosines = np.empty((len(angles_deg), len(normals_table)))
+    for i, a in enumerate(angles_deg):
+        cosines[i] = normals_table @ kinematics.rotation(a)[2]
+    return cosines
+
+
+def _choose_angles(cosines, max_incidence_deg):
+    """Greedy cover: the candidate angle that brings most remaining points within the planned
+    incidence, repeatedly; points no angle brings within it get the one nearest. Returns the
+    chosen candidate row per point."""
+    good = cosines >= np.cos(np.radians(max_incidence_deg))
+    todo = good.any(axis=0)
+    chosen = []
+    while todo.any():
+        best = int(np.argmax((good & todo).sum(axis=1)))
+        chosen.append(best)
+        todo &= ~good[best]
+    best_any = np.argmax(cosines, axis=0)
+    unreachable = ~good.any(axis=0)
+    chosen = sorted(set(chosen) | set(best_any[unreachable].tolist()))
+    sub = cosines[chosen]
+    return np.asarray(chosen)[np.argmax(sub, axis=0)], chosen
+
+
+# ---------------------------------------------------------------- checks
+
+def _line_of_sight(nominal, cad_from_machine, spot_machine, standoff):
+    """Exact: a ray down the beam from the lens must first meet the CAD at the planned spot.
+    Returns (visible (K,), distance along the beam to the first hit)."""
+    origins_m = spot_machine + np.array([0.0, 0.0, standoff])
+    origins = tf.apply_transform(cad_from_machine, origins_m)
+    down = cad_from_machine[:3, :3] @ np.array([0.0, 0.0, -1.0])
+    t, _, _ = nominal.raycast(origins, np.tile(down, (len(origins), 1)))
+    visible = np.isfinite(t) & (t > standoff - LINE_OF_SIGHT_TOLERANCE_MM)
+    return visible, t
+
+
+def _body_clear(samples_machine, spot_machine, standoff):
+    """The sensor body, a cylinder about the beam from just below the lens upwards, must hold
+    none of the blade's samples. The samples' highest z per cell of a 2D grid, spread over a
+    disc of the body's radius (grown by a cell's diagonal, so the test errs on the safe side),
+    gives at each spot the highest blade point under the body."""
+    from scipy.ndimage import maximum_filter
+    cell = BODY_CELL_MM
+    reach = BODY_RADIUS_MM + cell * np.sqrt(2.0)
+    pad = int(np.ceil(reach / cell))
+    lo = np.minimum(samples_machine[:, :2].min(axis=0), spot_machine[:, :2].min(axis=0))
+    idx = np.floor((samples_machine[:, :2] - lo) / cell).astype(int) + pad
+    shape = idx.max(axis=0) + pad + 1
+    spot_idx = np.floor((spot_machine[:, :2] - lo) / cell).astype(int) + pad
+    shape = np.maximum(shape, spot_idx.max(axis=0) + pad + 1)
+    height = np.full(tuple(shape), -np.inf)
+    np.maximum.at(height, (idx[:, 0], idx[:, 1]), samples_machine[:, 2])
+    r = np.arange(-pad, pad + 1) * cell
+    disc = (r[:, None] ** 2 + r[None, :] ** 2) <= reach ** 2
+    under_body = maximum_filter(height, footprint=disc, mode="constant", cval=-np.inf)
+    highest = under_body[spot_idx[:, 0], spot_idx[:, 1]]
+    return highest < spot_machine[:, 2] + standoff - BODY_CLEARANCE_MM
+
+
+def _expected_snr(sensor, incidence_rad):
+    """The sensor model's noise-free SNR at the range centre and the planned incidence."""
+    return np.asarray(sensor.snr(np.full(len(incidence_rad), sensor.standoff), incidence_rad),
+                      dtype=float)
+
+
+# ---------------------------------------------------------------- the plan
+
+def _runs(angle_rows, contours, reverse):
+    """Split each contour into runs of consecutive points that share an angle; order runs by
+    angle (reversed on alternate sections so the rotary goes back and forth)."""
+    runs = []
+    for first, end, closed in contours:
+        idx = np.arange(first, end)
+        cuts = np.flatnonzero(np.diff(angle_rows[idx]) != 0) + 1
+        pieces = [list(r) for r in np.split(idx, cuts)]
+        # On a closed contour the last and first runs meet when they share an angle.
+        if closed and len(pieces) > 1 and angle_rows[idx[0]] == angle_rows[idx[-1]]:
+            pieces[0] = pieces.pop() + pieces[0]
+        runs += pieces
+    runs.sort(key=lambda r: (angle_rows[r[0]], r[0]), reverse=reverse)
+    return runs
+
+
+def _plan_section(index, height, plane_point, axis, target, normal, nominal, table_to_cad,
+                  kinematics, sensor, limits, samples_table, max_incidence_deg):
+    """Angles, setpoints and checks for one section's points (see plan_sections)."""
+    standoff = float(sensor.standoff)
+    usable = np.cos(np.radians(0.5 * float(sensor.coverage_deg) - COVERAGE_MARGIN_DEG))
+    cad_to_table = tf.invert_transform(table_to_cad)
+    target_t = tf.apply_transform(cad_to_table, target)
+    normal_t = normal @ cad_to_table[:3, :3].T
+    cosines = _incidence_table(normal_t, ANGLES, kinematics)
+    _, chosen = _choose_angles(cosines, max_incidence_deg)
+    # Line of sight and body clearance at each chosen angle, for the points that angle could
+    # serve at all; each point then takes the clear chosen angle nearest to head-on.
+    score = np.full(cosines.shape, -np.inf)
+    beam_length = np.full(cosines.shape, np.nan)
+    for row in chosen:
+        a = ANGLES[row]
+        cand = np.flatnonzero(cosines[row] >= usable)
+        if len(cand) == 0:
+            continue
+        spot = kinematics.machine_point_of_table(target_t[cand], a)
+        cad_from_machine = _cad_from_machine(table_to_cad, kinematics, a)
+        visible, t = _line_of_sight(nominal, cad_from_machine, spot, standoff)
+        samples_m = kinematics.machine_point_of_table(samples_table, a)
+        ok = visible & _body_clear(samples_m, spot, standoff)
+        score[row, cand[ok]] = cosines[row, cand[ok]]
+        beam_length[row, cand] = t
+    rows = np.argmax(score, axis=0)
+    idx = np.arange(len(target))
+    blocked = ~np.isfinite(score[rows, idx])
+    if blocked.any():
+        raise InputError("plan: %d points of the section at %g %% cannot be seen within the "
+                         "sensor's coverage (less %g deg margin) without the sensor meeting "
+                         "the blade" % (int(blocked.sum()), height, COVERAGE_MARGIN_DEG))
+    incidence = np.degrees(np.arccos(np.clip(cosines[rows, idx], -1.0, 1.0)))
+    angle = ANGLES[rows]
+    spot = np.empty_like(target_t)
+    for a in np.unique(angle):
+        sel = angle == a
+        spot[sel] = kinematics.machine_point_of_table(target_t[sel], a)
+    stage = spot + np.array([0.0, 0.0, standoff])
+    for a in np.unique(angle):
+        sel = angle == a
+        try:
+            limits.check(stage[sel, 0], stage[sel, 1], stage[sel, 2], a)
+        except DeviceError as exc:
+            raise DeviceError("plan: section at %g %% unreachable within soft limits (%s)"
+                              % (height, exc)) from None
+    return PlannedSection(
+        index=index, height_pct=height, plane_point=plane_point, plane_normal=axis.copy(),
+        target_cad=target, normal_cad=normal, angle_deg=angle, stage_xyz=stage,
+        expected_standoff_mm=beam_length[rows, idx], incidence_deg=incidence,
+        expected_snr=_expected_snr(sensor, np.radians(incidence)))
+
+
+def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=None,
+                  spacing=0.1, kinematics=None, max_incidence_deg=MAX_INCIDENCE_DEG):
+    """Plan readings along the nominal sections at ``heights_pct`` (% of the span).
+
+    ``table_to_cad`` maps rotary-table points into the CAD frame (the registration's
+    measured_to_cad for points in the table frame); ``kinematics`` supplies the rotary axis
+    (None: the nominal axis through the origin along +Y); ``limits`` an AxisLimits.
+    Returns a Plan. Raises InputError for heights outside 0-100 or a plane that misses the
+    CAD, DeviceError when a setpoint is unreachable within the soft limits."""
+    heights = [float(h) for h in np.atleast_1d(heights_pct)]
+    if not heights:
+        raise InputError("--section-heights: at least one height is needed")
+    for h in heights:
+        if not (np.isfinite(h) and 0.0 <= h <= 100.0):
+            raise InputError("--section-heights: %g is outside 0-100 %% of the span" % h)
+    if not (np.isfinite(spacing) and spacing > 0):
+        raise InputError("plan: point spacing must be positive, got %r" % (spacing,))
+    table_to_cad = np.asarray(table_to_cad, dtype=float)
+    cad_to_table = tf.invert_transform(table_to_cad)
+    axis, origin, lo, hi = span_axis_of(nominal, span_axis)
+    kinematics = kinematics if kinematics is not None else RigKinematics()
+    samples_table = tf.apply_transform(cad_to_table, nominal.samples.xyz)
+
+    sections, paths = [], []
+    last_stage = None
+    for k, h in enumerate(heights):
+        plane_point = origin + axis * (lo + (hi - lo) * h / 100.0)
+        try:
+            target, normal, contours = nominal_section(nominal, plane_point, axis, spacing)
+        except InputError as exc:
+            raise InputError("--section-heights %g: %s" % (h, exc)) from None
+        section = _plan_section(k, h, plane_point, axis, target, normal, nominal, table_to_cad,
+                                kinematics, sensor, limits, samples_table, max_incidence_deg)
+        sections.append(section)
+        rows = np.searchsorted(ANGLES, section.angle_deg)
+        for run in _runs(rows, contours, reverse=bool(k % 2)):
+            run = np.asarray(run, dtype=int)
+            # Enter each run from the end nearer to where the stages are.
+            stage = section.stage_xyz
+            if last_stage is not None and (np.linalg.norm(stage[run[-1]] - last_stage)
+                                           < np.linalg.norm(stage[run[0]] - last_stage)):
+                run = run[::-1]
+            paths.append(PlannedPath(section=k, angle_deg=float(section.angle_deg[run[0]]),
+                                     points=run))
+            last_stage = stage[run[-1]]
+    info = {"max_incidence_deg": max_incidence_deg, "angle_step_deg": ANGLE_STEP_DEG,
+            "body_radius_mm": BODY_RADIUS_MM,
+            "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections]}
+    return Plan(sections=sections, paths=paths, table_to_cad=table_to_cad, span_axis=axis,
+                span_range=(lo, hi), axis_point=kinematics.axis_point.copy(),
+                axis_direction=kinematics.axis_direction.copy(),
+                standoff_mm=float(sensor.standoff), spacing_mm=float(spacing), info=info)
+
+
+def _cad_from_machine(table_to_cad, kinematics, angle_deg):
+    return table_to_cad @ tf.invert_transform(kinematics.table_to_machine_transform(angle_deg))
