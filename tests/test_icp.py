@@ -32,12 +32,13 @@ def ellipsoid_closest(points, axes=AXES):
         lo = np.where(F > 0, t, lo)
         hi = np.where(F <= 0, t, hi)
         t_new = t - F / dF
-        outside = ~((t_new > lo) & (t_new < hi))
+        outside = ~((t_new >= lo) & (t_new <= hi))
         t_new[outside] = 0.5 * (lo[outside] + hi[outside])
-        if np.all(np.abs(t_new - t) <= 1e-15 * (1.0 + np.abs(t))):
-            t = t_new
-            break
+        # Newton converges quadratically: a step this small leaves an error far below it.
+        done = np.all(np.abs(t_new - t) <= 1e-12 * (1.0 + np.abs(t)))
         t = t_new
+        if done:
+            break
     q = a2 * points / (a2 + t[:, None])
     grad = q / a2
     gnorm = np.linalg.norm(grad, axis=1)
@@ -163,9 +164,12 @@ class TestICP(unittest.TestCase):
         for trial in range(3):
             noise = rng.uniform(-0.006, 0.006, n)
             cad = surface_patch(rng, n)
-            # A 0.05 mm raised defect over the 5% of points nearest to a random one.
-            bump = np.argsort(np.linalg.norm(cad - cad[rng.integers(n)], axis=1))[:n // 20]
-            noise[bump] += 0.05
+            # A smooth 0.05 mm raised defect over the 5% of points nearest to a random one:
+            # its flanks, lower than the per-point rejection level, must not tilt the fit.
+            to_centre = np.linalg.norm(cad - cad[rng.integers(n)], axis=1)
+            bump = np.argsort(to_centre)[:n // 20]
+            radius = to_centre[bump].max() * (1 + 1e-9)
+            noise[bump] += 0.05 * np.cos(0.5 * np.pi * to_centre[bump] / radius) ** 2
             others = np.setdiff1d(np.arange(n), bump)
             gross = rng.choice(others, size=n // 50, replace=False)
             noise[gross] += rng.choice([-1.0, 1.0], size=len(gross)) * rng.uniform(0.1, 0.5,
@@ -173,15 +177,26 @@ class TestICP(unittest.TestCase):
             _, normals, _ = ellipsoid_closest(cad)
             truth = tf.random_transform(rng, 100.0)
             pts = tf.apply_transform(tf.invert_transform(truth), cad + noise[:, None] * normals)
-            res = icp.icp(pts, None, ellipsoid_closest, start_near(rng, truth))
+            # Gross errors come with a poor signal (SNR 2-10 against 60-95): their low weight
+            # must not excuse them from being flagged.
+            snr = rng.uniform(60.0, 95.0, n)
+            snr[gross] = rng.uniform(2.0, 10.0, len(gross))
+            res = icp.icp(pts, snr, ellipsoid_closest, start_near(rng, truth))
             self.assertTrue(res.converged)
             bound = icp.pose_uncertainty(res.covariance, res.center, CORNERS)
             self.assertLess(pose_error(res.transform, truth), 3 * bound, "trial %d" % trial)
             self.assertFalse(res.inlier[gross].any())
-            self.assertFalse(res.inlier[bump].any())
-            np.testing.assert_array_equal(res.weights[bump], 0.0)
+            # The per-point test alone keeps flank points up to ~4.5 sigma plus noise (~25 um).
+            self.assertFalse(res.inlier[bump[noise[bump] > 0.018]].any())
+            # Good points keep their weight, but for a margin along the defect's rim, where
+            # most of a point's neighbourhood is on the defect.
             good = np.setdiff1d(others, gross)
-            self.assertGreater(np.mean(res.inlier[good]), 0.99)
+            gaps = np.linalg.norm(cad[:, None] - cad[None, :], axis=2)
+            rim = np.median(np.sort(gaps, axis=1)[:, 16])    # a neighbourhood's radius
+            far = good[np.min(gaps[np.ix_(good, bump)], axis=1) > rim]
+            self.assertGreater(len(far), 0.8 * n)
+            self.assertGreater(np.mean(res.inlier[far]), 0.99)
+            self.assertGreater(np.mean(res.inlier[good]), 0.95)
             self.assertAlmostEqual(res.rms, 0.006 / np.sqrt(3), delta=0.0005)
 
     def test_snr_weights_beat_equal_weights_on_heteroscedastic_noise(self):

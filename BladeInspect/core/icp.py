@@ -11,7 +11,11 @@ w_i = a_i * rho_i:
   every iteration. rho = 1 for |z| <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
   Flat in the core, so the good points are fitted by plain weighted least squares (the
   efficient estimator, and the covariance formula below is exact for them); gross outliers and
-  real defects (many sigma away) weigh exactly 0. A point is an inlier when rho_i > 0.
+  real defects (many sigma away) weigh exactly 0. Two refinements (see robust_weights): a_i is
+  floored at 1 / max_noise_ratio^2 inside z (a low SNR lowers the weight, it does not excuse
+  a gross error), and rho_i is multiplied by the same taper applied to the median of z over
+  the point's measured neighbourhood (a defect's low flanks are coherent, noise is not).
+  A point is an inlier when rho_i > 0.
 
 Iterations: Horn's closed form against the exact closest points first (robust from a coarse
 start, but point-to-point only slides slowly along a smooth surface), then Gauss-Newton steps
@@ -42,6 +46,8 @@ class ICPOptions:
     k_full: float = 3.0         # robust scales below which a point has full weight
     k_zero: float = 4.5         # robust scales from which a point has no weight
     min_scale: float = 1e-6     # mm: residuals below this are exact data, not noise to scale by
+    max_noise_ratio: float = 1.0   # largest noise, in typical points' noise, granted a low SNR
+    defect_neighbours: int = 16    # neighbourhood size of the defect test; 0 switches it off
 
 
 @dataclass
@@ -94,19 +100,52 @@ def _snr_weights(snr, n):
     return snr / snr.mean()
 
 
-def robust_weights(distances, a, options):
-    """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point)."""
-    z = distances * np.sqrt(a)
-    usable = (a > 0) & np.isfinite(z)
+def _taper(u, options):
+    """1 up to k_full, a biweight-shaped fall to 0 at k_zero, 0 beyond (and for NaN)."""
+    x = np.clip((u - options.k_full) / (options.k_zero - options.k_full), 0.0, 1.0)
+    return np.where(u < options.k_zero, (1.0 - x ** 2) ** 2, 0.0)
+
+
+def _robust_scale(values, options):
+    med = np.median(values)
+    return max(MAD_TO_SIGMA * np.median(np.abs(values - med)), options.min_scale)
+
+
+def robust_weights(distances, a, options, neighbours=None):
+    """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point).
+
+    `neighbours` (N, k) indices of each point's nearest measured points switch on the defect
+    test: the median of the standardised residuals over a point's neighbourhood is judged
+    against the spread of those local medians. Noise averages out in a neighbourhood, a
+    defect's flank (a real deviation of a few sigma, too small for the per-point test) does
+    not, so flanks are rejected with the defect instead of tilting the fit.
+    """
+    usable = (a > 0) & np.isfinite(distances)
     if not usable.any():
-        return np.zeros(len(z)), np.nan
-    med = np.median(z[usable])
-    scale = max(MAD_TO_SIGMA * np.median(np.abs(z[usable] - med)), options.min_scale)
-    u = np.where(usable, np.abs(z) / scale, np.inf)
-    taper = (u - options.k_full) / (options.k_zero - options.k_full)
-    rho = np.where(u <= options.k_full, 1.0,
-                   np.where(u < options.k_zero, (1.0 - np.clip(taper, 0, 1) ** 2) ** 2, 0.0))
+        return np.zeros(len(distances)), np.nan
+    # The noise model grants a point of low SNR a noise of sigma0 / sqrt(a_i), without bound;
+    # but gross errors are what low SNRs bring (DESIGN.md), so when judging outliers no point
+    # is granted more than max_noise_ratio times a typical point's noise (by default none: the
+    # SNR lowers a point's weight, it does not excuse its residual).
+    z = np.where(usable, distances * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2)),
+                 np.inf)
+    scale = _robust_scale(z[usable], options)
+    rho = _taper(np.abs(z) / scale, options)
+    if neighbours is not None and options.defect_neighbours > 0:
+        # An unusable neighbour (z = inf) shifts a median by one rank at most; only a
+        # neighbourhood mostly without readings gets an infinite median, and no weight.
+        local = np.median(z[neighbours], axis=1)
+        finite = np.isfinite(local)
+        if finite.any():
+            rho = rho * _taper(np.abs(local) / _robust_scale(local[finite], options), options)
     return rho, scale
+
+
+def neighbourhoods(points, k):
+    """(N, k) indices of each point's k nearest points (itself included)."""
+    from scipy.spatial import cKDTree
+    k = min(k, len(points))
+    return cKDTree(points).query(points, k=k, workers=-1)[1].reshape(len(points), k)
 
 
 def _jacobian(points_cad, normals, center):
@@ -176,6 +215,9 @@ def icp(points, snr, closest_fn, init, options=None):
         raise InputError("icp: need at least 7 points of shape (N, 3), got %s"
                          % (points.shape,))
     a = _snr_weights(snr, len(points))
+    # Neighbourhoods in the measured frame: the points move rigidly, so they never change.
+    neighbours = (neighbourhoods(points, options.defect_neighbours)
+                  if 0 < options.defect_neighbours < len(points) else None)
     T = np.array(init, dtype=float)
     converged = False
     iterations = 0
@@ -184,7 +226,7 @@ def icp(points, snr, closest_fn, init, options=None):
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
-        rho, _ = robust_weights(distances, a, options)
+        rho, _ = robust_weights(distances, a, options, neighbours)
         w = a * rho
         if np.count_nonzero(w) < 7:
             last_step = None
@@ -216,7 +258,7 @@ def icp(points, snr, closest_fn, init, options=None):
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
         _, normals, distances = closest_fn(moved)
-    rho, _ = robust_weights(distances, a, options)
+    rho, _ = robust_weights(distances, a, options, neighbours)
     w = a * rho
     inlier = rho > 0
     center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)
