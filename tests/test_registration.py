@@ -35,8 +35,13 @@ class TestRegistrationFromAnyPose(unittest.TestCase):
                 dev = result.deviation[good]
                 self.assertAlmostEqual(np.sqrt(np.mean(dev ** 2)),
                                        info["noise_rms_injected_mm"], delta=1e-4)
-                # Gross outliers (0.1-0.5 mm) are all flagged, good points almost never.
-                self.assertEqual(np.count_nonzero(result.inlier[~good]), 0)
+                # Gross outliers are all flagged, good points almost never. An outlier pushed
+                # through a thin edge can land near the other side: judge each by its true
+                # distance to the CAD (the simulator's pose), not by its injected offset.
+                true_dist = nominal.signed_distance(
+                    tf.apply_transform(truth, ps.xyz[~good])).distance
+                far = np.abs(true_dist) > 0.02
+                self.assertEqual(np.count_nonzero(result.inlier[~good][far]), 0)
                 self.assertGreater(np.mean(result.inlier[good]), 0.99)
 
     def test_translation_far_away_and_upside_down(self):
