@@ -2,7 +2,7 @@
 pseudo-terminal, checked point for point against the same rig in process.
 
     PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_serial.py \
-        [--points 100000] [--two-ports] [--process] [--rx-buffer 128]
+        [--points 100000] [--two-ports] [--process] [--rx-buffer 1024]
 
 --process serves the device from a second process (as `./bladeinspect simrig` does) instead of
 a thread sharing the interpreter lock with the driver. The rig is a stand-in whose readings
@@ -41,7 +41,7 @@ def main():
     parser.add_argument("--points", type=int, default=100000)
     parser.add_argument("--two-ports", action="store_true")
     parser.add_argument("--process", action="store_true")
-    parser.add_argument("--rx-buffer", type=int, default=128,
+    parser.add_argument("--rx-buffer", type=int, default=1024,
                         help="controller receive buffer: 128 GRBL 1.1, 1024 grblHAL")
     args = parser.parse_args()
     if args.process:

@@ -1,6 +1,7 @@
 """Every way the serial rig can fail ends in one DeviceError whose one-line message names the
 port and the failure: a missing port, the port vanishing mid-scan, silence, garbage, alarms,
 limits and sensor errors, injected by the simulated device over a real pseudo-terminal."""
+import time
 import unittest
 
 import numpy as np
@@ -57,6 +58,18 @@ class SerialFaultTest(unittest.TestCase):
         message = self.scan_fails(self.device(Fault("silent", CONNECT + HOME + MID_SCAN)),
                                   "timeout, no answer within 0.3 s", timeout_s=0.3)
         self.assertIn("waiting for", message)
+
+    def test_long_move_is_not_a_timeout(self):
+        # The sync after a move is answered only after 1 s, 3x the timeout; the controller
+        # reports Run to the driver's status polls meanwhile, which is progress.
+        device = self.device(Fault("busy", CONNECT + HOME + 1, busy_s=1.0))
+        rig = SerialRig(device.port_url, timeout_s=0.3)
+        self.addCleanup(rig.close)
+        rig.home()
+        start = time.monotonic()
+        rig.move_to(x=5.0)
+        self.assertGreaterEqual(time.monotonic() - start, 1.0)
+        self.assertEqual(rig.position()[0], 5.0)
 
     def test_nothing_answers_at_open(self):
         # loop:// echoes the reset byte back: no controller greets.

@@ -85,13 +85,15 @@ class SerialRigFakeTest(unittest.TestCase):
     def test_stream_keeps_grbl_receive_buffer(self):
         # The device counts bytes received but not yet answered; a host ignoring GRBL's
         # 128 bytes must be caught by it, or the zero count proves nothing.
-        device, rig = self.open()
         path = section_path(np.random.default_rng(1), 3000)
-        rig.scan_path(path, 0.0)
-        self.assertEqual(device.overflows, 0)
-        rig.rx_buffer = 4096
-        rig.scan_path(path, 0.0)
-        self.assertGreater(device.overflows, 0)
+        for size in (128, 1024):
+            device, rig = self.open(rx_buffer=size)
+            self.assertEqual(rig.rx_buffer, size)       # as the controller reports in $I
+            rig.scan_path(path, 0.0)
+            self.assertEqual(device.overflows, 0)
+            rig.rx_buffer = 4 * size
+            rig.scan_path(path, 0.0)
+            self.assertGreater(device.overflows, 0)
 
     def test_one_line_of_two_port_urls(self):
         with self.assertRaisesRegex(InputError, "MOTION_PORT,SENSOR_PORT"):

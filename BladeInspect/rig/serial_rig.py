@@ -20,6 +20,8 @@ from .base import Readings, Rig
 
 # A real GRBL homes at a few mm/s over up to the full travel: give it far longer than a reply.
 HOME_TIMEOUT_S = 120.0
+# While an answer is awaited the status is polled this often, as GRBL senders do.
+STATUS_POLL_S = 0.5
 
 
 class _Port:
@@ -128,6 +130,7 @@ class SerialRig(Rig):
         self._status = None
         self._banner = None
         self._connecting = True
+        self._polls = 0         # status queries sent while waiting, not yet answered
         self._sensor_flushing = False
         self._inflight = collections.deque()     # (line, bytes) sent to the controller, unanswered
         self._inflight_bytes = 0
@@ -306,40 +309,49 @@ class SerialRig(Rig):
             if chunk:
                 self._motion.write(b"".join(chunk))
             else:
-                self._pump(timeout_s, "an ok for %s" % self._inflight[0][0])
+                size = len(pending[i][1])
+                self._wait_for(lambda: self._inflight_bytes + size <= self.rx_buffer,
+                               "an ok for %s" % self._inflight[0][0], timeout_s)
         self._wait_for(lambda: not self._inflight, "an ok for the last block", timeout_s)
 
     def _wait_for(self, done, what, timeout_s=None):
-        while not done():
-            self._pump(timeout_s, what)
-
-    def _pump(self, timeout_s, what):
-        """Handle every line waiting; if none, wait up to the timeout for one."""
+        """Handle incoming lines until done(). Times out after timeout_s without progress;
+        while waiting it polls the status, so a long move (the controller reporting Run)
+        is progress, and an idle or silent controller is not."""
         timeout = self.timeout_s if timeout_s is None else timeout_s
-        deadline = time.monotonic() + timeout
-        while True:
-            handled = False
+        poll = min(STATUS_POLL_S, timeout / 4.0)
+        now = time.monotonic()
+        deadline, next_poll = now + timeout, now + poll
+        while not done():
+            progressed = None
             for port in self._ports:
                 for line in port.read_lines():
-                    self._handle(port, line)
-                    handled = True
-            if handled:
-                return
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
+                    progressed = self._handle(port, line) or bool(progressed)
+            now = time.monotonic()
+            if progressed:
+                deadline = now + timeout
+            if progressed is not None:
+                continue
+            if now >= deadline:
                 raise DeviceError("serial:%s: timeout, no answer within %g s while waiting for %s"
                                   % (self.port_url, timeout, what))
-            self._motion.wait_readable(self._ports, remaining)
+            if now >= next_poll and not self._connecting:
+                self._motion.write(pr.STATUS_QUERY)
+                self._polls += 1
+                next_poll = now + poll
+            wake = deadline if self._connecting else min(deadline, next_poll)
+            self._motion.wait_readable(self._ports, max(0.0, wake - now))
 
     def _handle(self, port, line):
+        """Act on one line; False only for a poll's answer that shows no motion."""
         if self._connecting:
             # Until the reset's greeting, lines are leftovers of an earlier session.
             if line.startswith("Grbl "):
                 self._banner = line
-            return
+            return True
         if port is self._sensor and (not self._shared or line.startswith(pr.SENSOR_PREFIX)):
             self._handle_sensor(line[1:] if self._shared else line)
-            return
+            return True
         try:
             kind, payload = pr.parse_motion_line(line)
         except pr.ProtocolError:
@@ -357,6 +369,12 @@ class SerialRig(Rig):
                               % (self.port_url, what, pr.describe_alarm(payload)))
         elif kind == pr.STATUS:
             self._status = payload
+            if self._polls:
+                self._polls -= 1
+                if payload.state == "Alarm":
+                    raise DeviceError("serial:%s: controller is in alarm state while waiting"
+                                      % self.port_url)
+                return payload.state not in ("Idle", "Sleep")
         elif kind == pr.BANNER:
             if self._banner is not None and self._status is not None:
                 raise DeviceError("serial:%s: controller reset itself (%s)" % (self.port_url, line))
@@ -366,6 +384,7 @@ class SerialRig(Rig):
             if size is not None and not self._rx_buffer_forced:
                 self.rx_buffer = size
         # Other INFO lines ([MSG:...], [VER:...]) carry nothing the driver acts on.
+        return True
 
     def _answered(self, channel, line):
         """Retire the oldest unanswered line of the channel; an answer nobody asked for is

@@ -25,7 +25,9 @@ BANNER = "Grbl 1.1h ['$' for help]"
 SENSOR_MODEL = "BladeInspect-SimProbe"
 # The sensor buffers this many readings per acquisition; larger requests are OUT_OF_RANGE.
 MAX_READINGS = 10_000_000
-FAULT_KINDS = ("close", "garbage", "silent", "alarm", "sensor_error")
+# grblHAL's receive buffer: eight times GRBL 1.1's, so eight times fewer waits per pass.
+GRBLHAL_RX_BUFFER = 1024
+FAULT_KINDS = ("close", "garbage", "silent", "alarm", "sensor_error", "busy")
 
 
 @dataclass
@@ -33,11 +35,13 @@ class Fault:
     """Strikes at the command line after ``after_lines`` lines (G-code and sensor commands,
     counted since the device started): ``close`` closes the pty, ``garbage`` answers every
     line from then on with noise, ``silent`` stops answering, ``alarm`` raises ALARM:<alarm>
-    (1 hard limit), ``sensor_error`` makes the sensor report E <sensor_code>."""
+    (1 hard limit), ``sensor_error`` makes the sensor report E <sensor_code>, ``busy`` holds
+    that line's answers for ``busy_s`` seconds while reporting Run (a long move)."""
     kind: str
     after_lines: int
     alarm: int = 1
     sensor_code: str = "LASER_FAULT"
+    busy_s: float = 1.0
 
     def __post_init__(self):
         if self.kind not in FAULT_KINDS:
@@ -68,10 +72,11 @@ class SimRigDevice:
     (reading, snr); limits, home() and position() are used when present) on one pty, or on
     two (motion, sensor) with ``two_ports``. ``limits`` overrides the controller's soft limits
     (a controller set up tighter than the host believes). ``rx_buffer`` is the receive buffer
-    it reports in ``$I`` and holds the host to: 128 bytes as GRBL 1.1, 1024 as grblHAL."""
+    it reports in ``$I`` and holds the host to: 128 bytes as GRBL 1.1, 1024 as grblHAL (the
+    default: a rig fed at the sensor's 9000 points/s needs a controller of that class)."""
 
     def __init__(self, sim_rig, two_ports=False, fault=None, limits=None,
-                 rx_buffer=pr.GRBL_RX_BUFFER):
+                 rx_buffer=GRBLHAL_RX_BUFFER):
         self.sim_rig = sim_rig
         self.fault = fault
         self.limits = limits if limits is not None else getattr(sim_rig, "limits", None)
@@ -83,6 +88,9 @@ class SimRigDevice:
         self._motion = _Pty()
         self._sensor = _Pty() if two_ports else self._motion
         self._ptys = [self._motion] if self._sensor is self._motion else [self._motion, self._sensor]
+        self._busy_until = 0.0
+        self._busy_done = False
+        self._held = []         # answers of a busy line, sent when it is done
         self._stop = threading.Event()
         self._thread = None
         self._closed = False
@@ -114,10 +122,14 @@ class SimRigDevice:
 
     def _serve(self):
         while not self._stop.is_set() and not self._closed:
+            if self._held and time.monotonic() >= self._busy_until:
+                for pty, text in self._held:
+                    pty.outbox += text
+                self._held = []
             readers = [p.master for p in self._ptys]
             writers = [p.master for p in self._ptys if p.outbox]
             try:
-                readable, writable, _ = select.select(readers, writers, [], 0.05)
+                readable, writable, _ = select.select(readers, writers, [], 0.02)
             except (OSError, ValueError):
                 return
             for pty in self._ptys:
@@ -145,8 +157,13 @@ class SimRigDevice:
         del pty.outbox[:written]
 
     def _send(self, pty, line):
-        if not self._closed and not self._silent:
-            pty.outbox += (line + "\r\n").encode("ascii")
+        if self._closed or self._silent:
+            return
+        text = (line + "\r\n").encode("ascii")
+        if time.monotonic() < self._busy_until:
+            self._held.append((pty, text))
+        else:
+            pty.outbox += text
 
     def _close_ptys(self):
         self._closed = True
@@ -166,8 +183,10 @@ class SimRigDevice:
                 if self._state == "Alarm":
                     self._send(pty, "[MSG:'$H'|'$X' to unlock]")
             if b"?" in data:
-                for _ in range(data.count(b"?")):
-                    self._send(pty, pr.format_status(self._state, self._position))
+                state = "Run" if time.monotonic() < self._busy_until else self._state
+                if not self._silent:
+                    pty.outbox += ("%s\r\n" % pr.format_status(state, self._position)
+                                   ).encode("ascii") * data.count(b"?")
                 data = data.replace(b"?", b"")
             self._rx_pending += len(data)
             if self._rx_pending > self.rx_buffer:
@@ -193,6 +212,9 @@ class SimRigDevice:
             if fault.kind == "silent":
                 self._silent = True
                 return
+            if fault.kind == "busy" and not self._busy_done:
+                self._busy_done = True
+                self._busy_until = time.monotonic() + fault.busy_s
             if fault.kind == "garbage":
                 self._send(pty, "%%~ 0x3f garbage ~%%")
                 return
