@@ -34,6 +34,8 @@ class SerialFaultTest(unittest.TestCase):
         self.assertRegex(message, pattern)
         self.assertIn(device.port_url.split(",")[0], message)
         self.assertNotIn("\n", message)
+        with self.assertRaisesRegex(DeviceError, "unusable after an earlier failure"):
+            rig.scan_path(path, 15.0)
         rig.close()     # closing after a failure must not raise
         return message
 

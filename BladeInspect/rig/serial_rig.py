@@ -125,6 +125,7 @@ class SerialRig(Rig):
             self.sensor = sensor
         self._elapsed = 0.0
         self._timing_depth = 0
+        self._failure = None
         self._homed = False
         self._target = None
         self._status = None
@@ -165,10 +166,9 @@ class SerialRig(Rig):
     def move_to(self, x=None, y=None, z=None, a=None):
         with self._timed():
             self._ensure_homed()
-            cx, cy, cz, ca = self._target
-            target = tuple(c if v is None else float(v) for v, c in zip((x, y, z, a),
-                                                                          (cx, cy, cz, ca)))
-            self.limits.check(*target)
+        target = tuple(c if v is None else float(v) for v, c in zip((x, y, z, a), self._target))
+        self.limits.check(*target)
+        with self._timed():
             self._stream([pr.gcode_move("G0", x, y, z, a), pr.SYNC])
             self._target = target
 
@@ -206,11 +206,18 @@ class SerialRig(Rig):
     @contextlib.contextmanager
     def _timed(self):
         """Adds the wall time of the outermost rig operation to elapsed_s (home inside a
-        move counts once)."""
+        move counts once). A device failure inside leaves the exchange in an unknown state
+        (blocks unanswered, readings in flight): the rig refuses further work after it."""
+        if self._failure is not None:
+            raise DeviceError("serial:%s: rig unusable after an earlier failure (%s); open it "
+                              "again" % (self.port_url, self._failure))
         self._timing_depth += 1
         start = time.monotonic()
         try:
             yield
+        except DeviceError as exc:
+            self._failure = str(exc).split(": ", 1)[-1]
+            raise
         finally:
             self._timing_depth -= 1
             if self._timing_depth == 0:
