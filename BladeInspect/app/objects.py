@@ -402,7 +402,7 @@ def store_reconstruction(obj, recon):
     import Part
     shapes = [c.toShape() for c in recon.curves] + [s.toShape() for s in recon.surfaces]
     obj.Shape = Part.Compound(shapes)
-    obj.FitErrors = np.asarray(recon.fit_errors, dtype=float).ravel().tolist()
+    obj.FitErrors = [float(e["rms"]) for e in recon.fit_errors]
     obj.NCurves = len(recon.curves)
     obj.NSurfaces = len(recon.surfaces)
 
