@@ -88,6 +88,12 @@ class SimRigDevice:
         self._motion = _Pty()
         self._sensor = _Pty() if two_ports else self._motion
         self._ptys = [self._motion] if self._sensor is self._motion else [self._motion, self._sensor]
+        self._homed = False
+        self._alarm_latched = False
+        self._position = (tuple(float(v) for v in sim_rig.position())
+                          if hasattr(sim_rig, "position") else (0.0, 0.0, 0.0, 0.0))
+        self._silent = False
+        self._sensor_fault_sent = False
         self._busy_until = 0.0
         self._busy_done = False
         self._held = []         # answers of a busy line, sent when it is done
@@ -235,22 +241,19 @@ class SimRigDevice:
     # -- controller ------------------------------------------------------------------------
 
     def _reset(self):
+        """What a soft reset clears; homing, a latched alarm, the position and injected
+        faults survive it."""
         # As in GRBL, a reset does not clear a limit alarm: only $H or $X do.
-        self._homed = getattr(self, "_homed", False)
-        self._alarm_latched = getattr(self, "_alarm_latched", False)
         self._state = "Idle" if self._homed and not self._alarm_latched else "Alarm"
-        self._position = getattr(self, "_position", (0.0, 0.0, 0.0, 0.0))
         self._absolute = True
         self._motion_mode = 0
         self._feed = None
         self._trigger = False
         self._rx_pending = 0
-        self._silent = getattr(self, "_silent", False)
-        self._sensor_fault_sent = getattr(self, "_sensor_fault_sent", False)
         self._armed = None
         self._stage = []
         self._angle = None
-        for pty in getattr(self, "_ptys", []):
+        for pty in self._ptys:
             pty.inbox = b""
             pty.outbox.clear()
 
