@@ -405,7 +405,13 @@ class Report(_Command):
                               tolerance=settings.value("ToleranceMm"),
                               seed=registration.Seed, progress=p,
                               nominal=objects.nominal_of(registration.Nominal))
-        return progress.run("Report", job)
+        doc = registration.Document
+        try:
+            return progress.run("Report", job)
+        finally:
+            # The report saves its own document, which leaves another one active.
+            FreeCAD.setActiveDocument(doc.Name)
+            FreeCADGui.setActiveDocument(doc.Name)
 
 
 class Preferences(_Command):

@@ -14,6 +14,7 @@ from ..core.errors import Cancelled, InputError
 
 # Messages shown to the user, newest last: (title, text). Tests read them; dialogs can be off.
 MESSAGES = []
+LAST_TRACEBACK = [None]
 SHOW_DIALOGS = True
 _busy = []
 _open_boxes = []
@@ -91,7 +92,8 @@ def run(title, job):
         report_error(title, str(exc))
     except Exception as exc:
         # A bug, not bad input: one line to the user, the traceback to the log for a report.
-        FreeCAD.Console.PrintLog(traceback.format_exc())
+        LAST_TRACEBACK[0] = traceback.format_exc()
+        FreeCAD.Console.PrintLog(LAST_TRACEBACK[0])
         report_error(title, "internal error: %s: %s (details in the report view's log)"
                      % (type(exc).__name__, exc))
     finally:
