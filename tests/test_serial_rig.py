@@ -141,33 +141,41 @@ class SerialRigSimulatedTest(unittest.TestCase):
 
 
 class SimrigCommandTest(unittest.TestCase):
-    """``simrig_main`` in its own process, as ``./bladeinspect simrig --seed S`` runs it: the
-    printed port reaches a rig holding the demo blade, measuring as it does in process."""
+    """``simrig_main`` in its own process, as ``./bladeinspect simrig --cad CAD --seed S`` runs
+    it: the printed port reaches a rig holding that CAD, measuring as it does in process."""
 
-    def test_served_demo_blade_matches_in_process(self):
+    def test_served_cad_matches_in_process(self):
         import os
         import signal
         import subprocess
-        import sys
+        import tempfile
+        import Part
         from BladeInspect.rig.simrig_device import _load_nominal, simulated_rig_for
         from tests.helpers import REPO
+        folder = tempfile.TemporaryDirectory()
+        self.addCleanup(folder.cleanup)
+        # A cylinder's ray casts are cheap; the demo blade's first one takes seconds.
+        cad = os.path.join(folder.name, "part.step")
+        Part.makeCylinder(15.0, 60.0).exportStep(cad)
         env = dict(os.environ, PYTHONPATH=REPO + ":/usr/lib/freecad-python3/lib")
         server = subprocess.Popen(
-            ["/usr/bin/python3", "-c", "from BladeInspect.rig.simrig_device import simrig_main;"
-             " simrig_main(None, 3)"], cwd=REPO, env=env, stdout=subprocess.PIPE, text=True)
+            ["/usr/bin/python3", "-c", "import FreeCAD; from BladeInspect.rig.simrig_device "
+             "import simrig_main; simrig_main(%r, 3)" % cad],
+            cwd=REPO, env=env, stdout=subprocess.PIPE, text=True)
         self.addCleanup(server.wait, 10)
         self.addCleanup(server.send_signal, signal.SIGTERM)
+        reference = simulated_rig_for(_load_nominal(cad), 3)     # while the server loads
         first = server.stdout.readline()
         self.assertRegex(first, r"^simulated rig \(seed 3\) on /dev/pts/\d+$")
         rig = SerialRig(first.split()[-1], timeout_s=10)
         self.addCleanup(rig.close)
-        reference = simulated_rig_for(_load_nominal(None), 3)
         rig.home()
         reference.home()
-        path = np.column_stack([np.linspace(-40, 40, 120), np.full(120, 60.0), np.full(120, 60.0)])
-        got, expected = rig.scan_path(path, 30.0), reference.scan_path(path, 30.0)
-        assert_same_readings(self, got, expected)
-        self.assertGreater(np.isfinite(got.reading_mm).sum(), 5)
+        path = np.column_stack([np.linspace(-40, 40, 80), np.full(80, 60.0), np.full(80, 60.0)])
+        for angle in (30.0, 120.0):
+            got, expected = rig.scan_path(path, angle), reference.scan_path(path, angle)
+            assert_same_readings(self, got, expected)
+            self.assertGreater(np.isfinite(got.reading_mm).sum(), 5)
 
 
 if __name__ == "__main__":
