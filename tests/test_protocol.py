@@ -82,6 +82,12 @@ class MotionLineTest(unittest.TestCase):
         self.assertEqual(pr.parse_motion_line("ALARM:1"), (pr.ALARM, 1))
         self.assertEqual(pr.parse_motion_line("[MSG:Caution: Unlocked]"), (pr.INFO, "MSG:Caution: Unlocked"))
         self.assertEqual(pr.parse_motion_line("Grbl 1.1h ['$' for help]")[0], pr.BANNER)
+        self.assertEqual(pr.parse_motion_line("GrblHAL 1.1f ['$' or '$HELP' for help]")[0],
+                         pr.BANNER)
+        self.assertEqual(pr.parse_build_options("OPT:V,15,128"), 128)
+        self.assertEqual(pr.parse_build_options("OPT:VNMSL,35,1024,3,0"), 1024)
+        self.assertIsNone(pr.parse_build_options("OPT:V"))
+        self.assertIsNone(pr.parse_build_options("VER:1.1h.20190825:"))
         self.assertEqual(pr.parse_motion_line("<Idle|MPos:0,0,0,0>")[0], pr.STATUS)
         for line in ("okay", "error:x", "%%~ garbage", "ALARM:"):
             with self.assertRaises(pr.ProtocolError, msg=line):

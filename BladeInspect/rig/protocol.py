@@ -21,6 +21,8 @@ GRBL_RX_BUFFER = 128
 # GRBL's line buffer: longer lines are rejected with error:14 (1.1) rather than executed.
 GRBL_MAX_LINE = 80
 STATUS_QUERY = b"?"
+# GRBL greets with "Grbl 1.1h ['$' for help]", grblHAL with "GrblHAL 1.1f ['$' or '$HELP' ...]".
+BANNER_PREFIXES = ("Grbl ", "GrblHAL ")
 SOFT_RESET = b"\x18"
 
 GRBL_ERRORS = {
@@ -208,7 +210,7 @@ def parse_motion_line(line):
         return STATUS, parse_status(line)
     if line.startswith("[") and line.endswith("]"):
         return INFO, line[1:-1]
-    if line.startswith("Grbl "):
+    if line.startswith(BANNER_PREFIXES):
         return BANNER, line
     raise ProtocolError("unexpected line %r" % line)
 

@@ -353,7 +353,7 @@ class SerialRig(Rig):
         """Act on one line; False only for a poll's answer that shows no motion."""
         if self._connecting:
             # Until the reset's greeting, lines are leftovers of an earlier session.
-            if line.startswith("Grbl "):
+            if line.startswith(pr.BANNER_PREFIXES):
                 self._banner = line
             return True
         if port is self._sensor and (not self._shared or line.startswith(pr.SENSOR_PREFIX)):
