@@ -124,13 +124,13 @@ class TestMeasurement(DocumentCase):
         from BladeInspect.inspect.pipeline import load_points
         path = os.path.join(self.tmp, "pts.csv")
         rng = np.random.default_rng(2)
-        first = rng.uniform(-10, 10, (50, 4))
+        first = np.column_stack([rng.uniform(-10, 10, (50, 3)), rng.uniform(0, 100, 50)])
         np.savetxt(path, first, delimiter=",", header="x,y,z,snr", comments="", fmt="%.9f")
         obj = objects.make_measurement(self.doc, load_points(path), source_file=path)
         self.doc.recompute()
         np.testing.assert_allclose(np.reshape(obj.Coordinates, (-1, 3)), first[:, :3],
                                    atol=1e-9)
-        second = rng.uniform(-10, 10, (70, 4))
+        second = np.column_stack([rng.uniform(-10, 10, (70, 3)), rng.uniform(0, 100, 70)])
         np.savetxt(path, second, delimiter=",", header="x,y,z,snr", comments="", fmt="%.9f")
         os.utime(path, ns=(1, 10 ** 18))   # a different mtime even within the clock's tick
         obj.touch()
@@ -140,6 +140,84 @@ class TestMeasurement(DocumentCase):
         np.testing.assert_allclose(np.reshape(obj.Coordinates, (-1, 3)), expected[:, :3],
                                    atol=1e-9)
         np.testing.assert_allclose(obj.SNR, expected[:, 3], atol=1e-9)
+
+
+class FakeReconstruction:
+    """What cad.loft.reconstruct returns: B-spline curves through known points, a surface."""
+
+    def __init__(self, points_per_curve):
+        import Part
+        self.curves = []
+        for pts in points_per_curve:
+            curve = Part.BSplineCurve()
+            curve.interpolate([FreeCAD.Vector(*p) for p in pts])
+            self.curves.append(curve)
+        surface = Part.BSplineSurface()
+        grid = [[FreeCAD.Vector(x, y, 0.1 * x * y) for y in range(4)] for x in range(4)]
+        surface.interpolate(grid)
+        self.surfaces = [surface]
+        self.samples = np.zeros((0, 3))
+        self.fit_errors = [{"section": i, "side": "suction", "rms": 0.001 * (i + 1),
+                            "max": 0.003 * (i + 1)} for i in range(len(points_per_curve))]
+
+
+class TestReconstruction(DocumentCase):
+    def _curves(self, rng, shift=0.0):
+        return [np.column_stack([np.linspace(0, 40, 12), rng.uniform(-2, 2, 12) + shift,
+                                 np.full(12, 10.0 * k)]) for k in range(3)]
+
+    def test_geometry_passes_through_the_fitted_points_after_reopen(self):
+        import Part
+        rng = np.random.default_rng(7)
+        curves = self._curves(rng)
+        meas = objects.make_measurement(self.doc, FakePointSet(np.vstack(curves)))
+        obj = objects.make_reconstruction(self.doc, meas, FakeReconstruction(curves))
+        name = obj.Name
+        obj = self.reopen().getObject(name)
+        self.assertEqual(obj.NCurves, 3)
+        self.assertEqual(obj.NSurfaces, 1)
+        self.assertEqual(len(obj.Shape.Faces), 1)
+        self.assertEqual(len(obj.Shape.Edges), 3 + 4)   # three curves, the face's boundary
+        np.testing.assert_allclose(obj.FitErrors, [0.001, 0.002, 0.003])
+        self.assertAlmostEqual(obj.MaxFitErrorMm, 0.009)
+        # Each curve interpolates its points: OCC's own distance to the stored shape is ~0.
+        for pts in curves:
+            for p in pts[::3]:
+                d = obj.Shape.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0]
+                self.assertLess(d, 1e-7)
+
+    def test_recomputes_when_the_measurement_changes(self):
+        import types
+        rng = np.random.default_rng(8)
+        first, second = self._curves(rng), self._curves(rng, shift=5.0)
+        calls = []
+
+        def fake_reconstruct(pointset):
+            calls.append(len(pointset.xyz))
+            return FakeReconstruction(second)
+        module = types.ModuleType("BladeInspect.cad.loft")
+        module.reconstruct = fake_reconstruct
+        import sys
+        saved_module = sys.modules.get("BladeInspect.cad.loft")
+        saved_pointset_of = objects.pointset_of
+        sys.modules["BladeInspect.cad.loft"] = module
+        objects.pointset_of = lambda obj: FakePointSet(np.reshape(obj.Coordinates, (-1, 3)))
+        try:
+            meas = objects.make_measurement(self.doc, FakePointSet(np.vstack(first)))
+            obj = objects.make_reconstruction(self.doc, meas, FakeReconstruction(first))
+            self.doc.recompute()
+            self.assertEqual(calls, [])
+            objects.store_pointset(meas, FakePointSet(np.vstack(second)[:30]))
+            self.doc.recompute()
+            self.assertEqual(calls, [30])
+            ys = [v.Y for v in obj.Shape.Edges[0].Vertexes]
+            self.assertTrue(all(y > 2.5 for y in ys), ys)   # the shifted curves are stored
+        finally:
+            objects.pointset_of = saved_pointset_of
+            if saved_module is None:
+                del sys.modules["BladeInspect.cad.loft"]
+            else:
+                sys.modules["BladeInspect.cad.loft"] = saved_module
 
 
 class TestRegistration(DocumentCase):

@@ -374,7 +374,12 @@ class Reconstruction(_Proxy):
         _add(obj, "App::PropertyLink", "Measurement", "Reconstruction",
              "Measurement whose section lines are fitted")
         _add(obj, "App::PropertyFloatList", "FitErrors", "Reconstruction",
-             "Fit error of each section curve, mm", read_only=True)
+             "RMS fit error of each section curve, mm", read_only=True)
+        _add(obj, "App::PropertyFloat", "MaxFitErrorMm", "Reconstruction",
+             "Largest distance of a measured point from its section curve, mm", read_only=True)
+        _add(obj, "App::PropertyString", "FitErrorsJson", "Reconstruction",
+             "Fit errors per curve (section, side, rms, max) as cad.loft reports them",
+             hidden=True)
         _add(obj, "App::PropertyInteger", "NCurves", "Reconstruction", "Section curves",
              read_only=True)
         _add(obj, "App::PropertyInteger", "NSurfaces", "Reconstruction", "Lofted surfaces",
@@ -402,7 +407,11 @@ def store_reconstruction(obj, recon):
     import Part
     shapes = [c.toShape() for c in recon.curves] + [s.toShape() for s in recon.surfaces]
     obj.Shape = Part.Compound(shapes)
-    obj.FitErrors = [float(e["rms"]) for e in recon.fit_errors]
+    errors = list(recon.fit_errors)
+    # cad.loft reports a dict per curve (section, side, n_points, rms, max).
+    obj.FitErrors = [float(e["rms"]) for e in errors]
+    obj.MaxFitErrorMm = max((float(e["max"]) for e in errors), default=0.0)
+    obj.FitErrorsJson = json.dumps(errors, default=_json_default)
     obj.NCurves = len(recon.curves)
     obj.NSurfaces = len(recon.surfaces)
 
