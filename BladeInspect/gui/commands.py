@@ -222,12 +222,12 @@ class ImportPoints(_Command):
 
         def job(p):
             p(0.1, "reading %s" % os.path.basename(path))
-            name = os.path.splitext(os.path.basename(path))[0]
-            return objects.make_measurement(doc, load_points(path), name="Measurement",
-                                            source_file=path)
+            obj = objects.make_measurement(doc, load_points(path), name="Measurement",
+                                           source_file=path)
+            obj.Label = os.path.splitext(os.path.basename(path))[0]
+            return obj
         obj = progress.run("Import points", job)
         if obj is not None:
-            obj.Label = os.path.splitext(os.path.basename(path))[0]
             _recompute_gui(doc)
         return obj
 

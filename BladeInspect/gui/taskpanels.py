@@ -3,7 +3,6 @@ Panels collect input and show output; the work is done by the commands' pipeline
 import dataclasses
 import math
 
-import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
