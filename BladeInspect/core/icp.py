@@ -13,8 +13,9 @@ w_i = a_i * rho_i:
   efficient estimator, and the covariance formula below is exact for them); gross outliers and
   real defects (many sigma away) weigh exactly 0. Two refinements (see robust_weights): a_i is
   floored at 1 / max_noise_ratio^2 inside z (a low SNR lowers the weight, it does not excuse
-  a gross error), and rho_i is multiplied by the same taper applied to the median of z over
-  the point's measured neighbourhood (a defect's low flanks are coherent, noise is not).
+  a gross error), and rho_i is multiplied by the same taper applied to the mean of the
+  (clipped) z over the point's measured neighbourhood (a defect's low flanks are coherent,
+  noise is not).
   A point is an inlier when rho_i > 0.
 
 Iterations: Horn's closed form against the exact closest points first (robust from a coarse
@@ -111,14 +112,15 @@ def _robust_scale(values, options):
     return max(MAD_TO_SIGMA * np.median(np.abs(values - med)), options.min_scale)
 
 
-def robust_weights(distances, a, options, neighbours=None):
+def robust_weights(distances, a, options, neighbourhoods=None):
     """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point).
 
-    `neighbours` (N, k) indices of each point's nearest measured points switch on the defect
-    test: the median of the standardised residuals over a point's neighbourhood is judged
-    against the spread of those local medians. Noise averages out in a neighbourhood, a
+    `neighbourhoods` (of the measured points) switches on the defect test: the mean of the
+    standardised residuals, clipped at +-k_full s, over a point's neighbourhood is judged
+    against the robust spread of those means. Noise averages out in a neighbourhood, a
     defect's flank (a real deviation of a few sigma, too small for the per-point test) does
-    not, so flanks are rejected with the defect instead of tilting the fit.
+    not, so flanks are rejected with the defect instead of tilting the fit; the clipping keeps
+    a gross outlier from rejecting its neighbours.
     """
     usable = (a > 0) & np.isfinite(distances)
     if not usable.any():
@@ -131,21 +133,58 @@ def robust_weights(distances, a, options, neighbours=None):
                  np.inf)
     scale = _robust_scale(z[usable], options)
     rho = _taper(np.abs(z) / scale, options)
-    if neighbours is not None and options.defect_neighbours > 0:
-        # An unusable neighbour (z = inf) shifts a median by one rank at most; only a
-        # neighbourhood mostly without readings gets an infinite median, and no weight.
-        local = np.median(z[neighbours], axis=1)
+    if neighbourhoods is not None:
+        limit = options.k_full * scale
+        local = neighbourhoods.means(np.clip(z, -limit, limit), usable)
         finite = np.isfinite(local)
         if finite.any():
             rho = rho * _taper(np.abs(local) / _robust_scale(local[finite], options), options)
     return rho, scale
 
 
-def neighbourhoods(points, k):
-    """(N, k) indices of each point's k nearest points (itself included)."""
-    from scipy.spatial import cKDTree
-    k = min(k, len(points))
-    return cKDTree(points).query(points, k=k, workers=-1)[1].reshape(len(points), k)
+class Neighbourhoods:
+    """Each measured point's neighbourhood: the `size` points around it along a Morton
+    (Z-order) curve through the cloud. Neighbours along the curve are near in space (but for
+    the curve's rare long jumps), and a mean over a sliding window costs two cumulative sums,
+    where k-nearest neighbours of a few hundred thousand points would cost seconds. The points
+    move rigidly during ICP, so the order is computed once."""
+
+    LEVELS = 1 << 10   # grid steps per axis for the curve (30-bit codes)
+
+    def __init__(self, points, size):
+        lo = points.min(axis=0)
+        step = max(float(np.max(points.max(axis=0) - lo)), 1e-9) / (self.LEVELS - 1)
+        ijk = np.minimum(((points - lo) / step).astype(np.int64), self.LEVELS - 1)
+        code = (self._spread(ijk[:, 0]) << 2) | (self._spread(ijk[:, 1]) << 1) \
+            | self._spread(ijk[:, 2])
+        self.order = np.argsort(code, kind="stable")
+        n = len(points)
+        self.size = min(size, n)
+        # Window start of each position along the curve, the window centred where possible.
+        self._start = np.clip(np.arange(n) - self.size // 2, 0, n - self.size)
+
+    @staticmethod
+    def _spread(v):
+        """The 10 bits of v moved to every third bit (Morton interleaving)."""
+        v = v & 0x3FF
+        v = (v | (v << 16)) & 0x030000FF
+        v = (v | (v << 8)) & 0x0300F00F
+        v = (v | (v << 4)) & 0x030C30C3
+        v = (v | (v << 2)) & 0x09249249
+        return v
+
+    def means(self, values, usable):
+        """Mean of `values` over each point's neighbourhood, counting usable points only (NaN
+        where a neighbourhood has none)."""
+        ordered = np.where(usable, values, 0.0)[self.order]
+        sums = np.concatenate([[0.0], np.cumsum(ordered)])
+        counts = np.concatenate([[0], np.cumsum(usable[self.order])])
+        end = self._start + self.size
+        with np.errstate(invalid="ignore", divide="ignore"):
+            along = (sums[end] - sums[self._start]) / (counts[end] - counts[self._start])
+        result = np.empty(len(values))
+        result[self.order] = along
+        return result
 
 
 def _jacobian(points_cad, normals, center):
@@ -215,9 +254,8 @@ def icp(points, snr, closest_fn, init, options=None):
         raise InputError("icp: need at least 7 points of shape (N, 3), got %s"
                          % (points.shape,))
     a = _snr_weights(snr, len(points))
-    # Neighbourhoods in the measured frame: the points move rigidly, so they never change.
-    neighbours = (neighbourhoods(points, options.defect_neighbours)
-                  if 0 < options.defect_neighbours < len(points) else None)
+    neighbourhoods = (Neighbourhoods(points, options.defect_neighbours)
+                      if 0 < options.defect_neighbours < len(points) else None)
     T = np.array(init, dtype=float)
     converged = False
     iterations = 0
@@ -226,7 +264,7 @@ def icp(points, snr, closest_fn, init, options=None):
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
-        rho, _ = robust_weights(distances, a, options, neighbours)
+        rho, _ = robust_weights(distances, a, options, neighbourhoods)
         w = a * rho
         if np.count_nonzero(w) < 7:
             last_step = None
@@ -258,7 +296,7 @@ def icp(points, snr, closest_fn, init, options=None):
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
         _, normals, distances = closest_fn(moved)
-    rho, _ = robust_weights(distances, a, options, neighbours)
+    rho, _ = robust_weights(distances, a, options, neighbourhoods)
     w = a * rho
     inlier = rho > 0
     center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)
