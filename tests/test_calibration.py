@@ -172,5 +172,44 @@ class TestCalibrateOnSimulatedRig(unittest.TestCase):
             cal.calibrate(rig, -1.0)
 
 
+class TestCalibrationCommand(unittest.TestCase):
+    def test_run_calibration_on_the_simulated_rig(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "RIG.json")
+            result = cal.run_calibration(path, "sim", 25.0, seed=9, axis_offset_mm=0.2,
+                                         axis_tilt_deg=0.1)
+            with open(path) as fh:
+                saved = json.load(fh)
+        truth = result["truth"]
+        self.assertAlmostEqual(np.linalg.norm(truth["axis_point"]), 0.2, places=12)
+        self.assertLess(np.linalg.norm(np.subtract(saved["axis_point"], truth["axis_point"])),
+                        0.002)
+        self.assertLess(np.degrees(np.arccos(np.dot(saved["axis_direction"],
+                                                    truth["axis_direction"]))), 0.001)
+
+    def test_same_axis_over_the_serial_driver(self):
+        # The simulated device on a pseudo-terminal gives the very readings of the rig in
+        # process, so the serial path must find exactly the same axis.
+        from BladeInspect.rig.serial_rig import SerialRig
+        from BladeInspect.rig.simrig_device import SimRigDevice
+        angles = cal.DEFAULT_ANGLES[::2]
+        device = SimRigDevice(cal.simulated_calibration_rig(seed=4, axis_offset_mm=0.2,
+                                                            axis_tilt_deg=0.1)[0]).start()
+        self.addCleanup(device.stop)
+        rig = SerialRig(device.port_url, timeout_s=5)
+        self.addCleanup(rig.close)
+        over_serial = cal.calibrate(rig, 25.0, angles=angles)
+        in_process = cal.calibrate(cal.simulated_calibration_rig(
+            seed=4, axis_offset_mm=0.2, axis_tilt_deg=0.1)[0], 25.0, angles=angles)
+        np.testing.assert_allclose(over_serial["axis_point"], in_process["axis_point"],
+                                   atol=1e-12)
+        np.testing.assert_allclose(over_serial["axis_direction"],
+                                   in_process["axis_direction"], atol=1e-12)
+
+    def test_bad_rig_spec(self):
+        with self.assertRaises(InputError):
+            cal.run_calibration(None, "usb")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -288,3 +288,51 @@ def sphere_residual(rig, kinematics, sphere_diameter=DEFAULT_DIAMETER, angles=DE
     fit = fitting.fit_sphere(pts, radius=radius, weights=snr)
     return {"rms_mm": float(np.sqrt(np.mean(fit.residuals ** 2))),
             "n_points": int(len(pts)), "centre_table": fit.center.tolist()}
+
+
+def simulated_calibration_rig(sphere_diameter=DEFAULT_DIAMETER, seed=0, axis_offset_mm=0.0,
+                              axis_tilt_deg=0.0, stage_scale=(0.0, 0.0, 0.0), sensor=None,
+                              sphere_position=DEFAULT_SPHERE_POSITION):
+    """A SimulatedRig measuring a reference sphere, its TRUE kinematics off the nominal by the
+    given axis offset and tilt (in seeded random directions across +Y) and stage scale errors:
+    what `calibrate --rig sim` measures, and what tests judge calibration against.
+    Returns (rig, true kinematics)."""
+    from ..core import transforms as tf
+    from .simulated import SimulatedRig
+    rng = np.random.default_rng(seed)
+    lean, shift = rng.uniform(0.0, 2.0 * np.pi, 2)
+    tilt = np.radians(axis_tilt_deg)
+    direction = np.array([np.sin(tilt) * np.cos(lean), np.cos(tilt), np.sin(tilt) * np.sin(lean)])
+    point = axis_offset_mm * np.array([np.cos(shift), 0.0, np.sin(shift)])
+    truth = RigKinematics(axis_point=point, axis_direction=direction, stage_scale=stage_scale)
+    mount = np.asarray(sphere_position, dtype=float) + rng.uniform(-1.0, 1.0, 3)
+    rig = SimulatedRig(SpherePart(0.5 * float(sphere_diameter)),
+                       tf.make_transform(np.eye(3), -mount), sensor=sensor, kinematics=truth,
+                       seed=seed)
+    return rig, truth
+
+
+def run_calibration(out_path, rig_spec="sim", sphere_diameter=DEFAULT_DIAMETER, seed=0,
+                    rig_file=None, progress=None, **simulated_errors):
+    """The `calibrate` command: open the rig ('sim' -> simulated_calibration_rig with
+    ``simulated_errors``; 'serial:PATH' -> the serial driver), calibrate, write RIG.json.
+    ``rig_file``: the kinematics believed so far (default nominal). Returns calibrate()'s dict,
+    with the simulator's truth under ``truth`` for a simulated rig."""
+    prior = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
+    truth = None
+    if rig_spec == "sim":
+        rig, truth = simulated_calibration_rig(sphere_diameter, seed=seed, **simulated_errors)
+    elif str(rig_spec).startswith("serial:"):
+        from .serial_rig import SerialRig
+        rig = SerialRig(rig_spec[len("serial:"):])
+    else:
+        raise InputError("--rig: expected sim or serial:PORT, got %r" % (rig_spec,))
+    try:
+        result = calibrate(rig, sphere_diameter, out_path=out_path, kinematics=prior,
+                           progress=progress)
+    finally:
+        rig.close()
+    if truth is not None:
+        result["truth"] = {"axis_point": truth.axis_point.tolist(),
+                           "axis_direction": truth.axis_direction.tolist()}
+    return result
