@@ -383,6 +383,15 @@ class TestPackaging(unittest.TestCase):
         with open(os.path.join(REPO, "InitGui.py")) as fh:
             self.assertIn("class BladeInspectWorkbench", fh.read())
 
+    def test_freecads_own_metadata_reader_accepts_package_xml(self):
+        meta = FreeCAD.Metadata(os.path.join(REPO, "package.xml"))
+        self.assertEqual((meta.Name, meta.Version), ("BladeInspect", "0.1.0"))
+        self.assertEqual(meta.License[0]["name"], "LGPL-2.1-or-later")
+        wb = meta.Content["workbench"][0]
+        self.assertEqual((wb.Classname, wb.Subdirectory, wb.FreeCADMin),
+                         ("BladeInspectWorkbench", "./", "0.20.0"))
+        self.assertEqual([d["package"] for d in wb.Depend], ["numpy", "scipy", "pyserial"])
+
     def test_every_command_has_a_valid_svg_icon(self):
         for verb in COMMAND_VERBS + ("",):
             name = "BladeInspect_" + verb if verb else "BladeInspect"
