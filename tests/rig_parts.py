@@ -30,7 +30,9 @@ class TwistedEllipse:
     chord (semi-axis a, along +X at z = 0) turns right-handed about +Z by twist_deg over the
     length. Span along +Z like the demo blade."""
 
-    SAMPLES = 160
+    # The solid is convex in each section, so a ray enters it once: a step that jumps a
+    # sliver thinner than itself can only turn a grazing hit into a miss, never a wrong hit.
+    SAMPLES = 96
     BISECTIONS = 60
 
     def __init__(self, a=25.0, b=3.0, length=70.0, twist_deg=25.0):

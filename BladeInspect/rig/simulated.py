@@ -118,7 +118,8 @@ class SimulatedRig(Rig):
 
     def cad_from_machine(self, angle_deg):
         """4x4 taking machine points at this rotary angle into the CAD frame (the truth)."""
-        machine_to_table = tf.invert_transform(self.kinematics.table_to_machine_transform(angle_deg))
+        machine_to_table = tf.invert_transform(
+            self.kinematics.table_to_machine_transform(angle_deg))
         return self.table_to_cad @ machine_to_table
 
     def measure(self, stage_xyz, angle_deg, pass_index):

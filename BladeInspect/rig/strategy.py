@@ -1,0 +1,554 @@
+"""The blind section-line scan (paper 3.1.1, steps 1-5), driven only by what the sensor reads.
+
+Per section plane Y = y_k and per view (rotary angle):
+  1. find the surface: linear passes at fixed Z stepping down through the search envelope
+     (or at the level the previous section found) until the sensor reads;
+  2. that linear scan at fixed Z gives the first points, only those within the working range;
+  3. fit a cubic uniform B-spline to the valid points (parametric by chord length, so the
+     steep flanks near the edges are as easy as the flat middle);
+  4. rescan along the fitted curve raised by the standoff, judge |d - z_s| <= epsilon, and
+     extend the path past both ends along the curve's tangent while readings continue;
+     refit with everything read so far and repeat;
+  5. when a pass meets the criterion over the whole section and neither end grows, scan the
+     curve once more at the final point spacing; only readings meeting the criterion are kept.
+Views of a section: the first side at the section's base angle, the edges at +-90 deg (edge up,
+as far as the angular coverage reaches) and the other side at +180 deg. The next section's
+base angle is the one that levelled this section's first side (its chord read from the points)
+carried on by the twist rate read between the last two sections, so every section is scanned
+nearly level. The first section levels itself the same way before it counts.
+
+Everything is in stage coordinates while planning (surface height = Z - d); the kinematics
+(RIG.json) turns the kept readings into machine and then table-frame points.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from ..core.errors import InputError
+from .kinematics import RigKinematics
+
+# Views of one section as (name, angle offset from the section's base angle in deg).
+SIDE_VIEWS = (("side1", 0.0), ("side2", 180.0))
+EDGE_VIEWS = (("edge1", 90.0), ("edge2", 270.0))
+MIN_VIEW_POINTS = 5
+SPAN_PROBE_OFFSETS = (-15.0, 0.0, 15.0)
+MAX_EXTENSION_FACTOR = 4.0
+# Where the re-centred first window puts the highest surface point found, in half ranges
+# above the window's centre.
+RECENTRE_TOP = 0.6
+LEVEL_TOLERANCE_DEG = 10.0
+MAX_LEVELLING = 3
+KNOT_SPACING_MM = 1.5
+# Second-difference penalty relative to the data term: small enough not to bias the fit where
+# data are dense, enough to bridge gaps (a straight line across them) and the end intervals.
+SMOOTHING = 1e-3
+OUTLIER_SIGMAS = 6.0
+OUTLIER_FLOOR_MM = 0.03
+MAX_FIT_ROUNDS = 5
+# Sampling of the fitted curve for point-to-curve distances: its chord error at the curvature
+# of a blade's edge (radius ~0.2 mm and up) stays below a micrometre.
+DENSE_STEP_MM = 0.02
+
+
+# ---------------------------------------------------------------- section curve (step 3)
+
+class SectionCurve:
+    """Cubic uniform B-spline (x(s), z(s)) fitted to section points, s ~ arc length on
+    [0, length], x increasing with s; beyond the ends it continues along the end tangents (the
+    path extension), kept at least ``min_dx`` outward in x per unit length: a surface seen
+    from above is never steeper than the sensor's coverage, and a vertical extension would
+    probe the same spot over and over."""
+
+    def __init__(self, x_spline, z_spline, length, min_dx=np.cos(np.radians(85.0))):
+        self._x, self._z = x_spline, z_spline
+        self._dx, self._dz = x_spline.derivative(), z_spline.derivative()
+        self.length = float(length)
+        self.min_dx = float(min_dx)
+
+    def tangent(self, s):
+        """Unit tangent in the direction of increasing s (and x), at most as steep as
+        min_dx allows."""
+        t = np.array([float(self._dx(s)), float(self._dz(s))])
+        n = np.linalg.norm(t)
+        t = t / n if n > 0 else np.array([1.0, 0.0])
+        if t[0] < self.min_dx:
+            t = np.array([self.min_dx, np.copysign(np.sqrt(1.0 - self.min_dx ** 2), t[1])])
+        return t
+
+    def __call__(self, s):
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        inner = np.clip(s, 0.0, self.length)
+        out = np.column_stack([self._x(inner), self._z(inner)])
+        for end, mask in ((0.0, s < 0.0), (self.length, s > self.length)):
+            if np.any(mask):
+                start = np.array([float(self._x(end)), float(self._z(end))])
+                out[mask] = start + np.outer(s[mask] - end, self.tangent(end))
+        return out
+
+
+def _chord_parameter(x, z):
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(z)))])
+    return s
+
+
+def _penalised_fit(s, values, length, knot_spacing):
+    """Cubic spline with uniform knots, least squares plus a second-difference penalty."""
+    intervals = max(1, int(np.ceil(length / knot_spacing)))
+    inner = np.linspace(0.0, length, intervals + 1)
+    knots = np.concatenate([[0.0] * 3, inner, [length] * 3])
+    B = BSpline.design_matrix(np.clip(s, 0.0, length), knots, 3).toarray()
+    n = B.shape[1]
+    D = np.diff(np.eye(n), 2, axis=0)
+    BtB = B.T @ B
+    lam = SMOOTHING * max(np.mean(np.diag(BtB)), 1e-12)
+    coef = np.linalg.solve(BtB + lam * D.T @ D + 1e-12 * np.eye(n), B.T @ values)
+    return BSpline(knots, coef, 3, extrapolate=False)
+
+
+def fit_section_curve(x, z, knot_spacing=KNOT_SPACING_MM, max_incidence_deg=85.0):
+    """Cubic uniform B-spline through section points seen from above (a graph z(x)). Gross
+    errors are removed by a robust scale of the point-to-curve distances (of every point, so
+    a point wrongly dropped while an outlier still bent the curve comes back) and the fit is
+    repeated until the kept set settles. Returns (SectionCurve, kept mask in input order)."""
+    from scipy.spatial import cKDTree
+    x = np.asarray(x, dtype=float)
+    z = np.asarray(z, dtype=float)
+    order = np.argsort(x, kind="stable")
+    points = np.column_stack([x, z])
+    keep = np.ones(len(x), bool)
+    min_dx = np.cos(np.radians(max_incidence_deg))
+    for _ in range(MAX_FIT_ROUNDS):
+        idx = order[keep[order]]
+        s = _chord_parameter(x[idx], z[idx])
+        length = max(s[-1], 1e-6)
+        curve = SectionCurve(_penalised_fit(s, x[idx], length, knot_spacing),
+                             _penalised_fit(s, z[idx], length, knot_spacing), length, min_dx)
+        dense = curve(np.linspace(0.0, length, max(2, int(length / DENSE_STEP_MM) + 1)))
+        r, _ = cKDTree(dense).query(points)
+        # Half-normal distances: sigma = 1.4826 * median.
+        limit = max(OUTLIER_SIGMAS * 1.4826 * np.median(r[keep]), OUTLIER_FLOOR_MM)
+        new_keep = r <= limit
+        if np.count_nonzero(new_keep) < MIN_VIEW_POINTS or np.array_equal(new_keep, keep):
+            break
+        keep = new_keep
+    return curve, keep
+
+
+# ---------------------------------------------------------------- results and state
+
+@dataclass
+class ViewResult:
+    name: str
+    angle_deg: float
+    stage_xyz: np.ndarray          # (N,3) final-pass triggers kept
+    reading_mm: np.ndarray         # (N,)
+    snr: np.ndarray                # (N,)
+    passes: list                   # per pass: kind, points, readings, max_standoff_error_mm, ...
+    surface_z: float = None        # median surface height in stage Z (the next section's hint)
+
+
+@dataclass
+class SectionResult:
+    index: int
+    y: float
+    base_angle_deg: float
+    table_xyz: np.ndarray          # (N,3) table-frame points
+    snr: np.ndarray
+    angle_deg: np.ndarray          # (N,) rotary angle of each point
+    views: list                    # ViewResult
+    simulated_s: float
+    max_standoff_error_mm: float
+
+    @property
+    def passes(self):
+        return sum(len(v.passes) for v in self.views)
+
+
+@dataclass
+class StrategyState:
+    """Everything a resumed scan needs to measure the remaining sections exactly as an
+    uninterrupted one would (JSON-ready through to_dict)."""
+    section_y: list = None
+    next_section: int = 0
+    base_angle_deg: float = 0.0
+    levelled: bool = False
+    surface_z: dict = field(default_factory=dict)     # view name -> stage-Z surface height
+    level_angles: list = field(default_factory=list)  # [y, angle levelling side 1] per section
+    pass_index: int = None
+    span_range: list = None
+
+    def to_dict(self):
+        return {"section_y": None if self.section_y is None else [float(v) for v in self.section_y],
+                "next_section": int(self.next_section),
+                "base_angle_deg": float(self.base_angle_deg),
+                "levelled": bool(self.levelled),
+                "surface_z": {k: float(v) for k, v in self.surface_z.items()},
+                "level_angles": [[float(a), float(b)] for a, b in self.level_angles],
+                "pass_index": self.pass_index,
+                "span_range": self.span_range}
+
+    @classmethod
+    def from_dict(cls, data):
+        try:
+            return cls(section_y=data["section_y"], next_section=int(data["next_section"]),
+                       base_angle_deg=float(data["base_angle_deg"]),
+                       levelled=bool(data["levelled"]), surface_z=dict(data["surface_z"]),
+                       level_angles=[list(v) for v in data.get("level_angles", [])],
+                       pass_index=data.get("pass_index"), span_range=data.get("span_range"))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError("scan checkpoint: malformed strategy state (%s)" % exc)
+
+
+# ---------------------------------------------------------------- the strategy
+
+class ScanStrategy:
+    """The paper's section-line scan on any Rig.
+
+    ``span_range`` (lo, hi): the blade's extent along the rotary axis (machine Y); None probes
+    it. Sections are evenly spread inside it, ``end_margin`` (fraction of the span, at least
+    1 mm) from its ends, or ``section_spacing`` mm apart centred on it. ``point_spacing``: final
+    pass, along the section; ``probe_spacing``: probes and intermediate passes. ``epsilon``:
+    the standoff criterion |d - z_s|. ``sides`` 1 or 2, ``edges``: the extra edge views.
+    ``search_radius``: the part lies within this distance of the rotary axis.
+    ``kinematics``: the rig geometry believed (RIG.json); default nominal."""
+
+    def __init__(self, rig, n_sections=5, span_range=None, section_spacing=None,
+                 point_spacing=0.1, probe_spacing=0.5, epsilon=2.0, sides=2, edges=True,
+                 max_passes=8, search_radius=45.0, end_margin=0.05, extension_mm=3.0,
+                 kinematics=None, state=None):
+        sensor = rig.sensor
+        if sensor is None:
+            raise InputError("scan: the rig has no sensor model")
+        if int(n_sections) != n_sections or n_sections < 1:
+            raise InputError("--sections: must be a positive integer, got %r" % (n_sections,))
+        if sides not in (1, 2):
+            raise InputError("--sides: must be 1 or 2, got %r" % (sides,))
+        if not 0 < epsilon <= sensor.half_range:
+            raise InputError("--epsilon: must be in (0, %g] mm (the half range), got %r"
+                             % (sensor.half_range, epsilon))
+        for name, value in (("point spacing", point_spacing), ("probe spacing", probe_spacing),
+                            ("search radius", search_radius), ("extension", extension_mm)):
+            if not (np.isfinite(value) and value > 0):
+                raise InputError("scan %s: must be a positive number of mm, got %r"
+                                 % (name, value))
+        if int(max_passes) != max_passes or max_passes < 1:
+            raise InputError("scan max_passes: must be a positive integer, got %r"
+                             % (max_passes,))
+        if span_range is not None:
+            span_range = [float(v) for v in span_range]
+            if len(span_range) != 2 or not span_range[1] > span_range[0]:
+                raise InputError("scan span range: expected (lo, hi) with lo < hi, got %r"
+                                 % (span_range,))
+        self.rig = rig
+        self.sensor = sensor
+        self.n_sections = int(n_sections)
+        self.section_spacing = section_spacing
+        self.point_spacing = float(point_spacing)
+        self.probe_spacing = float(probe_spacing)
+        self.epsilon = float(epsilon)
+        self.views = SIDE_VIEWS[:sides] + (EDGE_VIEWS if edges else ())
+        self.views = tuple(sorted(self.views, key=lambda v: v[1]))
+        self.max_passes = int(max_passes)
+        self.search_radius = float(search_radius)
+        self.end_margin = float(end_margin)
+        self.extension_mm = float(extension_mm)
+        self.kinematics = kinematics if kinematics is not None else RigKinematics()
+        d = self.kinematics.axis_direction
+        # Turning the table by +phi lowers a chord inclined by phi when the axis runs along +Y.
+        self._twist_sign = 1.0 if d[1] >= 0 else -1.0
+        self.state = state if state is not None else StrategyState(span_range=span_range)
+        if state is not None and state.pass_index is not None and hasattr(rig, "set_pass_index"):
+            rig.set_pass_index(state.pass_index)
+
+    # -- public --------------------------------------------------------------------------------
+
+    @property
+    def section_y(self):
+        if self.state.section_y is None:
+            self.state.section_y = self._plan_sections()
+        return self.state.section_y
+
+    def sections(self, progress=None):
+        """Measure the remaining sections one by one, yielding SectionResult; self.state is
+        the checkpoint after each (what scan.py saves)."""
+        ys = self.section_y
+        while self.state.next_section < len(ys):
+            k = self.state.next_section
+            if progress is not None:
+                progress(k / len(ys), "section %d of %d at Y=%.2f" % (k + 1, len(ys), ys[k]))
+            result = self._scan_section(k, ys[k], ys[k + 1] if k + 1 < len(ys) else None)
+            self.state.next_section = k + 1
+            self.state.pass_index = getattr(self.rig, "pass_index", None)
+            yield result
+
+    def run(self, progress=None):
+        return list(self.sections(progress))
+
+    # -- sections ------------------------------------------------------------------------------
+
+    def _plan_sections(self):
+        if self.state.span_range is None:
+            self.state.span_range = self._probe_span()
+        lo, hi = self.state.span_range
+        span = hi - lo
+        margin = max(1.0, self.end_margin * span)
+        if self.n_sections == 1:
+            return [0.5 * (lo + hi)]
+        if self.section_spacing is not None:
+            total = self.section_spacing * (self.n_sections - 1)
+            if not (self.section_spacing > 0 and total <= span - 2 * margin):
+                raise InputError("--section-spacing %r: %d sections do not fit in the %.1f mm "
+                                 "span" % (self.section_spacing, self.n_sections, span))
+            mid = 0.5 * (lo + hi)
+            return list(mid - 0.5 * total + self.section_spacing * np.arange(self.n_sections))
+        return list(np.linspace(lo + margin, hi - margin, self.n_sections))
+
+    def _probe_span(self):
+        """The blade's extent along the rotary axis: passes along Y near the axis, stepping
+        down in Z, at the current angle and a quarter turn on: at one of the two the chord is
+        at least 45 deg from edge-on, wide enough to lie under a line all along the span
+        despite the twist. Everything read gives the span."""
+        lim = self.rig.limits
+        ax = self.kinematics.axis_point[0]
+        ys = self._samples(lim.y[0], lim.y[1], 1.0)
+        # Three lines along Y, serpentine: one of them crosses the blade away from its edges.
+        lines = [np.column_stack([np.full(len(ys), ax + dx), ys if i % 2 == 0 else ys[::-1]])
+                 for i, dx in enumerate(SPAN_PROBE_OFFSETS)]
+        xy = np.vstack(lines)
+        found = []
+        for angle in (self.state.base_angle_deg, self.state.base_angle_deg + 90.0):
+            seen = False
+            for level in self._levels():
+                z_stage = level + self.sensor.standoff
+                if not lim.z[0] <= z_stage <= lim.z[1]:
+                    continue
+                stage = np.column_stack([xy, np.full(len(xy), z_stage)])
+                d = np.asarray(self.rig.scan_path(stage, angle).reading_mm, dtype=float)
+                valid = np.isfinite(d)
+                if np.count_nonzero(valid) >= MIN_VIEW_POINTS:
+                    found.append(xy[valid, 1])
+                    seen = True
+                elif seen:
+                    break       # below the surface already seen: nothing more to find
+        if found:
+            found = np.concatenate(found)
+            return [float(found.min()), float(found.max())]
+        raise InputError("scan: the sensor found no surface within %g mm of the rotary axis "
+                         "(check the part is mounted and the search radius)" % self.search_radius)
+
+    def _levels(self):
+        """Surface heights (stage Z - standoff) to probe at, from the top of the search
+        envelope down; consecutive working windows overlap by a fifth of the range."""
+        az = self.kinematics.axis_point[2]
+        half = self.sensor.half_range
+        return list(np.arange(az + self.search_radius - 0.8 * half,
+                              az - self.search_radius - half, -1.6 * half))
+
+    def _predict_level(self, next_y):
+        """The angle that should put the next section's chord level: the last level angle
+        carried on by the twist rate read between the last two sections."""
+        (y1, a1) = self.state.level_angles[-1]
+        if next_y is None or len(self.state.level_angles) < 2:
+            return a1
+        (y0, a0) = self.state.level_angles[-2]
+        return a1 + (a1 - a0) * (next_y - y1) / (y1 - y0)
+
+    def _scan_section(self, k, y, next_y=None):
+        start = self.rig.elapsed_s
+        base = self.state.base_angle_deg
+        if not self.state.levelled:
+            base = self._level(y, base)
+        # Alternate the view order so that the rotary turns back and forth, not round and round.
+        views = self.views if k % 2 == 0 else self.views[::-1]
+        results = []
+        for name, offset in views:
+            view = self._scan_view(name, y, base + offset)
+            results.append(view)
+        first = next(v for v in results if v.name == "side1")
+        twist = self._chord_angle(first)
+        level = base + (0.0 if twist is None else self._twist_sign * twist)
+        self.state.level_angles.append([float(y), float(level)])
+        self.state.base_angle_deg = self._predict_level(next_y)
+        for v in results:
+            if v.surface_z is not None:
+                self.state.surface_z[v.name] = v.surface_z
+        pts, snr, ang = [], [], []
+        errors = [0.0]
+        for v in results:
+            machine = self.kinematics.machine_point(v.stage_xyz, v.reading_mm)
+            pts.append(self.kinematics.table_point(machine, v.angle_deg))
+            snr.append(v.snr)
+            ang.append(np.full(len(v.snr), v.angle_deg))
+            if len(v.reading_mm):
+                errors.append(float(np.max(np.abs(v.reading_mm - self.sensor.standoff))))
+        return SectionResult(index=k, y=float(y), base_angle_deg=float(base),
+                             table_xyz=np.vstack(pts) if pts else np.zeros((0, 3)),
+                             snr=np.concatenate(snr), angle_deg=np.concatenate(ang),
+                             views=results, simulated_s=self.rig.elapsed_s - start,
+                             max_standoff_error_mm=max(errors))
+
+    def _level(self, y, base):
+        """Step 1 for the first section: turn the part until the first side's chord is level
+        (an edge-on blade shows only an edge, its points stand steeply)."""
+        for _ in range(MAX_LEVELLING):
+            view = self._scan_view("side1", y, base, final=False)
+            twist = self._chord_angle(view)
+            if twist is None:
+                base += 90.0
+                continue
+            if view.surface_z is not None:
+                self.state.surface_z["side1"] = view.surface_z
+            base += self._twist_sign * twist
+            if abs(twist) < LEVEL_TOLERANCE_DEG:
+                break
+        self.state.levelled = True
+        self.state.base_angle_deg = base
+        return base
+
+    def _chord_angle(self, view):
+        """Inclination (deg, -90..90, from +X towards +Z) of the principal direction of the
+        view's surface points in the section plane; None without enough points."""
+        if len(view.reading_mm) < MIN_VIEW_POINTS:
+            return None
+        x = view.stage_xyz[:, 0]
+        z = view.stage_xyz[:, 2] - view.reading_mm
+        c = np.cov(np.vstack([x, z]))
+        w, v = np.linalg.eigh(c)
+        d = v[:, np.argmax(w)]
+        if d[0] < 0:
+            d = -d
+        return float(np.degrees(np.arctan2(d[1], d[0])))
+
+    # -- one view: steps 1-5 -------------------------------------------------------------------
+
+    def _scan_view(self, name, y, angle, final=True):
+        passes = []
+        found = self._find_surface(name, y, angle, passes)
+        if found is None:
+            return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes)
+        x_all, z_all = found
+        max_incidence = 0.5 * self.sensor.coverage_deg
+        open_ends = [True, True]
+        extension = [self.extension_mm, self.extension_mm]
+        for _ in range(self.max_passes):
+            curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
+            lo = -extension[0] if open_ends[0] else 0.0
+            hi = curve.length + (extension[1] if open_ends[1] else 0.0)
+            s = self._samples(lo, hi, self.probe_spacing)
+            stage, s = self._stage_path(curve(s), y, s)
+            readings = self.rig.scan_path(stage, angle)  # step 4
+            d = np.asarray(readings.reading_mm, dtype=float)
+            valid = np.isfinite(d)
+            passes.append(self._pass_info("rescan", readings, d))
+            # The criterion is judged on the section itself; the extensions are probes.
+            body = valid & (s >= 0.0) & (s <= curve.length)
+            err = np.abs(d[body] - self.sensor.standoff)
+            surface = np.column_stack([stage[:, 0], stage[:, 2] - d])
+            grew = [self._grows(surface[valid & (s < 0.0)], x_all, z_all, -1),
+                    self._grows(surface[valid & (s > curve.length)], x_all, z_all, 1)]
+            x_all = np.concatenate([x_all, surface[valid, 0]])
+            z_all = np.concatenate([z_all, surface[valid, 1]])
+            open_ends = [open_ends[0] and grew[0], open_ends[1] and grew[1]]
+            # While an end keeps reading, reach further: the working range often hides much
+            # of the section from the first linear scan.
+            extension = [min(2.0 * e, MAX_EXTENSION_FACTOR * self.extension_mm) if g else e
+                         for e, g in zip(extension, grew)]
+            if not any(open_ends) and np.all(err <= self.epsilon):
+                break
+        curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)
+        surface_z = float(np.median(z_all))
+        if not final:
+            keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.epsilon)
+            return ViewResult(name, angle, stage[keep], d[keep],
+                              np.asarray(readings.snr, dtype=float)[keep], passes, surface_z)
+        s = self._samples(0.0, curve.length, self.point_spacing)  # step 5
+        stage, s = self._stage_path(curve(s), y, s)
+        readings = self.rig.scan_path(stage, angle)
+        d = np.asarray(readings.reading_mm, dtype=float)
+        passes.append(self._pass_info("final", readings, d))
+        keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.epsilon)
+        return ViewResult(name, angle, stage[keep], d[keep],
+                          np.asarray(readings.snr, dtype=float)[keep], passes, surface_z)
+
+    def _grows(self, new_points, x_all, z_all, side):
+        """Whether readings in an end's extension add surface beyond the known end: by at least
+        a probe step, so that creeping towards grazing incidence near an edge stops."""
+        if len(new_points) == 0:
+            return False
+        end = np.argmin(x_all) if side < 0 else np.argmax(x_all)
+        beyond = new_points[(new_points[:, 0] - x_all[end]) * side > 0]
+        if len(beyond) == 0:
+            return False
+        reach = np.hypot(beyond[:, 0] - x_all[end], beyond[:, 1] - z_all[end])
+        return bool(reach.max() >= self.probe_spacing)
+
+    def _find_surface(self, name, y, angle, passes):
+        """Steps 1-2: linear passes along X at fixed Z, first at the height this view found on
+        the previous section, then stepping down through the search envelope, until the sensor
+        reads. Returns the surface points (x, z) of that pass, or None."""
+        ax = self.kinematics.axis_point[0]
+        lim = self.rig.limits
+        x0 = max(ax - self.search_radius, lim.x[0])
+        x1 = min(ax + self.search_radius, lim.x[1])
+        xs = self._samples(x0, x1, self.probe_spacing)
+        levels = self._levels()
+        hint = self.state.surface_z.get(name)
+        if hint is not None:
+            levels.insert(0, hint)
+        gross_snr = getattr(self.sensor, "gross_snr", 0.0)
+        for level in levels:
+            z_stage = level + self.sensor.standoff
+            if not lim.z[0] <= z_stage <= lim.z[1]:
+                continue
+            stage = np.column_stack([xs, np.full(len(xs), y), np.full(len(xs), z_stage)])
+            readings = self.rig.scan_path(stage, angle)
+            d = np.asarray(readings.reading_mm, dtype=float)
+            passes.append(self._pass_info("linear", readings, d))
+            valid = np.isfinite(d)
+            if np.count_nonzero(valid) < MIN_VIEW_POINTS:
+                continue
+            x, z, snr = stage[valid, 0], z_stage - d[valid], np.asarray(readings.snr)[valid]
+            top = z.max()
+            if top - level > -RECENTRE_TOP * self.sensor.half_range:
+                # Step 1's adjustment: lower the window so that the highest point found sits
+                # near its top; the steeper parts below the first find come into range.
+                z_stage = top - RECENTRE_TOP * self.sensor.half_range + self.sensor.standoff
+                if lim.z[0] <= z_stage <= lim.z[1]:
+                    stage[:, 2] = z_stage
+                    readings = self.rig.scan_path(stage, angle)
+                    d = np.asarray(readings.reading_mm, dtype=float)
+                    passes.append(self._pass_info("linear", readings, d))
+                    more = np.isfinite(d)
+                    x = np.concatenate([x, stage[more, 0]])
+                    z = np.concatenate([z, z_stage - d[more]])
+                    snr = np.concatenate([snr, np.asarray(readings.snr)[more]])
+            # The first path starts from the well-read part of the section, away from the
+            # grazing spots at high curvature that carry the gross errors.
+            good = snr >= gross_snr
+            if np.count_nonzero(good) >= MIN_VIEW_POINTS:
+                return x[good], z[good]
+            return x, z
+        return None
+
+    def _stage_path(self, xz, y, s):
+        """Sensor positions above the curve points at the standoff, inside the soft limits."""
+        stage = np.column_stack([xz[:, 0], np.full(len(xz), y), xz[:, 1] + self.sensor.standoff])
+        lim = self.rig.limits
+        inside = ((stage[:, 0] >= lim.x[0]) & (stage[:, 0] <= lim.x[1])
+                  & (stage[:, 2] >= lim.z[0]) & (stage[:, 2] <= lim.z[1]))
+        return stage[inside], s[inside]
+
+    @staticmethod
+    def _samples(lo, hi, spacing):
+        n = max(2, int(np.ceil((hi - lo) / spacing)) + 1)
+        return np.linspace(lo, hi, n)
+
+    def _pass_info(self, kind, readings, d):
+        valid = np.isfinite(d)
+        err = np.abs(d[valid] - self.sensor.standoff)
+        return {"kind": kind, "angle_deg": float(readings.angle_deg), "points": int(len(d)),
+                "readings": int(np.count_nonzero(valid)),
+                "max_standoff_error_mm": float(err.max()) if len(err) else None,
+                "pass_index": readings.meta.get("pass_index")}
