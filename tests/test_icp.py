@@ -260,6 +260,47 @@ class TestICP(unittest.TestCase):
             vertex = h * (fm - fp) / (2 * (fp - 2 * f0 + fm))
             self.assertLess(abs(vertex), 1e-7 if k < 3 else 1e-9, "direction %d" % k)
 
+    def test_points_without_signal_or_distance_are_left_out(self):
+        rng = np.random.default_rng(8)
+        pts, truth, _, _ = measured_cloud(rng, 400, rng.uniform(-0.006, 0.006, 400))
+        snr = rng.uniform(50.0, 100.0, 400)
+        snr[:20] = 0.0
+        missing = np.zeros(400, bool)
+        missing[20:40] = True
+
+        def closest_with_misses(p):
+            # e.g. a ray-cast distance that found no face: NaN everywhere for those points
+            q, n, d = ellipsoid_closest(p)
+            q[missing], n[missing], d[missing] = np.nan, np.nan, np.nan
+            return q, n, d
+        res = icp.icp(pts, snr, closest_with_misses, start_near(rng, truth))
+        self.assertTrue(res.converged)
+        self.assertFalse(res.inlier[:40].any())
+        np.testing.assert_array_equal(res.weights[:40], 0.0)
+        self.assertTrue(np.all(np.isfinite(res.covariance)))
+        bound = icp.pose_uncertainty(res.covariance, res.center, CORNERS)
+        self.assertLess(pose_error(res.transform, truth), 3 * bound)
+
+    def test_a_sphere_leaves_the_turn_about_its_centre_undetermined(self):
+        rng = np.random.default_rng(9)
+        u = rng.normal(size=(300, 3))
+        u = u[u[:, 2] > 0]
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        pts = 10.0 * u + rng.uniform(-0.006, 0.006, (len(u), 1)) * u
+
+        def sphere(p):
+            r = np.linalg.norm(p, axis=1)
+            n = p / r[:, None]
+            return 10.0 * n, n, r - 10.0
+        init = tf.make_transform(tf.rotation_from_vector([0.0, 0.0, 0.3]), [0.5, -0.3, 0.2])
+        res = icp.icp(pts, None, sphere, init)
+        self.assertTrue(res.converged)
+        # The centre is found (any turn about it fits as well), and the bound says the pose
+        # is not determined instead of reporting a number.
+        np.testing.assert_allclose(res.transform[:3, 3], 0.0, atol=0.002)
+        self.assertLess(res.rms, 0.006)
+        self.assertTrue(np.isinf(icp.pose_uncertainty(res.covariance, res.center, CORNERS)))
+
     def test_bad_input(self):
         pts = surface_patch(np.random.default_rng(7), 20)
         with self.assertRaises(InputError):

@@ -218,8 +218,11 @@ def pose_covariance(points_cad, normals, weights, residuals, center):
 
 def pose_uncertainty(cov, center, corners):
     """1 sigma displacement at the worst corner: a corner x moves by dt + dw x (x - c), i.e.
-    J_x [dt, dw] with J_x = [I, -[x - c]_x]; its RMS is sqrt(trace(J_x C J_x^T))."""
+    J_x [dt, dw] with J_x = [I, -[x - c]_x]; its RMS is sqrt(trace(J_x C J_x^T)).
+    Infinite when the covariance is (the points do not determine the pose)."""
     cov = np.asarray(cov, dtype=float)
+    if not np.all(np.isfinite(cov)):
+        return float("inf")
     worst = 0.0
     for x in np.asarray(corners, dtype=float):
         v = x - np.asarray(center, dtype=float)
@@ -271,7 +274,8 @@ def icp(points, snr, closest_fn, init, options=None):
             break
         center = w @ moved / w.sum()
         if iterations <= options.horn_iters:
-            R, t = horn(closest, moved, w)
+            keep = w > 0   # a point without a usable distance may have no closest point
+            R, t = horn(closest[keep], moved[keep], w[keep])
             last_step = None
             size = (np.linalg.norm(t + R @ center - center), _rotation_angle(R))
             T = make_transform(R, t) @ T
