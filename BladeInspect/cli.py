@@ -89,6 +89,60 @@ def build_parser():
                    help="normal error sigma in mm, clipped at 3 sigma (default 0.002)")
     s.add_argument("--outliers", type=float, default=0.0,
                    help="fraction of gross outliers, 0.1-0.5 mm at low SNR (default 0)")
+    sc = sub.add_parser("scan", help="scan a blade with the simulated or a serial rig")
+    sc.add_argument("--cad", default=None, help="part on the simulated rig (default: demo blade)")
+    sc.add_argument("--out", required=True)
+    sc.add_argument("--rig", default="sim", help="sim or serial:PORT (default sim)")
+    sc.add_argument("--sections", type=int, default=5)
+    sc.add_argument("--seed", type=_seed, default=0)
+    sc.add_argument("--rig-file", default=None, help="RIG.json from calibrate")
+    sc.add_argument("--resume", action="store_true",
+                    help="continue an interrupted scan in DIR from its last complete section")
+
+    sr = sub.add_parser("simrig", help="serve the simulated rig on a pseudo-terminal")
+    sr.add_argument("--cad", default=None)
+    sr.add_argument("--seed", type=_seed, default=0)
+
+    rp = sub.add_parser("report", help="register and write the inspection report")
+    rp.add_argument("--cad", required=True)
+    rp.add_argument("--points", required=True)
+    rp.add_argument("--out", required=True)
+    rp.add_argument("--cmm", default=None, help="CMM points x,y,z[,section] in the CAD frame")
+    rp.add_argument("--tolerance", type=float, default=0.04, help="profile tolerance +-T mm")
+    rp.add_argument("--section-heights", type=_heights, default=None,
+                    help="section planes in %% of span (default 10,30,50,70,90)")
+    rp.add_argument("--seed", type=_seed, default=0)
+
+    b = sub.add_parser("batch", help="inspect every point file of a production lot")
+    b.add_argument("--cad", required=True)
+    b.add_argument("--scans", required=True)
+    b.add_argument("--out", required=True)
+    b.add_argument("--tolerance", type=float, default=0.04)
+    b.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    b.add_argument("--scheduler", default=None, help="Dask scheduler tcp://HOST:PORT")
+
+    i = sub.add_parser("inspect", help="blind scan, register, CAD-planned scan, report")
+    i.add_argument("--cad", default=None)
+    i.add_argument("--out", required=True)
+    i.add_argument("--rig", default="sim")
+    i.add_argument("--rig-file", default=None)
+    i.add_argument("--section-heights", type=_heights, default=[10.0, 30.0, 50.0, 70.0, 90.0])
+    i.add_argument("--complete", action="store_true")
+    i.add_argument("--pitch", type=float, default=0.1)
+    i.add_argument("--cmm", default=None)
+    i.add_argument("--tolerance", type=float, default=0.04)
+    i.add_argument("--seed", type=_seed, default=0)
+
+    c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
+    c.add_argument("--out", required=True, help="RIG.json to write")
+    c.add_argument("--rig", default="sim")
+    c.add_argument("--rig-file", default=None, help="kinematics believed so far")
+    c.add_argument("--sphere-diameter", type=float, default=25.0)
+    c.add_argument("--seed", type=_seed, default=0)
+    c.add_argument("--sim-axis-offset", type=float, default=0.2,
+                   help="simulated rig only: injected axis offset in mm (default 0.2)")
+    c.add_argument("--sim-axis-tilt", type=float, default=0.1,
+                   help="simulated rig only: injected axis tilt in degrees (default 0.1)")
     return p
 
 
@@ -138,7 +192,90 @@ def cmd_demo(args):
     cmd_simulate(ns)
 
 
-COMMANDS = {"demo": cmd_demo, "register": cmd_register, "simulate": cmd_simulate}
+def cmd_scan(args):
+    from .inspect.pipeline import load_nominal
+    from .rig.kinematics import RigKinematics
+    from .rig.scan import open_rig, scan_to_dir
+    kinematics = RigKinematics.from_json(args.rig_file) if args.rig_file else None
+    nominal = load_nominal(args.cad) if args.rig == "sim" else None
+    rig = open_rig(args.rig, nominal=nominal, seed=args.seed, kinematics=kinematics)
+    try:
+        summary = scan_to_dir(args.out, rig, n_sections=args.sections, seed=args.seed,
+                              resume=args.resume, progress=Progress(), kinematics=kinematics)
+    finally:
+        rig.close()
+    sys.stdout.write("scanned %d sections, %d points; simulated %.1f s, real rig about %.1f s\n"
+                     "results in %s\n" % (len(summary["sections"]), summary["points"],
+                                           summary["simulated_s"], summary["real_time_s"],
+                                           os.path.abspath(args.out)))
+
+
+def cmd_simrig(args):
+    from .rig.simrig_device import run_simrig
+    from .inspect.pipeline import load_nominal
+    run_simrig(load_nominal(args.cad), seed=args.seed)
+
+
+def cmd_report(args, cad=None, points=None):
+    from .inspect.report import run_report
+    options = {}
+    if args.section_heights:
+        options["heights_pct"] = args.section_heights
+    summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
+                         tolerance=args.tolerance, seed=args.seed, progress=Progress(),
+                         **options)
+    _print_result(summary["result"], args.out)
+    sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
+
+
+def cmd_batch(args):
+    from .inspect.batch import run_batch
+    summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
+                        scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress())
+    sys.stdout.write("%s\n" % summary["message"])
+
+
+def cmd_inspect(args):
+    from .inspect.closed_loop import run_inspect
+    summary = run_inspect(args.cad, args.out, rig_spec=args.rig,
+                          section_heights=args.section_heights, complete=args.complete,
+                          pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
+                          seed=args.seed, rig_file=args.rig_file, progress=Progress())
+    _print_result(summary["result"], args.out)
+    sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
+
+
+def cmd_calibrate(args):
+    from .rig.calibration import run_calibration
+    errors = {}
+    if args.rig == "sim":
+        errors = {"axis_offset_mm": args.sim_axis_offset, "axis_tilt_deg": args.sim_axis_tilt}
+    result = run_calibration(args.out, rig_spec=args.rig, sphere_diameter=args.sphere_diameter,
+                             seed=args.seed, rig_file=args.rig_file, progress=Progress(),
+                             **errors)
+    out = sys.stdout
+    out.write("rotary axis through (%.4f, %.4f, %.4f) mm, direction (%.7f, %.7f, %.7f)\n"
+              % (tuple(result["axis_point"]) + tuple(result["axis_direction"])))
+    out.write("  tilt from +Y: %.4f deg about Z, %.4f deg about X; sphere measured %.4f mm "
+              "(nominal %.4f); circle residual RMS %.4f mm\n"
+              % (result["axis_tilt_about_z_deg"], result["axis_tilt_about_x_deg"],
+                 result["measured_diameter_mm"], result["sphere_diameter_mm"],
+                 result["circle_residual_rms_mm"]))
+    truth = result.get("truth")
+    if truth:
+        p, d = np.array(result["axis_point"]), np.array(result["axis_direction"])
+        tp, td = np.array(truth["axis_point"]), np.array(truth["axis_direction"])
+        # Axis position error: the offset of the true axis from the found one, across the axis.
+        off = (p - tp) - np.dot(p - tp, td) * td
+        angle = np.degrees(np.arccos(np.clip(abs(np.dot(d, td)), -1.0, 1.0)))
+        out.write("  against the simulator's truth: position %.2f um, direction %.5f deg\n"
+                  % (1e3 * np.linalg.norm(off), angle))
+    out.write("rig calibration written to %s\n" % os.path.abspath(args.out))
+
+
+COMMANDS = {"demo": cmd_demo, "register": cmd_register, "simulate": cmd_simulate,
+            "scan": cmd_scan, "simrig": cmd_simrig, "report": cmd_report, "batch": cmd_batch,
+            "inspect": cmd_inspect, "calibrate": cmd_calibrate}
 
 
 def main(argv=None):
