@@ -119,6 +119,14 @@ class Rotor67Solid(unittest.TestCase):
                 else:
                     self.assertLess(share, 0.7, "surface %d" % (k + 1))
 
+    def test_cached_copies_are_independent(self):
+        again = make_rotor67_blade(ROTOR67_SECTIONS)
+        again.shape.translate(V(0, 0, 10))
+        again.roles["hub"].append(99)
+        third = make_rotor67_blade(ROTOR67_SECTIONS)
+        self.assertAlmostEqual(third.shape.BoundBox.ZMin, self.shape.BoundBox.ZMin, places=9)
+        self.assertEqual(third.roles, self.model.roles)
+
     def test_independent_cloud_lies_on_the_loft(self):
         cloud = np.loadtxt(ROTOR67_CLOUD)[:, 1:4] * 1000.0
         rng = np.random.default_rng(67)

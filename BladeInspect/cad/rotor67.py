@@ -18,11 +18,13 @@ sections 1..NS are lofted, hub to casing with no tip gap, as that cloud has it; 
 Frame: X = r cos(theta), Y = r sin(theta), Z = axial, millimetres; the rotation axis is Z.
 The upper (larger theta) side is the convex one: the suction side.
 """
+import os
 import re
 
 import numpy as np
 
 from ..core.errors import InputError
+from .demo_blade import BladeModel
 
 FOOT_MM = 304.8
 BLOCKS = ("axial", "r_theta", "thickness", "radius")
@@ -127,8 +129,25 @@ def make_rotor67_blade(dat_path, sections=None):
     """Rotor 67 as a ``BladeModel``: a solid of suction and pressure B-spline faces through
     the 1-based ``sections`` (default all: hub to casing) closed by filled hub and tip faces;
     roles suction, pressure, hub, tip."""
+    # Rebuilt only when the file changes: the pipeline and the document objects both load it.
+    try:
+        stat = os.stat(dat_path)
+    except OSError:
+        raise InputError("%s: no such section file" % dat_path) from None
+    key = (os.path.abspath(dat_path), stat.st_mtime_ns, stat.st_size,
+           None if sections is None else tuple(sections))
+    if key not in _CACHE:
+        _CACHE[key] = _build(dat_path, sections)
+    model = _CACHE[key]
+    return BladeModel(shape=model.shape.copy(),
+                      roles={k: list(v) for k, v in model.roles.items()},
+                      params=dict(model.params))
+
+_CACHE = {}
+
+
+def _build(dat_path, sections):
     import Part
-    from .demo_blade import BladeModel
     from .surface_build import interpolate_grid, close_sides
 
     table = read_rotor67(dat_path)
