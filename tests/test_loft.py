@@ -78,10 +78,35 @@ class FitSectionCurve(unittest.TestCase):
         d, _ = cKDTree(dense).query(fitted)
         self.assertLess(d.max(), NOISE)
         self.assertLess(np.sqrt(np.mean(d ** 2)), 0.4 * NOISE_RMS)
-        np.testing.assert_allclose(np.abs(curve_points(b[0]) - fitted).max() if
-                                   np.linalg.norm(curve_points(b[0])[0] - fitted[0]) < 1
-                                   else np.abs(curve_points(b[0])[::-1] - fitted).max(),
-                                   0.0, atol=1e-9)
+        self.assertEqual(a[0].getPoles(), b[0].getPoles())
+
+    def test_pass_folding_round_an_edge(self):
+        # An edge view: two flanks joined by a round edge (radius 0.8 mm), a U whose largest
+        # extent runs along the flanks, given in random order.
+        rng = np.random.default_rng(9)
+        r, flank = 0.8, 4.0
+        s = rng.uniform(0, 2 * flank + np.pi * r, 900)
+        phi = np.clip((s - flank) / r, 0, np.pi)
+        on_round = (s > flank) & (s < flank + np.pi * r)
+        upper = s <= flank
+        x = np.where(on_round, -r * np.sin(phi), np.where(upper, flank - s,
+                                                          s - flank - np.pi * r))
+        y = np.where(on_round, r * np.cos(phi), np.where(upper, r, -r))
+        pts = np.column_stack([x, y, np.zeros_like(x)])
+        # Exact distance: to the circle on the round, to the flank lines elsewhere.
+        def distance(p):
+            round_d = np.abs(np.hypot(p[:, 0], p[:, 1]) - r)
+            flank_d = np.abs(np.abs(p[:, 1]) - r)
+            return np.where(p[:, 0] < 0, round_d, flank_d)
+        self.assertLess(distance(pts).max(), 1e-12)
+        normal = np.where(on_round[:, None], pts / r, np.column_stack([0 * x, np.sign(y), 0 * x]))
+        noisy = pts + rng.uniform(-NOISE, NOISE, len(s))[:, None] * normal
+        curve, rms, worst = fit_section_curve(noisy[rng.permutation(len(s))])
+        fitted = curve_points(curve, 2000)
+        self.assertLess(rms, 2 * NOISE_RMS)
+        # The round edge has a curvature jump at each flank, where a cubic lags a little.
+        self.assertLess(np.percentile(distance(fitted), 95), NOISE)
+        self.assertLess(distance(fitted).max(), 0.02)
 
     def test_too_few_or_bad_points(self):
         with self.assertRaises(InputError):
@@ -111,8 +136,8 @@ class CompatibleAndLoft(unittest.TestCase):
         for orig, comp in zip(self.curves, out):
             edge = Part.Edge(orig)
             for p in curve_points(comp, 25):
-                # Arc length is not a spline of the old parameter: refit error < 0.1 um.
-                self.assertLess(edge.distToShape(Part.Vertex(V(*p)))[0], 1e-4)
+                # Arc length is not a spline of the old parameter: refit error < 0.2 um.
+                self.assertLess(edge.distToShape(Part.Vertex(V(*p)))[0], 2e-4)
             total = comp.length()
             for f in (0.25, 0.5, 0.8):
                 self.assertAlmostEqual(comp.length(0, f) / total, f, delta=2e-4)
@@ -130,7 +155,7 @@ class CompatibleAndLoft(unittest.TestCase):
         face = Part.Face(loft(self.curves))
         for c in self.curves:
             for p in curve_points(c, 10):
-                self.assertLess(face.distToShape(Part.Vertex(V(*p)))[0], 1e-4)
+                self.assertLess(face.distToShape(Part.Vertex(V(*p)))[0], 2e-4)
         with self.assertRaises(InputError):
             loft(comp[:1])
 

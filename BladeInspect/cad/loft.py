@@ -11,6 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
+from scipy.spatial import cKDTree
 
 import FreeCAD
 import Part
@@ -72,13 +75,29 @@ def _closest_params(spline, points, params):
 
 
 def order_points(points):
-    """Points sorted along their direction of largest extent, and that direction."""
+    """Indices ordering points along the curve they sample, and each point's distance from
+    the curve's first end along the way (an arc length, noise zig-zags included).
+
+    Walks a minimum spanning tree of near neighbours from one end of its longest path. Unlike
+    sorting along the direction of largest extent this also orders passes that fold back, such
+    as an edge view wrapping round a leading edge."""
     pts = np.asarray(points, dtype=float)
-    centred = pts - pts.mean(axis=0)
-    _, _, vt = np.linalg.svd(centred, full_matrices=False)
-    axis = vt[0]
-    order = np.argsort(centred @ axis, kind="stable")
-    return pts[order], axis
+    n = len(pts)
+    tree_index = cKDTree(pts)
+    k = min(8, n - 1)
+    while True:
+        dist, nbr = tree_index.query(pts, k + 1)
+        # csgraph reads a zero weight as "no edge": keep coincident points joined.
+        graph = coo_matrix((dist[:, 1:].ravel() + 1e-12,
+                            (np.repeat(np.arange(n), k), nbr[:, 1:].ravel())), shape=(n, n))
+        if k >= n - 1 or connected_components(graph, directed=False)[0] == 1:
+            break
+        k = min(2 * k, n - 1)
+    mst = minimum_spanning_tree(graph)
+    first_end = int(np.argmax(shortest_path(mst, directed=False, indices=0)))
+    along = shortest_path(mst, directed=False, indices=first_end)
+    order = np.argsort(along, kind="stable")
+    return order, along[order]
 
 
 def _to_part_curve(knots, poles, degree):
@@ -100,8 +119,9 @@ def _spline_of(curve):
 def fit_section_curve(points, n_poles=None, degree=DEGREE):
     """A cubic B-spline least-squares approximation of one section pass.
 
-    ``points`` (K, 3) are ordered along their direction of largest extent; parameters start
-    as the normalised position along it and are then corrected to the closest curve points.
+    ``points`` (K, 3), in any order, are ordered along the curve (see ``order_points``);
+    parameters start as their normalised distance along it and are then corrected to the
+    closest curve points.
     ``n_poles`` defaults to K/10 within [degree + 3, 100]: uniform knots need many spans to
     follow a rounded edge, and ten points a span keep the noise averaged. Returns (Part.BSplineCurve,
     rms_fit_error, max_fit_error): distances from the points to the curve, mm."""
@@ -117,11 +137,13 @@ def fit_section_curve(points, n_poles=None, degree=DEGREE):
     n_poles = int(min(n_poles, len(pts)))
     if n_poles < degree + 1:
         raise InputError("section curve: %d poles, at least %d needed" % (n_poles, degree + 1))
-    ordered, axis = order_points(pts)
-    along = (ordered - ordered.mean(axis=0)) @ axis
-    if along[-1] - along[0] <= 0:
+    # A fixed starting order: the same points in any row order give the same curve.
+    pts = pts[np.lexsort(pts.T[::-1])]
+    order, along = order_points(pts)
+    ordered = pts[order]
+    if along[-1] <= 1e-9:
         raise InputError("section points: all %d points coincide" % len(pts))
-    params = (along - along[0]) / (along[-1] - along[0])
+    params = along / along[-1]
     knots = uniform_knots(n_poles, degree)
     for _ in range(PARAMETER_CORRECTIONS):
         spline = BSpline(knots, _least_squares_poles(params, ordered, knots, degree), degree)
