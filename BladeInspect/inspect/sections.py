@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from scipy.spatial import ConvexHull, cKDTree
+from scipy.spatial import cKDTree
 
 from ..core import pca
 from ..core.errors import InputError
@@ -234,16 +234,20 @@ def span_axis_of(nominal, span_axis=None):
 
 
 def _farthest_pair(xy):
-    if len(xy) >= 3:
-        try:
-            xy_h = xy[ConvexHull(xy).vertices]
-        except Exception:  # degenerate (collinear) set: every point is a candidate
-            xy_h = xy
-    else:
-        xy_h = xy
-    d = np.linalg.norm(xy_h[:, None, :] - xy_h[None, :, :], axis=2)
-    i, j = np.unravel_index(np.argmax(d), d.shape)
-    return xy_h[i], xy_h[j]
+    """The profile's two mutually farthest points, by alternating farthest-point searches from
+    the point farthest from the centroid: for an elongated, airfoil-like outline this settles
+    on the diameter in two or three linear passes (an exact all-pairs search over a dense
+    convex outline's hull is quadratic and takes seconds)."""
+    a = xy[np.argmax(np.sum((xy - xy.mean(axis=0)) ** 2, axis=1))]
+    best = -1.0
+    for _ in range(8):
+        d2 = np.sum((xy - a) ** 2, axis=1)
+        b = xy[np.argmax(d2)]
+        if d2.max() <= best:
+            break
+        best = d2.max()
+        a, b = b, a
+    return a, b
 
 
 def _width_at(polylines_2d, t0):
@@ -536,10 +540,12 @@ def section_table(result, nominal, heights_pct=DEFAULT_HEIGHTS_PCT, band=0.25, w
 
     sections = []
     for source, label, origin, normal, height, idx in specs:
-        polylines = cut(nominal.shape, origin, normal)
-        profile = _build_profile(nominal, polylines, normal, result.points_cad[idx], origin)
-        if not polylines:
+        try:
+            polylines = cut(nominal.shape, origin, normal)
+        except InputError:
+            polylines = []
             warnings.append("section %s: the plane misses the CAD" % label)
+        profile = _build_profile(nominal, polylines, normal, result.points_cad[idx], origin)
         zone = classify(profile, result.points_cad[idx], edge_fraction)
         sec = Section(label=label, source=source, origin=np.asarray(origin, dtype=float),
                       normal=np.asarray(normal, dtype=float), height_pct=float(height),
