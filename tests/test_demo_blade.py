@@ -206,7 +206,8 @@ class DemoBladeBuild(unittest.TestCase):
     def test_nonsense_parameters_raise_input_error(self):
         bad = [dict(chord_root=-50), dict(thickness_tip=0), dict(span=float("nan")),
                dict(n_sections=3), dict(camber_root=-0.1), dict(te_radius_root=5.0),
-               dict(le_radius_tip=-1), dict(twist_deg=120), dict(n_sections=7.5)]
+               dict(le_radius_tip=-1), dict(twist_deg=120), dict(n_sections=7.5),
+               dict(sweep="3"), dict(lean=float("inf")), dict(n_profile=None)]
         for kwargs in bad:
             with self.assertRaises(InputError) as ctx:
                 make_demo_blade(BladeParams(**kwargs))

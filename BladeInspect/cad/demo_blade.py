@@ -19,7 +19,7 @@ The suction side is the convex (+normal) side, the pressure side the other; both
 leading edge (xi = 0) to the trailing edge (xi = 1) and share those two points at each section.
 Span along +Z from z = 0 (hub) to z = span; the stacking point is at 40 % chord.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -58,10 +58,15 @@ class BladeParams:
         def need(ok, name, what):
             if not ok:
                 raise InputError("BladeParams.%s = %r: %s" % (name, getattr(self, name), what))
+        for f in fields(self):
+            value = getattr(self, f.name)
+            need(isinstance(value, (int, float, np.integer, np.floating))
+                 and not isinstance(value, bool) and np.isfinite(value), f.name,
+                 "must be a finite number")
         for name in ("span", "chord_root", "chord_tip", "thickness_root", "thickness_tip",
                      "le_radius_root", "le_radius_tip", "te_radius_root", "te_radius_tip"):
             value = getattr(self, name)
-            need(np.isfinite(value) and value > 0, name, "must be a positive number")
+            need(value > 0, name, "must be positive")
         for name in ("camber_root", "camber_tip"):
             need(0 <= getattr(self, name) < 0.2, name, "must be in [0, 0.2)")
         for name in ("thickness_root", "thickness_tip"):
@@ -70,8 +75,6 @@ class BladeParams:
         need(0.35 <= self.camber_position <= 0.65, "camber_position", "must be in [0.35, 0.65]")
         need(abs(self.twist_deg) < 90, "twist_deg", "must be within +-90")
         need(0.5 <= self.twist_exponent <= 4, "twist_exponent", "must be in [0.5, 4]")
-        for name in ("stagger_root_deg", "sweep", "lean"):
-            need(np.isfinite(getattr(self, name)), name, "must be finite")
         need(int(self.n_sections) == self.n_sections and self.n_sections >= 4, "n_sections",
              "must be an integer >= 4")
         need(int(self.n_profile) == self.n_profile and self.n_profile >= 9, "n_profile",
