@@ -353,11 +353,11 @@ def run():
         from BladeInspect.gui.preferences import PreferencesPage
         page = PreferencesPage()
         page.widgets["ToleranceMm"].setValue(0.05)
-        page.widgets["Sides"].setCurrentText("suction")
+        page.widgets["Sides"].setValue(1)
         page.saveSettings()
         group = FreeCAD.ParamGet(settings.PARAM_PATH)
         check("tolerance saved", abs(group.GetFloat("ToleranceMm") - 0.05) < 1e-12)
-        check("sides saved", group.GetString("Sides") == "suction")
+        check("sides saved", group.GetInt("Sides") == 1)
         check("colour limit falls back to tolerance", abs(settings.colour_limit() - 0.05) < 1e-12)
         page.form.show()
         page.form.resize(520, 420)

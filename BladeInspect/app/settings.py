@@ -5,7 +5,7 @@ import FreeCAD
 
 PARAM_PATH = "User parameter:BaseApp/Preferences/Mod/BladeInspect"
 
-# name: (kind, default, label, unit, minimum, maximum)
+# name: (kind "float" or "int", default, label, unit, minimum, maximum)
 SETTINGS = {
     "StandoffMm": ("float", 44.0, "Sensor standoff z_s", "mm", 1.0, 500.0),
     "WorkingRangeMm": ("float", 8.0, "Sensor working range +-delta", "mm", 0.1, 100.0),
@@ -14,7 +14,8 @@ SETTINGS = {
     "PointsPerSecond": ("float", 9000.0, "Sensor rate", "points/s", 1.0, 1e6),
     "Sections": ("int", 5, "Sections per scan", "", 1, 200),
     "SectionSpacingMm": ("float", 0.0, "Section spacing (0 = spread over the span)", "mm", 0.0, 1000.0),
-    "Sides": ("choice", "both", "Sides to scan", "", ("both", "suction", "pressure"), None),
+    "PointSpacingMm": ("float", 0.1, "Point spacing along a section", "mm", 0.005, 10.0),
+    "Sides": ("int", 2, "Sides scanned (2 = the part turned over)", "", 1, 2),
     "ToleranceMm": ("float", 0.04, "Profile tolerance", "mm", 0.0001, 10.0),
     "ColourLimitMm": ("float", 0.0, "Colour map limit (0 = the tolerance)", "mm", 0.0, 10.0),
     "Seed": ("int", 0, "Random seed (simulated rig, registration)", "", 0, 2 ** 31 - 1),
@@ -30,10 +31,7 @@ def value(name):
     group = _group()
     if kind == "float":
         return group.GetFloat(name, default)
-    if kind == "int":
-        return group.GetInt(name, default)
-    text = group.GetString(name, default)
-    return text if text in SETTINGS[name][4] else default
+    return group.GetInt(name, default)
 
 
 def store(name, new_value):
@@ -41,12 +39,8 @@ def store(name, new_value):
     group = _group()
     if kind == "float":
         group.SetFloat(name, float(new_value))
-    elif kind == "int":
-        group.SetInt(name, int(new_value))
     else:
-        if new_value not in SETTINGS[name][4]:
-            raise ValueError("%s: expected one of %s, got %r" % (name, SETTINGS[name][4], new_value))
-        group.SetString(name, new_value)
+        group.SetInt(name, int(new_value))
 
 
 def colour_limit():

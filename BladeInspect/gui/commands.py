@@ -181,13 +181,14 @@ class Scan(_Command):
         from ..inspect.pipeline import load_points
         doc = active_document()
         out_dir = scan_folder(doc)
-        accepted = pyinspect.signature(scan_to_dir).parameters
+        params = pyinspect.signature(scan_to_dir).parameters
+        takes_strategy_options = any(p.kind == p.VAR_KEYWORD for p in params.values())
 
         def job(p):
-            kwargs = {k: v for k, v in options.items() if k in accepted and k != "n_sections"}
-            if "spacing" in kwargs and not kwargs["spacing"]:
-                del kwargs["spacing"]
-            scan_to_dir(out_dir, RIG.rig, options["n_sections"], progress=p, **kwargs)
+            # The strategy's own defaults stand for options the scan does not take.
+            kwargs = {k: v for k, v in options.items()
+                      if (k in params or takes_strategy_options) and v is not None}
+            scan_to_dir(out_dir, RIG.rig, progress=p, **kwargs)
             path = os.path.join(out_dir, "points.csv")
             pointset = load_points(path)
             return objects.make_measurement(doc, pointset, name="Scan", source_file=path)

@@ -12,10 +12,7 @@ class PreferencesPage:
         layout = QtGui.QFormLayout(self.form)
         self.widgets = {}
         for name, (kind, default, label, unit, lo, hi) in settings.SETTINGS.items():
-            if kind == "choice":
-                widget = QtGui.QComboBox()
-                widget.addItems(list(lo))
-            elif kind == "int":
+            if kind == "int":
                 widget = QtGui.QSpinBox()
                 widget.setRange(int(lo), int(hi))
             else:
@@ -31,15 +28,8 @@ class PreferencesPage:
 
     def loadSettings(self):
         for name, widget in self.widgets.items():
-            value = settings.value(name)
-            if isinstance(widget, QtGui.QComboBox):
-                widget.setCurrentText(value)
-            else:
-                widget.setValue(value)
+            widget.setValue(settings.value(name))
 
     def saveSettings(self):
         for name, widget in self.widgets.items():
-            if isinstance(widget, QtGui.QComboBox):
-                settings.store(name, widget.currentText())
-            else:
-                settings.store(name, widget.value())
+            settings.store(name, widget.value())

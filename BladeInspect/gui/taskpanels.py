@@ -113,7 +113,7 @@ class ConnectRigPanel(_Panel):
 
 
 class ScanPanel(_Panel):
-    """Scan parameters, defaults from the preferences."""
+    """Scan parameters (the scan strategy's options), defaults from the preferences."""
     title = "Scan"
 
     def __init__(self, on_accept):
@@ -122,18 +122,26 @@ class ScanPanel(_Panel):
         self.sections = _spin(settings.value("Sections"), 1, 200)
         self.spacing = _spin(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm")
         self.spacing.setToolTip("Distance between sections; 0 spreads them over the span")
-        self.sides = QtGui.QComboBox()
-        self.sides.addItems(list(settings.SETTINGS["Sides"][4]))
-        self.sides.setCurrentText(settings.value("Sides"))
+        self.point_spacing = _spin(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm")
+        self.sides = _spin(settings.value("Sides"), 1, 2)
+        self.sides.setToolTip("2 turns the part over to scan the other side")
+        self.epsilon = _spin(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm")
+        self.epsilon.setToolTip("Rescan a section until every point is within this distance "
+                                "of the sensor's standoff")
         self.seed = _spin(settings.value("Seed"), 0, 2 ** 31 - 1)
         self.layout.addRow("Sections", self.sections)
         self.layout.addRow("Section spacing", self.spacing)
+        self.layout.addRow("Point spacing", self.point_spacing)
         self.layout.addRow("Sides", self.sides)
+        self.layout.addRow("Standoff criterion \u03b5", self.epsilon)
         self.layout.addRow("Seed", self.seed)
 
     def options(self):
-        return {"n_sections": self.sections.value(), "spacing": self.spacing.value(),
-                "sides": self.sides.currentText(), "seed": self.seed.value()}
+        spacing = self.spacing.value()
+        return {"n_sections": self.sections.value(),
+                "section_spacing": spacing if spacing > 0 else None,
+                "point_spacing": self.point_spacing.value(), "sides": self.sides.value(),
+                "epsilon": self.epsilon.value(), "seed": self.seed.value()}
 
     def accept(self):
         options = self.options()
