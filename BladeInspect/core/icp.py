@@ -7,8 +7,8 @@ w_i = a_i * rho_i:
   (DESIGN.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the mean makes
   a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
 * rho_i in [0, 1] — a redescending robust weight of the standardised residual
-  z_i = d_i sqrt(a_i) / s, where s = 1.4826 * MAD(d sqrt(a)) is a robust scale re-estimated at
-  every iteration. rho = 1 for |z| <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
+  z_i = d_i sqrt(a_i) / s, where s = 1.4826 * median |d sqrt(a)| is a robust scale
+  re-estimated at every iteration. rho = 1 for |z| <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
   Flat in the core, so the good points are fitted by plain weighted least squares (the
   efficient estimator, and the covariance formula below is exact for them); gross outliers and
   real defects (many sigma away) weigh exactly 0. Two refinements (see robust_weights): a_i is
@@ -108,8 +108,10 @@ def _taper(u, options):
 
 
 def _robust_scale(values, options):
-    med = np.median(values)
-    return max(MAD_TO_SIGMA * np.median(np.abs(values - med)), options.min_scale)
+    """Robust sigma of values that should scatter about 0: 1.4826 * median |v|. About 0, not
+    about their median, because the weights judge |v| itself: from a rough start, residuals
+    offset to one side must widen the scale, not be rejected all together."""
+    return max(MAD_TO_SIGMA * np.median(np.abs(values)), options.min_scale)
 
 
 def robust_weights(distances, a, options, neighbourhoods=None):
