@@ -140,6 +140,21 @@ class TestICP(unittest.TestCase):
             self.assertLess(np.max(np.abs(res.distances)), 1e-6)
             self.assertTrue(res.inlier.all())
 
+    def test_robust_weights_take_in_residuals_offset_to_one_side(self):
+        # From a rough start every residual may be about +1.5 mm: the scale must take them
+        # in, not reject them all as far from their common median.
+        rng = np.random.default_rng(10)
+        d = 1.5 + rng.uniform(-0.2, 0.2, 1000)
+        rho, scale = icp.robust_weights(d, np.ones(1000), icp.ICPOptions())
+        self.assertTrue(np.all(rho == 1.0))
+        self.assertAlmostEqual(scale, 1.4826 * np.median(np.abs(d)))
+        # At convergence, a few gross errors among 6 um noise get no weight, the rest full.
+        d = rng.uniform(-0.006, 0.006, 1000)
+        d[:20] = rng.uniform(0.1, 0.5, 20)
+        rho, _ = icp.robust_weights(d, np.ones(1000), icp.ICPOptions())
+        np.testing.assert_array_equal(rho[:20], 0.0)
+        np.testing.assert_array_equal(rho[20:], 1.0)
+
     def test_scatter_agrees_with_the_predicted_uncertainty(self):
         rng = np.random.default_rng(3)
         errors, predicted = [], []
