@@ -32,13 +32,14 @@ FAULT_KINDS = ("close", "garbage", "silent", "alarm", "sensor_error", "busy")
 
 @dataclass
 class Fault:
-    """Strikes at the command line after ``after_lines`` lines (G-code and sensor commands,
-    counted since the device started): ``close`` closes the pty, ``garbage`` answers every
+    """Strikes at the first command line (G-code or sensor) after ``after_lines`` lines and
+    ``after_passes`` completed passes since the device started: ``close`` closes the pty, ``garbage`` answers every
     line from then on with noise, ``silent`` stops answering, ``alarm`` raises ALARM:<alarm>
     (1 hard limit), ``sensor_error`` makes the sensor report E <sensor_code>, ``busy`` holds
     that line's answers for ``busy_s`` seconds while reporting Run (a long move)."""
     kind: str
-    after_lines: int
+    after_lines: int = 0
+    after_passes: int = 0
     alarm: int = 1
     sensor_code: str = "LASER_FAULT"
     busy_s: float = 1.0
@@ -211,7 +212,8 @@ class SimRigDevice:
     def _line(self, pty, line):
         self.lines_received += 1
         fault = self.fault
-        if fault is not None and self.lines_received > fault.after_lines:
+        if (fault is not None and self.lines_received > fault.after_lines
+                and self.passes >= fault.after_passes):
             if fault.kind == "close":
                 self._close_ptys()
                 return
