@@ -184,37 +184,43 @@ class Reconstruct(unittest.TestCase):
         rng = np.random.default_rng(21)
         # The demo blade's own section heights: the truth is cubic across them too.
         model, xyz, sec, ang = blade_scan(rng, np.linspace(0, 70, 9), twist_per_section=9.0)
-        move = random_transform(rng, 100.0)
-        order = rng.permutation(len(xyz))
-        ps = PointSet(xyz=apply_transform(move, xyz)[order], snr=None,
-                      columns={"section": sec[order], "angle_deg": ang[order],
-                               "phase": np.zeros(len(xyz))})
-        recon = reconstruct(ps)
-        self.assertEqual(len(recon.curves), 18)
-        self.assertEqual(len(recon.surfaces), 2)
-        self.assertEqual(recon.notes, [])
-        # The angles turn 72 degrees over the span; each side is still one track.
-        for side in (0, 1):
-            self.assertEqual(len([g for g in recon.groups if g["side"] == side]), 9)
-        for e in recon.fit_errors:
-            self.assertAlmostEqual(e["rms"] / NOISE_RMS, 1.0, delta=0.15)
-        back = invert_transform(move)
         faces = [model.shape.Faces[model.roles[r][0]] for r in ("suction", "pressure")]
-        for surface in recon.surfaces:
-            u0, u1, v0, v1 = surface.bounds()
-            pts = np.array([tuple(surface.value(u, v)) for v in np.linspace(v0, v1, 25)
-                            for u in np.linspace(u0, u1, 8)])
-            pts = apply_transform(back, pts)
-            d = np.array([min(f.distToShape(Part.Vertex(V(*p)))[0] for f in faces)
-                          for p in pts])
-            self.assertLess(np.median(d), 0.002)
-            self.assertLess(d.max(), 0.008)
-        self.assertEqual(recon.samples.shape[1], 3)
-        self.assertGreater(len(recon.samples), 5000)
-        # The samples lie on the lofted surfaces: spot-check against OCC.
-        for p in recon.samples[:: len(recon.samples) // 15]:
-            q = apply_transform(back, p[None])[0]
-            self.assertLess(min(f.distToShape(Part.Vertex(V(*q)))[0] for f in faces), 0.008)
+        # A random pose, and one turning the mid-span chord across X so that the passes'
+        # walking directions differ between sections (the curves must be turned to match).
+        turn = np.radians(81.2)
+        across = np.eye(4)
+        across[:2, :2] = [[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]]
+        for move in (random_transform(rng, 100.0), across):
+            order = rng.permutation(len(xyz))
+            ps = PointSet(xyz=apply_transform(move, xyz)[order], snr=None,
+                          columns={"section": sec[order], "angle_deg": ang[order],
+                                   "phase": np.zeros(len(xyz))})
+            recon = reconstruct(ps)
+            self.assertEqual(len(recon.curves), 18)
+            self.assertEqual(len(recon.surfaces), 2)
+            self.assertEqual(recon.notes, [])
+            # The angles turn 72 degrees over the span; each side is still one track.
+            for side in (0, 1):
+                self.assertEqual(len([g for g in recon.groups if g["side"] == side]), 9)
+            for e in recon.fit_errors:
+                self.assertAlmostEqual(e["rms"] / NOISE_RMS, 1.0, delta=0.15)
+            back = invert_transform(move)
+            for surface in recon.surfaces:
+                u0, u1, v0, v1 = surface.bounds()
+                pts = np.array([tuple(surface.value(u, v)) for v in np.linspace(v0, v1, 25)
+                                for u in np.linspace(u0, u1, 8)])
+                pts = apply_transform(back, pts)
+                d = np.array([min(f.distToShape(Part.Vertex(V(*p)))[0] for f in faces)
+                              for p in pts])
+                self.assertLess(np.median(d), 0.002)
+                self.assertLess(d.max(), 0.008)
+            self.assertEqual(recon.samples.shape[1], 3)
+            self.assertGreater(len(recon.samples), 5000)
+            # The samples lie on the lofted surfaces: spot-check against OCC.
+            for p in recon.samples[:: len(recon.samples) // 15]:
+                q = apply_transform(back, p[None])[0]
+                self.assertLess(min(f.distToShape(Part.Vertex(V(*q)))[0] for f in faces),
+                                0.008)
 
     def test_degenerate_groups_are_skipped_with_notes(self):
         rng = np.random.default_rng(4)
@@ -230,6 +236,23 @@ class Reconstruct(unittest.TestCase):
         self.assertTrue(any("3 points" in n for n in recon.notes), recon.notes)
         skipped = [g for g in recon.groups if g["curve"] is None]
         self.assertEqual([(g["section"], g["n_points"]) for g in skipped], [(1, 3)])
+
+    def test_views_seeing_different_stretches_give_no_surface(self):
+        rng = np.random.default_rng(6)
+        model, xyz, sec, ang = blade_scan(rng, [10.0, 30.0, 50.0], n_per_pass=200)
+        # A third view that sees a short stretch near the leading edge on one section and
+        # most of the side on the others.
+        srf = model.shape.Faces[model.roles["suction"][0]].Surface
+        extra = []
+        for k, (z, hi) in enumerate(((10.0, 0.25), (30.0, 0.8), (50.0, 0.8))):
+            u = np.linspace(0.02, hi, 150)
+            extra.append(np.array([tuple(srf.value(x, z)) for x in u]))
+        recon = reconstruct(PointSet(
+            xyz=np.vstack([xyz] + extra),
+            columns={"section": np.concatenate([sec, np.repeat([0.0, 1.0, 2.0], 150)]),
+                     "angle_deg": np.concatenate([ang, np.full(450, 85.0)])}))
+        self.assertEqual((len(recon.curves), len(recon.surfaces)), (9, 2))
+        self.assertTrue(any("mm long, no surface" in n for n in recon.notes), recon.notes)
 
     def test_one_section_gives_curves_without_surfaces(self):
         rng = np.random.default_rng(8)

@@ -27,6 +27,8 @@ ANGLE_CLUSTER_GAP_DEG = 20.0
 # Between neighbouring sections a view's angle follows the blade's twist, well below this.
 ANGLE_TRACK_DEG = 60.0
 PARAMETER_CORRECTIONS = 3
+# Curves of one side more different in length than this cover different parts of the blade.
+MAX_LENGTH_RATIO = 1.5
 SAMPLES_U = 160
 SAMPLES_V_PER_SECTION = 8
 
@@ -341,8 +343,16 @@ def reconstruct(pointset, n_poles=None):
         if np.any(np.diff(offsets) <= 1e-9):
             notes.append("side %d: two sections in one plane, no surface" % side)
             continue
-        side_curves = _oriented([curves[g["curve"]] for g in fitted])
-        surfaces.append(loft(make_compatible(side_curves), v_params=offsets))
+        side_curves = [curves[g["curve"]] for g in fitted]
+        lengths = [c.length() for c in side_curves]
+        if max(lengths) > MAX_LENGTH_RATIO * min(lengths):
+            # The view saw very different stretches of the blade on different sections (as
+            # edge views do): skinning them would shear the surface through the part.
+            notes.append("side %d: section curves %.1f to %.1f mm long, no surface"
+                         % (side, min(lengths), max(lengths)))
+            continue
+        surfaces.append(loft(make_compatible(_oriented(side_curves, span)),
+                             v_params=offsets))
     for g in groups:
         g.pop("offset", None)
 
@@ -355,13 +365,20 @@ def reconstruct(pointset, n_poles=None):
                           fit_errors=fit_errors, groups=groups, notes=notes)
 
 
-def _oriented(curves):
-    """The curves turned, where needed, to start at the end nearer the previous one's start
-    (each curve's own direction comes from an arbitrary sign of its principal axis)."""
+def _oriented(curves, span):
+    """The curves turned, where needed, to run the same way as the previous one: the way
+    whose points, compared along the curves with the offset along ``span`` taken out, lie
+    nearer (a curve's own direction comes from whichever end its points were walked from)."""
+    def in_plane(curve, reverse=False):
+        t = np.linspace(curve.FirstParameter, curve.LastParameter, 25)
+        pts = np.array([tuple(curve.value(x)) for x in (t[::-1] if reverse else t)])
+        return pts - np.outer(pts @ span, span)
     out = [curves[0]]
     for curve in curves[1:]:
-        start = out[-1].StartPoint
-        if (curve.EndPoint - start).Length < (curve.StartPoint - start).Length:
+        ref = in_plane(out[-1])
+        same = np.mean(np.linalg.norm(in_plane(curve) - ref, axis=1))
+        turned = np.mean(np.linalg.norm(in_plane(curve, reverse=True) - ref, axis=1))
+        if turned < same:
             curve = curve.copy()
             curve.reverse()
         out.append(curve)
