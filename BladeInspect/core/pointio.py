@@ -69,30 +69,55 @@ def _read_text(path):
 def _split_csv(path, text):
     """Header names, each column's field strings, and the count of skipped rows (whose field
     count differs from the header's)."""
-    lines = [line for line in text.splitlines()
-             if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
+    header, body = _header_and_body(text)
+    if header is None:
         raise InputError("%s: the file has only comments" % path)
-    names = [n.strip().strip('"').strip("'").strip().lower() for n in lines[0].split(",")]
+    names = [n.strip().strip('"').strip("'").strip().lower() for n in header.split(",")]
     missing = [n for n in ("x", "y", "z") if n not in names]
     if missing:
         raise InputError("%s: the header line must name columns x, y, z (missing %s; found "
-                         "'%s')" % (path, ", ".join(missing), lines[0].strip()[:80]))
+                         "'%s')" % (path, ", ".join(missing), header.strip()[:80]))
     duplicates = sorted(n for n, c in Counter(names).items() if c > 1)
     if duplicates or "" in names:
         raise InputError("%s: the header has %s" % (
             path, "duplicate columns " + ", ".join(duplicates) if duplicates
             else "an empty column name"))
-    data = lines[1:]
-    if not data:
+    n_cols = len(names)
+    body = body.rstrip("\n")
+    if not body.strip():
         raise InputError("%s: a header but no data rows" % path)
-    n_commas = len(names) - 1
-    good = [line for line in data if line.count(",") == n_commas]
+    if "#" not in body and _every_line_has_commas(body, n_cols - 1):
+        # The usual file: one split of the whole text instead of one per line.
+        tokens = body.replace("\n", ",").split(",")
+        return names, [tokens[j::n_cols] for j in range(n_cols)], 0
+    data = [line for line in body.split("\n")
+            if line.strip() and not line.lstrip().startswith("#")]
+    good = [line for line in data if line.count(",") == n_cols - 1]
     if not good:
-        raise InputError("%s: no data row has the header's %d columns" % (path, len(names)))
+        raise InputError("%s: no data row has the header's %d columns" % (path, n_cols))
     tokens = ",".join(good).split(",")
-    columns = [tokens[j::len(names)] for j in range(len(names))]
-    return names, columns, len(data) - len(good)
+    return names, [tokens[j::n_cols] for j in range(n_cols)], len(data) - len(good)
+
+
+def _header_and_body(text):
+    """The first line that is neither blank nor a comment, and the text after it."""
+    pos = 0
+    while pos < len(text):
+        end = text.find("\n", pos)
+        end = len(text) if end < 0 else end
+        line = text[pos:end]
+        if line.strip() and not line.lstrip().startswith("#"):
+            return line, text[end + 1:]
+        pos = end + 1
+    return None, ""
+
+
+def _every_line_has_commas(body, n_commas):
+    data = np.frombuffer(body.encode("utf-8"), dtype=np.uint8)
+    newlines = np.flatnonzero(data == 10)
+    per_line = np.bincount(np.searchsorted(newlines, np.flatnonzero(data == 44)),
+                           minlength=len(newlines) + 1)
+    return bool(np.all(per_line == n_commas))
 
 
 def _split_whitespace(path, text):
@@ -205,7 +230,7 @@ def write_points_csv(path, xyz, columns=None):
     if xyz.ndim != 2 or xyz.shape[1] != 3:
         raise InputError("%s: points must be (N, 3), got %s" % (path, xyz.shape))
     header = ["x", "y", "z"]
-    text_cols = [np.char.mod("%.6f", xyz[:, k]) for k in range(3)]
+    text_cols = [_format_column(xyz[:, k]) for k in range(3)]
     for name, values in (columns or {}).items():
         if values is None:
             continue
@@ -215,21 +240,22 @@ def write_points_csv(path, xyz, columns=None):
                              % (path, name, values.shape, len(xyz)))
         if name.lower() in header:
             raise InputError("%s: column %s given twice" % (path, name))
-        if values.dtype.kind == "f":
-            text = np.char.mod("%.6f", values)
-        elif values.dtype.kind in "iub":
-            text = np.char.mod("%d", values.astype(np.int64))
-        else:
-            text = values.astype(str)
-            if any("," in t or "\n" in t for t in text):
-                raise InputError("%s: column %s has text with a comma or line break"
-                                 % (path, name))
+        text = _format_column(values)
+        if values.dtype.kind not in "fiub" and any("," in t or "\n" in t for t in text):
+            raise InputError("%s: column %s has text with a comma or line break"
+                             % (path, name))
         header.append(name.lower())
         text_cols.append(text)
-    rows = text_cols[0].astype(object)
-    for col in text_cols[1:]:
-        rows = rows + "," + col.astype(object)
     with open(path, "w") as fh:
         fh.write(",".join(header) + "\n")
-        if len(rows):
-            fh.write("\n".join(rows.tolist()) + "\n")
+        if len(xyz):
+            fh.write("\n".join(map(",".join, zip(*text_cols))) + "\n")
+
+
+def _format_column(values):
+    """Field strings of a column (Python's own formatting beats numpy's char functions)."""
+    if values.dtype.kind == "f":
+        return ["%.6f" % v for v in values.tolist()]
+    if values.dtype.kind in "iub":
+        return ["%d" % v for v in values.astype(np.int64).tolist()]
+    return [str(v) for v in values.tolist()]
