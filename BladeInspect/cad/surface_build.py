@@ -57,19 +57,7 @@ def interpolate_grid(points, u_params, v_params, degree=3):
     return surface
 
 
-def interpolate_curve(points, params, degree=3):
-    """A clamped not-a-knot B-spline curve through ``points`` (n, 3) at ``params``."""
-    pts = np.asarray(points, dtype=float)
-    k = min(degree, len(pts) - 1)
-    spline = make_interp_spline(np.asarray(params, dtype=float), pts, k=k, axis=0)
-    knots, mults = _knots_mults(spline.t)
-    curve = Part.BSplineCurve()
-    curve.buildFromPolesMultsKnots([FreeCAD.Vector(*p) for p in spline.c], mults, knots,
-                                   False, k)
-    return curve
-
-
-def close_sides(side_a, side_b, cap_edges_start, cap_edges_end, planar_caps, tolerance=1e-4):
+def close_sides(side_a, side_b, cap_edges_start, cap_edges_end, planar_caps):
     """Sew two side faces and two caps into a solid (outward normals).
 
     ``side_a``/``side_b`` are faces meeting along their u=0 and u=1 edges;
@@ -80,7 +68,7 @@ def close_sides(side_a, side_b, cap_edges_start, cap_edges_end, planar_caps, tol
     caps = []
     for edges in (cap_edges_start, cap_edges_end):
         if planar_caps:
-            caps.append(Part.Face(Part.Wire(Part.__sortEdges__(list(edges)))))
+            caps.append(Part.Face(Part.Wire(list(edges))))
         else:
             caps.append(Part.makeFilledFace(list(edges)))
     originals = [side_a, side_b] + caps
