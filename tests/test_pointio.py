@@ -75,6 +75,15 @@ class TestCsv(PointFileCase):
         self.assertEqual(ps.n_rows_skipped, 6)
         self.assertEqual(len(ps.columns["phase"]), len(keep))
 
+    def test_comments_before_a_quoted_header_and_windows_line_ends(self):
+        rows = "".join('%d,%d,%d,"s"\r\n' % (i, -i, 2 * i) for i in range(11))
+        text = '# exported by a CMM\r\n\r\n"X", "Y", "Z","note"\r\n' + rows
+        ps = pointio.read_points(self.write("q.csv", text))
+        np.testing.assert_array_equal(ps.xyz, np.arange(11)[:, None] * [1.0, -1.0, 2.0])
+        self.assertIsNone(ps.snr)
+        self.assertEqual(ps.columns["note"].tolist(), ['"s"'] * 11)
+        self.assertEqual(ps.n_rows_skipped, 0)
+
     def test_errors_name_the_file_and_problem(self):
         header = "x,y,z,snr\n"
         good = "".join("%d,%d,%d,50\n" % (i, i, i) for i in range(12))
@@ -176,12 +185,13 @@ class TestSpeed(PointFileCase):
         body = "\n".join("%.6f,%.6f,%.6f,%.2f" % (p[0], p[1], p[2], 50.0) for p in xyz[:1000])
         # The same 1000 rows repeated keep the file's creation out of the timing's way.
         path = self.write("big.csv", "x,y,z,snr\n" + "\n".join([body] * (n // 1000)) + "\n")
-        start = time.perf_counter()
+        # CPU time, not wall time: other jobs share the machine's two cores. The target is
+        # under 1 s; about 0.35 s measured.
+        start = time.process_time()
         ps = pointio.read_points(path)
-        elapsed = time.perf_counter() - start
+        elapsed = time.process_time() - start
         self.assertEqual(len(ps.xyz), n)
-        # 1 s is the target on an idle machine; the margin absorbs other jobs sharing the CPUs.
-        self.assertLess(elapsed, 2.5)
+        self.assertLess(elapsed, 1.0)
 
 
 if __name__ == "__main__":
