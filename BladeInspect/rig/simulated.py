@@ -82,6 +82,19 @@ def make_thickening(curve_points, radius, height):
     return field
 
 
+def simulated_rig_for(part, seed=0, **rig_options):
+    """A SimulatedRig of ``part`` (with ``bbox_corners``) clamped at a random fixture pose
+    drawn from ``seed``: its span (the bounding box's longest side) along the rotary axis, the
+    box centre near the axis. The same seed gives the same pose and the same readings."""
+    corners = np.asarray(part.bbox_corners, dtype=float)
+    extent = corners.max(axis=0) - corners.min(axis=0)
+    span_axis = np.eye(3)[int(np.argmax(extent))]
+    centre = 0.5 * (corners.max(axis=0) + corners.min(axis=0))
+    pose = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=span_axis,
+                               cad_center=centre)
+    return SimulatedRig(part, pose, seed=seed, **rig_options)
+
+
 class SimulatedRig(Rig):
     """``part``: anything with raycast(origins, directions) -> (t, face, normal) in the CAD
     frame, normals outward (cad.nominal.Nominal, calibration.SpherePart, analytic test parts).

@@ -33,6 +33,9 @@ from .kinematics import RigKinematics
 SIDE_VIEWS = (("side1", 0.0), ("side2", 180.0))
 EDGE_VIEWS = (("edge1", 90.0), ("edge2", 270.0))
 MIN_VIEW_POINTS = 5
+MIN_EDGE_POINTS = 3
+EDGE_WINDOW_MM = 5.0
+EDGE_PROBE_SPACING_MM = 0.05
 SPAN_PROBE_OFFSETS = (-15.0, 0.0, 15.0)
 MAX_EXTENSION_FACTOR = 4.0
 # Where the re-centred first window puts the highest surface point found, in half ranges
@@ -249,7 +252,6 @@ class ScanStrategy:
         self.probe_spacing = float(probe_spacing)
         self.epsilon = float(epsilon)
         self.views = SIDE_VIEWS[:sides] + (EDGE_VIEWS if edges else ())
-        self.views = tuple(sorted(self.views, key=lambda v: v[1]))
         self.max_passes = int(max_passes)
         self.search_radius = float(search_radius)
         self.end_margin = float(end_margin)
@@ -360,12 +362,11 @@ class ScanStrategy:
         base = self.state.base_angle_deg
         if not self.state.levelled:
             base = self._level(y, base)
-        # Alternate the view order so that the rotary turns back and forth, not round and round.
-        views = self.views if k % 2 == 0 else self.views[::-1]
         results = []
-        for name, offset in views:
-            view = self._scan_view(name, y, base + offset)
-            results.append(view)
+        for name, offset in self._view_order(k):
+            angle = base + offset
+            near = self._edge_prediction(results, angle) if name.startswith("edge") else None
+            results.append(self._scan_view(name, y, angle, near=near))
         first = next(v for v in results if v.name == "side1")
         twist = self._chord_angle(first)
         level = base + (0.0 if twist is None else self._twist_sign * twist)
@@ -388,6 +389,33 @@ class ScanStrategy:
                              snr=np.concatenate(snr), angle_deg=np.concatenate(ang),
                              views=results, simulated_s=self.rig.elapsed_s - start,
                              max_standoff_error_mm=max(errors))
+
+    def _view_order(self, k):
+        """Even sections turn up through 0, 90, 180, 270 deg, odd ones back down through
+        180, 90, 0, -90: the rotary goes to and fro, and every edge view comes after a side
+        view of the same section that shows where the edge is."""
+        if k % 2 == 0:
+            return sorted(self.views, key=lambda v: v[1])
+        back = [(n, o - 360.0 if o > 180.0 else o) for n, o in self.views]
+        return sorted(back, key=lambda v: -v[1])
+
+    def _edge_prediction(self, side_views, angle):
+        """Where an edge should show at this angle, from the ends of the side views measured
+        (stage coordinates, turned about the axis): the end that comes out on top, or None."""
+        k = self.kinematics
+        ends = []
+        for v in side_views:
+            if not v.name.startswith("side") or len(v.reading_mm) < MIN_VIEW_POINTS:
+                continue
+            surface = v.stage_xyz - np.column_stack([np.zeros((len(v.reading_mm), 2)),
+                                                     v.reading_mm])
+            for i in (np.argmin(surface[:, 0]), np.argmax(surface[:, 0])):
+                table = k.table_point(surface[i:i + 1], v.angle_deg)
+                ends.append(k.machine_point_of_table(table, angle)[0])
+        if not ends:
+            return None
+        top = max(ends, key=lambda p: p[2])
+        return float(top[0]), float(top[2])
 
     def _level(self, y, base):
         """Step 1 for the first section: turn the part until the first side's chord is level
@@ -423,9 +451,9 @@ class ScanStrategy:
 
     # -- one view: steps 1-5 -------------------------------------------------------------------
 
-    def _scan_view(self, name, y, angle, final=True):
+    def _scan_view(self, name, y, angle, final=True, near=None):
         passes = []
-        found = self._find_surface(name, y, angle, passes)
+        found = self._find_surface(name, y, angle, passes, near)
         if found is None:
             return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes)
         x_all, z_all = found
@@ -484,12 +512,29 @@ class ScanStrategy:
         reach = np.hypot(beyond[:, 0] - x_all[end], beyond[:, 1] - z_all[end])
         return bool(reach.max() >= self.probe_spacing)
 
-    def _find_surface(self, name, y, angle, passes):
+    def _find_surface(self, name, y, angle, passes, near=None):
         """Steps 1-2: linear passes along X at fixed Z, first at the height this view found on
         the previous section, then stepping down through the search envelope, until the sensor
-        reads. Returns the surface points (x, z) of that pass, or None."""
-        ax = self.kinematics.axis_point[0]
+        reads. Returns the surface points (x, z) of that pass, or None.
+
+        ``near`` (x, z): where an edge is expected. A thin edge turned up shows only its nose
+        to the sensor (the flanks lie beyond the coverage), a fraction of a millimetre that
+        coarse probes step over: it is looked for first with a fine pass around there."""
         lim = self.rig.limits
+        if near is not None:
+            z_stage = near[1] + self.sensor.standoff
+            xs = self._samples(near[0] - EDGE_WINDOW_MM, near[0] + EDGE_WINDOW_MM,
+                               min(self.point_spacing, EDGE_PROBE_SPACING_MM))
+            xs = xs[(xs >= lim.x[0]) & (xs <= lim.x[1])]
+            if lim.z[0] <= z_stage <= lim.z[1] and len(xs):
+                stage = np.column_stack([xs, np.full(len(xs), y), np.full(len(xs), z_stage)])
+                readings = self.rig.scan_path(stage, angle)
+                d = np.asarray(readings.reading_mm, dtype=float)
+                passes.append(self._pass_info("linear", readings, d))
+                valid = np.isfinite(d)
+                if np.count_nonzero(valid) >= MIN_EDGE_POINTS:
+                    return stage[valid, 0], z_stage - d[valid]
+        ax = self.kinematics.axis_point[0]
         x0 = max(ax - self.search_radius, lim.x[0])
         x1 = min(ax + self.search_radius, lim.x[1])
         xs = self._samples(x0, x1, self.probe_spacing)
