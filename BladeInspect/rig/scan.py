@@ -1,0 +1,247 @@
+"""Open a rig and run the blind section scan into a folder: DIR/points.csv (table frame) and
+DIR/scan.json (per-section record, times, the simulator's truth, the checkpoint).
+
+Both files grow one COMPLETED section at a time: the points are appended, then scan.json is
+replaced atomically (temporary file + os.replace) with a checkpoint holding the strategy's
+state, the rig's pass counter and the byte length of points.csv. A scan cut short (a
+DeviceError mid-section, a cancel) keeps its finished sections, and ``resume=True`` continues
+after the last of them: points.csv is cut back to the checkpoint (dropping a section's rows
+appended just before the interruption) and the strategy carries on from its saved state, so
+nothing is measured twice or lost and a simulated rig reads exactly what it would have.
+"""
+
+import json
+import os
+import tempfile
+
+import numpy as np
+
+from ..core.errors import InputError
+from .strategy import ScanStrategy, StrategyState
+
+POINTS_FILE = "points.csv"
+RECORD_FILE = "scan.json"
+POINTS_HEADER = "x,y,z,snr,section,angle_deg\n"
+# Per pass on a real rig, beyond motion and acquisition: stopping, arming the trigger and
+# reading the sensor's buffer out (a few hundred ms on a serial line).
+PASS_OVERHEAD_S = 0.3
+
+
+def open_rig(spec, nominal=None, seed=0, kinematics=None, **rig_options):
+    """``sim``: a SimulatedRig of ``nominal`` (None: the demo blade) clamped at a random
+    fixture pose drawn from ``seed``, with ``kinematics`` as its true geometry (default
+    nominal); ``serial:PORT`` (or ``serial:MOTION,SENSOR``): the serial driver."""
+    spec = str(spec)
+    if spec == "sim":
+        from .simulated import simulated_rig_for
+        if nominal is None:
+            nominal = _demo_nominal()
+        return simulated_rig_for(nominal, seed=seed, kinematics=kinematics, **rig_options)
+    if spec.startswith("serial:") and len(spec) > len("serial:"):
+        from .serial_rig import SerialRig
+        return SerialRig(spec[len("serial:"):], **rig_options)
+    raise InputError("--rig %s: expected sim or serial:PORT" % spec)
+
+
+def _demo_nominal():
+    from ..cad.demo_blade import make_demo_blade
+    from ..cad.nominal import nominal_from_shape
+    model = make_demo_blade()
+    return nominal_from_shape(model.shape, roles=model.roles)
+
+
+def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
+                **strategy_options):
+    """Run the blind scan (rig.strategy.ScanStrategy with ``strategy_options``) and write it
+    to ``out_dir`` section by section. Returns the scan record (what scan.json holds, plus
+    ``points``: the number of points). ``progress(fraction, message)`` is called per section.
+
+    A folder holding a previous scan is an InputError unless ``resume``; on resume the saved
+    options are used (the scan continues as it began) and the rig must be the same one."""
+    if not out_dir:
+        raise InputError("--out: a folder is required")
+    points_path = os.path.join(out_dir, POINTS_FILE)
+    record_path = os.path.join(out_dir, RECORD_FILE)
+    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
+        raise InputError("--out %s: exists and is not a folder" % out_dir)
+    os.makedirs(out_dir, exist_ok=True)
+    has_record = os.path.exists(record_path)
+    if not resume and (has_record or os.path.exists(points_path)):
+        raise InputError("--out %s: holds a previous scan (use --resume to continue it, or "
+                         "another folder)" % out_dir)
+    if resume and has_record:
+        record = _load_record(record_path)
+        _check_same_rig(record, rig, seed, record_path)
+        options = record["options"]
+        _truncate_points(points_path, record["checkpoint"]["points_bytes"])
+        state = StrategyState.from_dict(record["checkpoint"]["strategy"])
+    else:
+        if resume and os.path.exists(points_path):
+            raise InputError("--out %s: has %s but no %s to resume from"
+                             % (out_dir, POINTS_FILE, RECORD_FILE))
+        options = dict(strategy_options, n_sections=int(n_sections))
+        record = _new_record(rig, seed, options)
+        with open(points_path, "w") as f:
+            f.write(POINTS_HEADER)
+        record["checkpoint"]["points_bytes"] = os.path.getsize(points_path)
+        state = None
+        _write_record(record_path, record)
+    strategy = ScanStrategy(rig, state=state, **_strategy_kwargs(options))
+    start_elapsed = rig.elapsed_s
+    base_simulated = record["simulated_s"]
+    for section in strategy.sections(progress):
+        _append_points(points_path, section)
+        record["sections"].append(_section_record(section))
+        record["points"] += int(len(section.snr))
+        record["passes"] += section.passes
+        record["simulated_s"] = base_simulated + (rig.elapsed_s - start_elapsed)
+        record["real_time_s"] = _real_time(rig, record)
+        record["section_y"] = [float(v) for v in strategy.section_y]
+        record["complete"] = strategy.state.next_section >= len(strategy.section_y)
+        record["checkpoint"] = {"strategy": strategy.state.to_dict(),
+                                "points_bytes": os.path.getsize(points_path)}
+        _write_record(record_path, record)
+    if progress is not None:
+        progress(1.0, "scan complete: %d sections, %d points"
+                 % (len(record["sections"]), record["points"]))
+    return record
+
+
+# ---------------------------------------------------------------- record
+
+def _strategy_kwargs(options):
+    allowed = ("n_sections", "span_range", "section_spacing", "point_spacing", "probe_spacing",
+               "epsilon", "sides", "edges", "max_passes", "search_radius", "end_margin",
+               "extension_mm", "kinematics")
+    unknown = sorted(set(options) - set(allowed))
+    if unknown:
+        raise InputError("scan: unknown option %s" % ", ".join(unknown))
+    kwargs = dict(options)
+    if isinstance(kwargs.get("kinematics"), dict):
+        from .kinematics import RigKinematics
+        kwargs["kinematics"] = RigKinematics.from_dict(kwargs["kinematics"], "scan.json options")
+    return kwargs
+
+
+def _json_options(options):
+    out = {}
+    for k, v in options.items():
+        if k == "kinematics":
+            out[k] = None if v is None else v.to_dict()
+        elif isinstance(v, np.ndarray):
+            out[k] = v.tolist()
+        elif isinstance(v, (np.floating, np.integer)):
+            out[k] = v.item()
+        else:
+            out[k] = v
+    return out
+
+
+def _new_record(rig, seed, options):
+    from .. import __version__ as version
+    sensor = rig.sensor
+    record = {
+        "software": {"name": "BladeInspect", "version": version},
+        "kind": "blind section scan",
+        "rig": type(rig).__name__,
+        "seed": int(seed),
+        "options": _json_options(options),
+        "sensor": sensor.to_dict() if hasattr(sensor, "to_dict") else None,
+        "frame": "rotary table (machine frame turned back by the rotary angle)",
+        "complete": False,
+        "sections": [],
+        "section_y": None,
+        "points": 0,
+        "passes": 0,
+        "simulated_s": 0.0,
+        "real_time_s": 0.0,
+        "checkpoint": {"strategy": StrategyState().to_dict(), "points_bytes": 0},
+    }
+    truth = getattr(rig, "table_to_cad", None)
+    if truth is not None:
+        record["table_to_cad"] = np.asarray(truth, dtype=float).tolist()
+        record["rig_seed"] = int(getattr(rig, "seed", seed))
+    return record
+
+
+def _check_same_rig(record, rig, seed, path):
+    if int(record.get("seed", seed)) != int(seed):
+        raise InputError("%s: the scan was made with seed %s, not %s"
+                         % (path, record.get("seed"), seed))
+    if record.get("rig") != type(rig).__name__:
+        raise InputError("%s: the scan was made on a %s rig, not a %s"
+                         % (path, record.get("rig"), type(rig).__name__))
+    truth = getattr(rig, "table_to_cad", None)
+    if truth is not None and "table_to_cad" in record:
+        if not np.allclose(np.asarray(record["table_to_cad"]), truth, atol=1e-9):
+            raise InputError("%s: the simulated part is clamped differently from the scan "
+                             "being resumed (another CAD or seed?)" % path)
+
+
+def _load_record(path):
+    try:
+        with open(path) as f:
+            record = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise InputError("%s: not a readable scan record (%s)" % (path, exc))
+    checkpoint = record.get("checkpoint") if isinstance(record, dict) else None
+    if (not isinstance(checkpoint, dict) or "strategy" not in checkpoint
+            or "points_bytes" not in checkpoint or "options" not in record
+            or not isinstance(record.get("sections"), list)):
+        raise InputError("%s: not a scan record with a checkpoint" % path)
+    return record
+
+
+def _write_record(path, record):
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".scan-", suffix=".json", dir=folder)
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(record, f, indent=1)
+            f.write("\n")
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def _truncate_points(path, size):
+    if not os.path.exists(path) or os.path.getsize(path) < size:
+        raise InputError("%s: shorter than its checkpoint in %s (the scan folder was changed)"
+                         % (path, RECORD_FILE))
+    with open(path, "r+b") as f:
+        f.truncate(size)
+
+
+def _append_points(path, section):
+    rows = np.column_stack([section.table_xyz, section.snr])
+    lines = ["%.6f,%.6f,%.6f,%.6f,%d,%.6f\n" % (x, y, z, s, section.index, a)
+             for (x, y, z, s), a in zip(rows, section.angle_deg)]
+    with open(path, "a") as f:
+        f.write("".join(lines))
+        f.flush()
+        os.fsync(f.fileno())
+
+
+def _section_record(section):
+    return {"index": int(section.index),
+            "y": float(section.y),
+            "base_angle_deg": float(section.base_angle_deg),
+            "points": int(len(section.snr)),
+            "passes": int(section.passes),
+            "max_standoff_error_mm": float(section.max_standoff_error_mm),
+            "simulated_s": float(section.simulated_s),
+            "views": [{"name": v.name, "angle_deg": float(v.angle_deg),
+                       "points": int(len(v.snr)), "passes": v.passes}
+                      for v in section.views]}
+
+
+def _real_time(rig, record):
+    """A simulated rig's time plus the per-pass overhead a real one adds; a real rig's
+    elapsed time is already real."""
+    from .simulated import SimulatedRig
+    if isinstance(rig, SimulatedRig):
+        return record["simulated_s"] + PASS_OVERHEAD_S * record["passes"]
+    return record["simulated_s"]
