@@ -247,15 +247,12 @@ def _choose_angles(cosines, max_incidence_deg):
 
 # ---------------------------------------------------------------- checks
 
-def _line_of_sight(nominal, cad_from_machine, spot_machine, standoff):
-    """Exact: a ray down the beam from the lens must first meet the CAD at the planned spot.
-    Returns (visible (K,), distance along the beam to the first hit)."""
-    origins_m = spot_machine + np.array([0.0, 0.0, standoff])
-    origins = tf.apply_transform(cad_from_machine, origins_m)
+def _beam_rays(table_to_cad, kinematics, angle_deg, spot_machine, standoff):
+    """Rays in the CAD frame down the beam from the lens (standoff above each spot)."""
+    cad_from_machine = _cad_from_machine(table_to_cad, kinematics, angle_deg)
+    origins = tf.apply_transform(cad_from_machine, spot_machine + np.array([0.0, 0.0, standoff]))
     down = cad_from_machine[:3, :3] @ np.array([0.0, 0.0, -1.0])
-    t, _, _ = nominal.raycast(origins, np.tile(down, (len(origins), 1)))
-    visible = np.isfinite(t) & (t > standoff - LINE_OF_SIGHT_TOLERANCE_MM)
-    return visible, t
+    return origins, np.tile(down, (len(origins), 1))
 
 
 def _body_clear(samples_machine, spot_machine, standoff):
@@ -305,45 +302,72 @@ def _runs(angle_rows, contours, reverse):
     return runs
 
 
-def _plan_section(index, height, plane_point, axis, target, normal, nominal, table_to_cad,
-                  kinematics, sensor, limits, samples_table, max_incidence_deg):
-    """Angles, setpoints and checks for one section's points (see plan_sections)."""
+class _SectionWork:
+    """One section between choosing its candidate angles and checking them."""
+
+    def __init__(self, index, height, plane_point, axis, target, normal, contours,
+                 table_to_cad, kinematics):
+        self.index, self.height, self.plane_point, self.axis = index, height, plane_point, axis
+        self.target, self.normal, self.contours = target, normal, contours
+        cad_to_table = tf.invert_transform(table_to_cad)
+        self.target_t = tf.apply_transform(cad_to_table, target)
+        self.cosines = _incidence_table(normal @ cad_to_table[:3, :3].T, ANGLES, kinematics)
+        self.chosen = []
+        self.score = np.full(self.cosines.shape, -np.inf)
+        self.beam_length = np.full(self.cosines.shape, np.nan)
+
+
+def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table):
+    """Line of sight (one exact ray cast for every section and angle together: the cast's cost
+    is mostly per beam direction, and sections share their angles) and body clearance at each
+    section's chosen angles, for the points each angle could serve at all. Fills each
+    section's score (cos incidence where the view is clear) and beam length."""
     standoff = float(sensor.standoff)
     usable = np.cos(np.radians(0.5 * float(sensor.coverage_deg) - COVERAGE_MARGIN_DEG))
-    cad_to_table = tf.invert_transform(table_to_cad)
-    target_t = tf.apply_transform(cad_to_table, target)
-    normal_t = normal @ cad_to_table[:3, :3].T
-    cosines = _incidence_table(normal_t, ANGLES, kinematics)
-    _, chosen = _choose_angles(cosines, max_incidence_deg)
-    # Line of sight and body clearance at each chosen angle, for the points that angle could
-    # serve at all; each point then takes the clear chosen angle nearest to head-on.
-    score = np.full(cosines.shape, -np.inf)
-    beam_length = np.full(cosines.shape, np.nan)
-    for row in chosen:
-        a = ANGLES[row]
-        cand = np.flatnonzero(cosines[row] >= usable)
-        if len(cand) == 0:
-            continue
-        spot = kinematics.machine_point_of_table(target_t[cand], a)
-        cad_from_machine = _cad_from_machine(table_to_cad, kinematics, a)
-        visible, t = _line_of_sight(nominal, cad_from_machine, spot, standoff)
-        samples_m = kinematics.machine_point_of_table(samples_table, a)
-        ok = visible & _body_clear(samples_m, spot, standoff)
-        score[row, cand[ok]] = cosines[row, cand[ok]]
-        beam_length[row, cand] = t
-    rows = np.argmax(score, axis=0)
-    idx = np.arange(len(target))
-    blocked = ~np.isfinite(score[rows, idx])
+    requests, origins, directions = [], [], []
+    samples_m = {}
+    for work in works:
+        for row in work.chosen:
+            cand = np.flatnonzero(work.cosines[row] >= usable)
+            if len(cand) == 0:
+                continue
+            a = ANGLES[row]
+            spot = kinematics.machine_point_of_table(work.target_t[cand], a)
+            o, d = _beam_rays(table_to_cad, kinematics, a, spot, standoff)
+            if row not in samples_m:
+                samples_m[row] = kinematics.machine_point_of_table(samples_table, a)
+            clear = _body_clear(samples_m[row], spot, standoff)
+            requests.append((work, row, cand, clear))
+            origins.append(o)
+            directions.append(d)
+    if not requests:
+        return
+    t, _, _ = nominal.raycast(np.vstack(origins), np.vstack(directions))
+    start = 0
+    for work, row, cand, clear in requests:
+        tt = t[start:start + len(cand)]
+        start += len(cand)
+        ok = clear & np.isfinite(tt) & (tt > standoff - LINE_OF_SIGHT_TOLERANCE_MM)
+        work.score[row, cand[ok]] = work.cosines[row, cand[ok]]
+        work.beam_length[row, cand] = tt
+
+
+def _finish_section(work, kinematics, sensor, limits):
+    """Each point's angle (the clear chosen one nearest head-on), setpoints, limit checks."""
+    standoff = float(sensor.standoff)
+    rows = np.argmax(work.score, axis=0)
+    idx = np.arange(len(work.target))
+    blocked = ~np.isfinite(work.score[rows, idx])
     if blocked.any():
         raise InputError("plan: %d points of the section at %g %% cannot be seen within the "
                          "sensor's coverage (less %g deg margin) without the sensor meeting "
-                         "the blade" % (int(blocked.sum()), height, COVERAGE_MARGIN_DEG))
-    incidence = np.degrees(np.arccos(np.clip(cosines[rows, idx], -1.0, 1.0)))
+                         "the blade" % (int(blocked.sum()), work.height, COVERAGE_MARGIN_DEG))
+    incidence = np.degrees(np.arccos(np.clip(work.cosines[rows, idx], -1.0, 1.0)))
     angle = ANGLES[rows]
-    spot = np.empty_like(target_t)
+    spot = np.empty_like(work.target_t)
     for a in np.unique(angle):
         sel = angle == a
-        spot[sel] = kinematics.machine_point_of_table(target_t[sel], a)
+        spot[sel] = kinematics.machine_point_of_table(work.target_t[sel], a)
     stage = spot + np.array([0.0, 0.0, standoff])
     for a in np.unique(angle):
         sel = angle == a
@@ -351,12 +375,12 @@ def _plan_section(index, height, plane_point, axis, target, normal, nominal, tab
             limits.check(stage[sel, 0], stage[sel, 1], stage[sel, 2], a)
         except DeviceError as exc:
             raise DeviceError("plan: section at %g %% unreachable within soft limits (%s)"
-                              % (height, exc)) from None
+                              % (work.height, exc)) from None
     return PlannedSection(
-        index=index, height_pct=height, plane_point=plane_point, plane_normal=axis.copy(),
-        target_cad=target, normal_cad=normal, angle_deg=angle, stage_xyz=stage,
-        expected_standoff_mm=beam_length[rows, idx], incidence_deg=incidence,
-        expected_snr=_expected_snr(sensor, np.radians(incidence)))
+        index=work.index, height_pct=work.height, plane_point=work.plane_point,
+        plane_normal=work.axis.copy(), target_cad=work.target, normal_cad=work.normal,
+        angle_deg=angle, stage_xyz=stage, expected_standoff_mm=work.beam_length[rows, idx],
+        incidence_deg=incidence, expected_snr=_expected_snr(sensor, np.radians(incidence)))
 
 
 def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=None,
@@ -382,27 +406,36 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     kinematics = kinematics if kinematics is not None else RigKinematics()
     samples_table = tf.apply_transform(cad_to_table, nominal.samples.xyz)
 
-    sections, paths = [], []
-    last_stage = None
+    works = []
     for k, h in enumerate(heights):
         plane_point = origin + axis * (lo + (hi - lo) * h / 100.0)
         try:
             target, normal, contours = nominal_section(nominal, plane_point, axis, spacing)
         except InputError as exc:
             raise InputError("--section-heights %g: %s" % (h, exc)) from None
-        section = _plan_section(k, h, plane_point, axis, target, normal, nominal, table_to_cad,
-                                kinematics, sensor, limits, samples_table, max_incidence_deg)
+        works.append(_SectionWork(k, h, plane_point, axis, target, normal, contours,
+                                  table_to_cad, kinematics))
+    # One set of angles for all sections: fewer rotations between sections, and the exact ray
+    # cast's cost is mostly per beam direction.
+    _, shared = _choose_angles(np.hstack([w.cosines for w in works]), max_incidence_deg)
+    for work in works:
+        work.chosen = shared
+    _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table)
+    sections, paths = [], []
+    last_stage = None
+    for work in works:
+        section = _finish_section(work, kinematics, sensor, limits)
         sections.append(section)
         rows = np.searchsorted(ANGLES, section.angle_deg)
-        for run in _runs(rows, contours, reverse=bool(k % 2)):
+        for run in _runs(rows, work.contours, reverse=bool(work.index % 2)):
             run = np.asarray(run, dtype=int)
             # Enter each run from the end nearer to where the stages are.
             stage = section.stage_xyz
             if last_stage is not None and (np.linalg.norm(stage[run[-1]] - last_stage)
                                            < np.linalg.norm(stage[run[0]] - last_stage)):
                 run = run[::-1]
-            paths.append(PlannedPath(section=k, angle_deg=float(section.angle_deg[run[0]]),
-                                     points=run))
+            paths.append(PlannedPath(section=work.index,
+                                     angle_deg=float(section.angle_deg[run[0]]), points=run))
             last_stage = stage[run[-1]]
     info = {"max_incidence_deg": max_incidence_deg, "angle_step_deg": ANGLE_STEP_DEG,
             "body_radius_mm": BODY_RADIUS_MM,
