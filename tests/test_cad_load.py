@@ -86,6 +86,34 @@ class LoadShape(unittest.TestCase):
         self.assertAlmostEqual(sum(s.Volume for s in loaded.Solids), self.blade.Volume + 1.0,
                                places=6)
 
+    def test_fcstd_containers_bodies_and_hidden_groups(self):
+        doc = FreeCAD.newDocument("LoadTestGroups", hidden=True)
+        try:
+            body = doc.addObject("PartDesign::Body", "Body")
+        except Exception:
+            FreeCAD.closeDocument(doc.Name)
+            self.skipTest("PartDesign is not loadable here")
+        body.addObject(doc.addObject("PartDesign::AdditiveBox", "BodyBox"))
+        moved = doc.addObject("App::Part", "Moved")
+        moved.Placement.Base = FreeCAD.Vector(100, 0, 0)
+        moved.addObject(doc.addObject("Part::Feature", "Blade"))
+        doc.getObject("Blade").Shape = self.blade
+        hidden = doc.addObject("App::Part", "Hidden")
+        hidden.Visibility = False
+        hidden.addObject(doc.addObject("Part::Box", "Fixture"))
+        doc.recompute()
+        doc.saveAs(self.path("groups.FCStd"))
+        FreeCAD.closeDocument(doc.Name)
+        loaded = load_shape(self.path("groups.FCStd"))
+        # The body once (not again as its feature), the blade where its container puts it,
+        # nothing of the hidden group.
+        self.assertEqual(len(loaded.Faces), 6 + len(self.blade.Faces))
+        volumes = sorted(s.Volume for s in loaded.Solids)
+        self.assertAlmostEqual(volumes[0], 1000.0, places=6)
+        self.assertAlmostEqual(volumes[1], self.blade.Volume, places=6)
+        blade = max(loaded.Solids, key=lambda s: s.Volume)
+        self.assertAlmostEqual(blade.BoundBox.XMin, self.blade.BoundBox.XMin + 100, places=6)
+
     def assert_input_error(self, path, *words):
         with self.assertRaises(InputError) as ctx:
             load_shape(path)

@@ -55,14 +55,7 @@ def _document_shape(path):
                     if os.path.abspath(d.FileName) == os.path.abspath(path)]
     try:
         doc = already_open[0] if already_open else FreeCAD.openDocument(path, True)
-        shapes = []
-        for obj in doc.Objects:
-            shape = getattr(obj, "Shape", None)
-            if not isinstance(shape, Part.Shape) or shape.isNull() or not shape.Faces:
-                continue
-            if not getattr(obj, "Visibility", True):
-                continue
-            shapes.append(shape.copy())
+        shapes = [_placed_shape(obj) for obj in doc.Objects if _is_visible_solid_part(obj)]
     except Exception:
         raise InputError("%s: not a readable FreeCAD document" % path) from None
     finally:
@@ -73,6 +66,31 @@ def _document_shape(path):
     if not shapes:
         raise InputError("%s: no visible object with faces in the document" % path)
     return shapes[0] if len(shapes) == 1 else Part.Compound(shapes)
+
+
+def _is_visible_solid_part(obj):
+    """A Part feature with faces shown in the document, counted once: a PartDesign body
+    stands for the features inside it, and a hidden container hides what it holds."""
+    if not obj.isDerivedFrom("Part::Feature"):
+        return False
+    shape = obj.Shape
+    if shape.isNull() or not shape.Faces:
+        return False
+    parent = obj.getParentGeoFeatureGroup()
+    if parent is not None and parent.isDerivedFrom("PartDesign::Body"):
+        return False
+    while obj is not None:
+        if not getattr(obj, "Visibility", True):
+            return False
+        obj = obj.getParentGeoFeatureGroup()
+    return True
+
+
+def _placed_shape(obj):
+    """The object's shape where the document shows it (inside containers' placements)."""
+    shape = obj.Shape.copy()
+    shape.Placement = obj.getGlobalPlacement()
+    return shape
 
 
 def read_points_any(path):
