@@ -146,6 +146,34 @@ class TestScanToDir(unittest.TestCase):
             scan_to_dir(out, other, seed=SEED + 1, resume=True)
 
 
+class TestDemoBlade(unittest.TestCase):
+    """The demo blade's CAD at a random fixture pose, judged by the CAD's own exact distance."""
+
+    def test_section_of_the_demo_blade_lies_on_its_cad(self):
+        try:
+            from BladeInspect.rig.scan import demo_nominal
+            nominal = demo_nominal()
+        except ImportError as exc:          # the CAD layer needs FreeCAD
+            self.skipTest("no CAD layer: %s" % exc)
+        rig = open_rig("sim", nominal=nominal, seed=8)
+        # The span is given (from the truth) to keep the test short; the probe is tested on
+        # the analytic blade.
+        table = tf.apply_transform(np.linalg.inv(rig.table_to_cad), nominal.bbox_corners)
+        with tempfile.TemporaryDirectory() as out:
+            summary = scan_to_dir(out, rig, seed=8, n_sections=1, edges=False,
+                                  span_range=(table[:, 1].min(), table[:, 1].max()))
+            rows = np.array(read_rows(os.path.join(out, "points.csv"))[1:], dtype=float)
+        self.assertGreater(len(rows), 500)
+        self.assertLessEqual(summary["sections"][0]["max_standoff_error_mm"], 2.0)
+        dev = nominal.signed_distance(tf.apply_transform(rig.table_to_cad, rows[:, :3])).distance
+        snr = rows[:, 3]
+        bound = 0.006 * np.sqrt(100.0 / snr) + 2e-4
+        good = snr >= 25.0
+        self.assertTrue(np.all(np.abs(dev[good]) <= bound[good]),
+                        np.max(np.abs(dev[good]) - bound[good]))
+        self.assertLess(np.mean(np.abs(dev) > bound), 0.02)
+
+
 class TestOpenRig(unittest.TestCase):
     def test_sim_is_clamped_by_the_seed(self):
         part = TwistedEllipse()

@@ -35,7 +35,7 @@ def open_rig(spec, nominal=None, seed=0, kinematics=None, **rig_options):
     if spec == "sim":
         from .simulated import simulated_rig_for
         if nominal is None:
-            nominal = _demo_nominal()
+            nominal = demo_nominal()
         return simulated_rig_for(nominal, seed=seed, kinematics=kinematics, **rig_options)
     if spec.startswith("serial:") and len(spec) > len("serial:"):
         from .serial_rig import SerialRig
@@ -43,7 +43,8 @@ def open_rig(spec, nominal=None, seed=0, kinematics=None, **rig_options):
     raise InputError("--rig %s: expected sim or serial:PORT" % spec)
 
 
-def _demo_nominal():
+def demo_nominal():
+    """The built-in demo blade as a Nominal (what ``sim`` measures without a CAD)."""
     from ..cad.demo_blade import make_demo_blade
     from ..cad.nominal import nominal_from_shape
     model = make_demo_blade()
