@@ -36,7 +36,7 @@ MIN_VIEW_POINTS = 5
 MIN_EDGE_POINTS = 3
 EDGE_WINDOW_MM = 5.0
 EDGE_PROBE_SPACING_MM = 0.05
-SPAN_PROBE_OFFSETS = (-15.0, 0.0, 15.0)
+SPAN_PROBE_OFFSETS = (-15.0, 15.0)
 MAX_EXTENSION_FACTOR = 4.0
 # Where the re-centred first window puts the highest surface point found, in half ranges
 # above the window's centre.
@@ -308,17 +308,18 @@ class ScanStrategy:
         return list(np.linspace(lo + margin, hi - margin, self.n_sections))
 
     def _probe_span(self):
-        """The blade's extent along the rotary axis: passes along Y near the axis, stepping
-        down in Z, at the current angle and a quarter turn on: at one of the two the chord is
-        at least 45 deg from edge-on, wide enough to lie under a line all along the span
-        despite the twist. Everything read gives the span."""
+        """The blade's extent along the rotary axis: passes along Y over the axis, stepping
+        down in Z, at the current angle and a quarter turn on. At one of the two the chord is
+        at least 45 deg from edge-on, so even 10 mm off the axis it lies under the line all
+        along the span despite the twist. Where the line reads, two more lines either side
+        (the other edge of a narrow view, a line leaving the chord) add to it; everything
+        read gives the span. Lines are long, so empty heights cost one line, not three."""
         lim = self.rig.limits
         ax = self.kinematics.axis_point[0]
         ys = self._samples(lim.y[0], lim.y[1], 1.0)
-        # Three lines along Y, serpentine: one of them crosses the blade away from its edges.
-        lines = [np.column_stack([np.full(len(ys), ax + dx), ys if i % 2 == 0 else ys[::-1]])
-                 for i, dx in enumerate(SPAN_PROBE_OFFSETS)]
-        xy = np.vstack(lines)
+        centre = np.column_stack([np.full(len(ys), ax), ys])
+        sides = np.vstack([np.column_stack([np.full(len(ys), ax + dx), ys[::(-1) ** i]])
+                           for i, dx in enumerate(SPAN_PROBE_OFFSETS)])
         found = []
         for angle in (self.state.base_angle_deg, self.state.base_angle_deg + 90.0):
             seen = False
@@ -326,19 +327,24 @@ class ScanStrategy:
                 z_stage = level + self.sensor.standoff
                 if not lim.z[0] <= z_stage <= lim.z[1]:
                     continue
-                stage = np.column_stack([xy, np.full(len(xy), z_stage)])
-                d = np.asarray(self.rig.scan_path(stage, angle).reading_mm, dtype=float)
-                valid = np.isfinite(d)
-                if np.count_nonzero(valid) >= MIN_VIEW_POINTS:
-                    found.append(xy[valid, 1])
-                    seen = True
-                elif seen:
-                    break       # below the surface already seen: nothing more to find
+                y_read = self._read_along(centre, z_stage, angle)
+                if len(y_read) < MIN_VIEW_POINTS:
+                    if seen:
+                        break       # below the surface already seen: nothing more to find
+                    continue
+                seen = True
+                found += [y_read, self._read_along(sides, z_stage, angle)]
         if found:
             found = np.concatenate(found)
             return [float(found.min()), float(found.max())]
         raise InputError("scan: the sensor found no surface within %g mm of the rotary axis "
                          "(check the part is mounted and the search radius)" % self.search_radius)
+
+    def _read_along(self, xy, z_stage, angle):
+        """Y of the readings of one pass over the (x, y) points at height z_stage."""
+        stage = np.column_stack([xy, np.full(len(xy), z_stage)])
+        d = np.asarray(self.rig.scan_path(stage, angle).reading_mm, dtype=float)
+        return xy[np.isfinite(d), 1]
 
     def _levels(self):
         """Surface heights (stage Z - standoff) to probe at, from the top of the search
