@@ -55,6 +55,21 @@ class FitSectionCurve(unittest.TestCase):
             self.assertLess(err.max(), NOISE)
             self.assertLess(np.sqrt(np.mean(err ** 2)), 0.4 * NOISE_RMS)
 
+    def test_gross_outliers_do_not_pull_the_curve(self):
+        rng = np.random.default_rng(17)
+        radius = 40.0
+        ang = np.sort(rng.uniform(-0.5, 0.5, 600))
+        err = rng.uniform(-NOISE, NOISE, len(ang))
+        spikes = rng.choice(len(ang), 12, replace=False)
+        err[spikes] = rng.choice([-1, 1], 12) * rng.uniform(0.1, 0.5, 12)
+        r = radius + err
+        pts = np.column_stack([r * np.cos(ang), r * np.sin(ang), 0 * ang])
+        curve, rms, worst = fit_section_curve(pts)
+        self.assertAlmostEqual(rms / NOISE_RMS, 1.0, delta=0.15)
+        self.assertLess(worst, 2 * NOISE)
+        fitted = curve_points(curve)
+        self.assertLess(np.abs(np.linalg.norm(fitted[:, :2], axis=1) - radius).max(), NOISE)
+
     def test_known_bspline_profile_any_input_order(self):
         rng = np.random.default_rng(11)
         # A wavy cubic profile 50 mm long, like one side of a blade section.

@@ -27,6 +27,10 @@ ANGLE_CLUSTER_GAP_DEG = 20.0
 # Between neighbouring sections a view's angle follows the blade's twist, well below this.
 ANGLE_TRACK_DEG = 60.0
 PARAMETER_CORRECTIONS = 3
+OUTLIER_SIGMAS = 4.0
+OUTLIER_FLOOR_MM = 0.002
+MAX_OUTLIER_FRACTION = 0.1
+OUTLIER_ROUNDS = 3
 # Curves of one side more different in length than this cover different parts of the blade.
 MAX_LENGTH_RATIO = 1.5
 SAMPLES_U = 160
@@ -125,8 +129,9 @@ def fit_section_curve(points, n_poles=None, degree=DEGREE):
     parameters start as their normalised distance along it and are then corrected to the
     closest curve points.
     ``n_poles`` defaults to K/10 within [degree + 3, 100]: uniform knots need many spans to
-    follow a rounded edge, and ten points a span keep the noise averaged. Returns (Part.BSplineCurve,
-    rms_fit_error, max_fit_error): distances from the points to the curve, mm."""
+    follow a rounded edge, and ten points a span keep the noise averaged. Gross outliers
+    (beyond 4 robust sigmas, at most 10 % of the points) are left out and the curve refitted. Returns (Part.BSplineCurve, rms_fit_error, max_fit_error): distances from the
+    points kept to the curve, mm."""
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
         raise InputError("section points: expected finite (K, 3) coordinates, got shape %s"
@@ -154,6 +159,23 @@ def fit_section_curve(points, n_poles=None, degree=DEGREE):
     spline = BSpline(knots, _least_squares_poles(params, ordered, knots, degree), degree)
     params = _closest_params(spline, ordered, params)
     dist = np.linalg.norm(spline(params) - ordered, axis=1)
+    # Gross-error rejection (a sensor's spikes): points beyond OUTLIER_SIGMAS robust sigmas of
+    # the current curve are left out and the curve refitted, a few rounds, since a curve
+    # pulled by spikes also flags good points next to them. Skipped when so many points are
+    # flagged that the curve, not the data, is at fault.
+    keep = np.ones(len(ordered), dtype=bool)
+    for _ in range(OUTLIER_ROUNDS):
+        sigma = 1.4826 * np.median(dist[keep])
+        flagged = dist > max(OUTLIER_SIGMAS * sigma, OUTLIER_FLOOR_MM)
+        if flagged.mean() > MAX_OUTLIER_FRACTION or np.array_equal(~flagged, keep):
+            break
+        keep = ~flagged
+        for _ in range(2):
+            spline = BSpline(knots, _least_squares_poles(params[keep], ordered[keep], knots,
+                                                         degree), degree)
+            params = _closest_params(spline, ordered, params)
+        dist = np.linalg.norm(spline(params) - ordered, axis=1)
+    dist = dist[keep]
     return (_to_part_curve(knots, spline.c, degree), float(np.sqrt(np.mean(dist ** 2))),
             float(dist.max()))
 
