@@ -261,6 +261,14 @@ class VerdictTest(unittest.TestCase):
         self.assertAlmostEqual(strict["worst_spots"][0]["deviation_mm"],
                                0.2 + self.noise[100], delta=1e-6)
 
+    def test_unmeasured_section_is_reported_not_failed(self):
+        result, _, _ = self.judge(0.0)
+        table = S.section_table(result, self.nominal, heights_pct=(10, 50))
+        v = V.judge(result, table, tolerance=0.04)
+        self.assertEqual([s["pass"] for s in v["sections"]], [None, True])
+        self.assertTrue(v["pass"])
+        self.assertIn("1 not measured", v["summary"])
+
     def test_bad_tolerance(self):
         result, table, _ = self.judge(0.0)
         with self.assertRaises(InputError):

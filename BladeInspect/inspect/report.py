@@ -368,7 +368,8 @@ def _verdict_lines(verdict, table):
                 verdict["n_spots"], verdict["n_isolated_out"])]
     lines += ["Spot %d: %s" % (k + 1, s["text"]) for k, s in enumerate(verdict["worst_spots"])]
     for s in verdict["sections"]:
-        text = "Section %s: %s" % (s["label"], "pass" if s["pass"] else "FAIL")
+        text = "Section %s: %s" % (s["label"], {True: "pass", False: "FAIL",
+                                                 None: "not measured"}[s["pass"]])
         if s.get("worst_deviation_mm") is not None:
             text += ", worst %+.4f mm at the %s" % (s["worst_deviation_mm"],
                                                     verdict_mod._ZONE_TEXT[s["worst_zone"] or ""])

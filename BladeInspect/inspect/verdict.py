@@ -105,7 +105,8 @@ def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_link_mm=SPOT_LINK_MM,
         entry = {"label": sec.label, "n": int(len(idx)),
                  "max_abs_mm": float(counted_dev.max()) if len(counted) else None,
                  "n_isolated_out": int(len(idx) - len(counted)),
-                 "pass": bool(len(idx) > 0 and (counted_dev <= tolerance).all())}
+                 # None: no measured point near this plane, nothing to judge
+                 "pass": bool((counted_dev <= tolerance).all()) if len(idx) else None}
         if len(counted):
             worst = counted[np.argmax(counted_dev)]
             entry["worst_zone"] = sec.zone[np.flatnonzero(idx == worst)[0]] or None
@@ -116,19 +117,22 @@ def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_link_mm=SPOT_LINK_MM,
             entry["cmm_pass"] = bool(len(cmm_abs) > 0 and (cmm_abs <= tolerance).all())
         sections_out.append(entry)
 
-    passed = bool(not spots and all(s["pass"] for s in sections_out))
+    passed = bool(not spots and all(s["pass"] is not False for s in sections_out))
+    unmeasured = [s["label"] for s in sections_out if s["pass"] is None]
     n_out = int(len(out_idx))
     if passed:
         summary = "PASS: within +-%.3f mm" % tolerance
         if len(isolated):
             summary += " except %d isolated point(s) treated as sensor outliers" % len(isolated)
     else:
-        failing = [s["label"] for s in sections_out if not s["pass"]]
+        failing = [s["label"] for s in sections_out if s["pass"] is False]
         summary = "FAIL: %d spot(s) outside +-%.3f mm" % (len(spots), tolerance)
         if failing:
-            summary += "; sections %s out of tolerance or unmeasured" % ", ".join(failing)
+            summary += "; section(s) %s out of tolerance" % ", ".join(failing)
         if spot_out:
             summary += "; worst %s" % spot_out[0]["text"]
+    if unmeasured:
+        summary += "; section(s) %s not measured" % ", ".join(unmeasured)
     return {
         "tolerance_mm": tolerance,
         "pass": passed,

@@ -1,0 +1,212 @@
+"""A production lot: one report per point file of a folder, and DIR/summary.csv.
+
+Each file gets out_dir/<file stem>/ with the `report` command's files. A file is done when its
+folder holds result.json (written last and atomically), so a lot interrupted midway resumes
+where it stopped; a bad file is reported in the summary and skipped. Files run in parallel in
+worker processes (concurrent.futures), or on a Dask distributed cluster when a scheduler
+address is given; either way every worker loads the nominal once and keeps it.
+"""
+
+import csv
+import json
+import os
+import threading
+import time
+
+from ..core.errors import InputError
+from . import verdict as verdict_mod
+
+POINT_EXTENSIONS = (".csv", ".xyz", ".asc", ".txt", ".ply", ".pcd")
+SUMMARY_FIELDS = ["file", "status", "n_points", "rms_mm", "worst_deviation_mm", "verdict",
+                  "pose_uncertainty_mm"]
+SECTION_FIELDS = ("n", "max_abs_mm", "rms_mm", "pct_within")
+
+_NOMINALS = {}
+_NOMINALS_LOCK = threading.Lock()
+
+
+def _nominal_for(cad_path):
+    """The worker's nominal, loaded on its first file and kept for the rest."""
+    from .pipeline import load_nominal
+    with _NOMINALS_LOCK:
+        if cad_path not in _NOMINALS:
+            _NOMINALS[cad_path] = load_nominal(cad_path)
+        return _NOMINALS[cad_path]
+
+
+def point_files(scans_dir):
+    """(stem used as folder name, path) of every point file in the folder, sorted by name; a
+    stem shared by two files gets its extension appended so no report overwrites another."""
+    if not os.path.isdir(scans_dir):
+        raise InputError("%s: no such scans folder" % scans_dir)
+    names = sorted(n for n in os.listdir(scans_dir)
+                   if n.lower().endswith(POINT_EXTENSIONS)
+                   and os.path.isfile(os.path.join(scans_dir, n)))
+    if not names:
+        raise InputError("%s: no point files (%s) in the folder"
+                         % (scans_dir, ", ".join(POINT_EXTENSIONS)))
+    stems = [os.path.splitext(n)[0] for n in names]
+    out = []
+    for name, stem in zip(names, stems):
+        if stems.count(stem) > 1:
+            stem = "%s_%s" % (stem, os.path.splitext(name)[1].lstrip(".").lower())
+        out.append((stem, os.path.join(scans_dir, name)))
+    return out
+
+
+def _row_from_result_json(name, doc):
+    verdict = doc.get("verdict") or {}
+    dev = doc.get("deviation") or {}
+    worst = max((dev.get("min"), dev.get("max")), key=lambda v: abs(v or 0.0))
+    row = {"file": name, "status": "ok", "n_points": doc.get("n_points"),
+           "rms_mm": doc.get("rms_mm"), "worst_deviation_mm": worst,
+           "verdict": "pass" if verdict.get("pass") else "fail",
+           "pose_uncertainty_mm": doc.get("pose_uncertainty_mm"), "error": ""}
+    for sec in (doc.get("sections") or {}).get("sections", []):
+        for key in SECTION_FIELDS:
+            row["section_%s_%s" % (sec["label"], key)] = sec["optical"].get(key)
+    return row
+
+
+def _read_done(folder):
+    path = os.path.join(folder, "result.json")
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path) as fh:
+            return json.load(fh)
+    except (OSError, ValueError):
+        return None     # unreadable: the file is simply done again
+
+
+def report_one(cad_path, points_path, folder, tolerance, seed):
+    """One file of the lot, in whichever process runs it: a summary row, never an exception."""
+    from .report import run_report
+    name = os.path.basename(points_path)
+    try:
+        run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
+                   nominal=_nominal_for(cad_path))
+    except InputError as exc:
+        return {"file": name, "status": "error", "error": str(exc)}
+    except Exception as exc:  # a bug on one blade must not stop the line; it is reported
+        return {"file": name, "status": "error",
+                "error": "internal error: %s: %s" % (type(exc).__name__, exc)}
+    return _row_from_result_json(name, _read_done(folder))
+
+
+def write_summary(path, rows):
+    """summary.csv: the fixed columns, per-section columns (union over files), error last;
+    replaced atomically so a reader never sees half a file."""
+    section_cols = sorted({k for r in rows for k in r if k.startswith("section_")},
+                          key=_section_col_key)
+    fields = SUMMARY_FIELDS + section_cols + ["error"]
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
+        writer.writeheader()
+        for r in rows:
+            writer.writerow({k: _csv_value(r.get(k)) for k in fields})
+    os.replace(tmp, path)
+
+
+def _section_col_key(col):
+    """Order section columns by section (numerically when labels are numbers), then field."""
+    rest = col[len("section_"):]
+    field = next(f for f in SECTION_FIELDS if rest.endswith("_" + f))
+    label = rest[:-len(field) - 1]
+    try:
+        return (0, float(label), "", SECTION_FIELDS.index(field))
+    except ValueError:
+        return (1, 0.0, label, SECTION_FIELDS.index(field))
+
+
+def _csv_value(v):
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return "%.6g" % v
+    return v
+
+
+def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
+              tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None):
+    """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
+    ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
+    Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns the summary rows in file order,
+    each with 'reused' True when the file was already done."""
+    progress = progress or (lambda f, m: None)
+    tolerance = float(tolerance)
+    if not tolerance > 0:
+        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    if cad_path is not None and not os.path.exists(cad_path):
+        raise InputError("%s: no such CAD file" % cad_path)
+    files = point_files(scans_dir)
+    os.makedirs(out_dir, exist_ok=True)
+    summary_path = os.path.join(out_dir, "summary.csv")
+
+    rows = {}
+    todo = []
+    for stem, path in files:
+        doc = _read_done(os.path.join(out_dir, stem))
+        if doc is not None:
+            rows[stem] = dict(_row_from_result_json(os.path.basename(path), doc), reused=True)
+        else:
+            todo.append((stem, path))
+
+    def finished(stem, row):
+        rows[stem] = dict(row, reused=False)
+        # the summary is rewritten as files finish, so an interrupted lot still has one
+        write_summary(summary_path, [rows[s] for s, _ in files if s in rows])
+        progress(len(rows) / len(files), "%s: %s" % (row["file"], row.get("verdict") or
+                                                     row.get("error")))
+
+    t0 = time.perf_counter()
+    if todo and scheduler:
+        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished)
+    elif todo:
+        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished)
+    write_summary(summary_path, [rows[s] for s, _ in files])
+    progress(1.0, "%d files (%d already done) in %.1f s"
+             % (len(files), len(files) - len(todo), time.perf_counter() - t0))
+    return [rows[s] for s, _ in files]
+
+
+def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished):
+    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    if workers < 1:
+        raise InputError("--workers: must be at least 1, got %d" % workers)
+    if workers == 1 or len(todo) == 1:
+        for stem, path in todo:
+            finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
+                                      seed))
+        return
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
+        futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
+                               tolerance, seed): stem for stem, path in todo}
+        for fut in as_completed(futures):
+            finished(futures[fut], fut.result())
+
+
+def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished):
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise InputError("--scheduler %s: the Dask 'distributed' package is not installed "
+                         "(apt-get install python3-distributed)" % scheduler)
+    try:
+        client = Client(scheduler, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        raise InputError("--scheduler %s: cannot reach the Dask scheduler (%s)"
+                         % (scheduler, exc))
+    try:
+        stems, futures = {}, []
+        for stem, path in todo:
+            fut = client.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
+                                tolerance, seed, pure=False)
+            stems[fut.key] = stem
+            futures.append(fut)
+        for fut in as_completed(futures):
+            finished(stems[fut.key], fut.result())
+    finally:
+        client.close()
