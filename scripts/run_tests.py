@@ -12,6 +12,16 @@ class CountingResult(unittest.TextTestResult):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self.passed = 0
+        self.durations = {}
+
+    def startTest(self, test):
+        self._started = time.time()
+        super().startTest(test)
+
+    def stopTest(self, test):
+        super().stopTest(test)
+        module = test.id().rsplit(".", 2)[0]
+        self.durations[module] = self.durations.get(module, 0.0) + time.time() - self._started
 
     def addSuccess(self, test):
         super().addSuccess(test)
@@ -28,7 +38,10 @@ def main():
     start = time.time()
     result = runner.run(suite)
     failed = len(result.failures) + len(result.errors) + len(result.unexpectedSuccesses)
-    print("test time: %.1f s" % (time.time() - start))
+    print("test time: %.1f s; slowest modules (test bodies, class set-ups not counted):"
+          % (time.time() - start))
+    for module, seconds in sorted(result.durations.items(), key=lambda kv: -kv[1])[:8]:
+        print("  %6.1f s  %s" % (seconds, module))
     print("%d passed, %d failed, %d skipped" % (result.passed, failed, len(result.skipped)),
           flush=True)
     os._exit(1 if failed or result.testsRun == 0 else 0)
