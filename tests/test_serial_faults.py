@@ -73,6 +73,29 @@ class SerialFaultTest(unittest.TestCase):
         self.assertGreaterEqual(time.monotonic() - start, 1.0)
         self.assertEqual(rig.position()[0], 5.0)
 
+    def test_slow_measurement_is_not_a_timeout(self):
+        # Ray casting a large pass may outlast the timeout; the device reports Run meanwhile.
+        class SlowRig(FakeSimulatedRig):
+            def measure(self, *args):
+                time.sleep(1.0)
+                return super().measure(*args)
+        device = SimRigDevice(SlowRig(seed=2)).start()
+        self.addCleanup(device.stop)
+        rig = SerialRig(device.port_url, timeout_s=0.3)
+        self.addCleanup(rig.close)
+        path = section_path(np.random.default_rng(4), 30)
+        readings = rig.scan_path(path, 15.0)
+        expected = FakeSimulatedRig(seed=2).scan_path(path, 15.0)
+        np.testing.assert_array_equal(readings.reading_mm, expected.reading_mm)
+
+    def test_simulation_failure_is_a_sensor_error(self):
+        class BrokenRig(FakeSimulatedRig):
+            def measure(self, *args):
+                raise ValueError("no part on the table")
+        device = SimRigDevice(BrokenRig(seed=2)).start()
+        self.scan_fails(device, r"sensor error SIMULATION_FAILED \(ValueError: no part on "
+                                r"the table\)")
+
     def test_nothing_answers_at_open(self):
         # loop:// echoes the reset byte back: no controller greets.
         with self.assertRaisesRegex(DeviceError, "timeout.*greeting"):

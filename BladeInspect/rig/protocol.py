@@ -70,6 +70,7 @@ SENSOR_ERRORS = {
     "NOT_ARMED": "trigger while no acquisition was started",
     "OVERRUN": "more triggers than readings requested",
     "LASER_FAULT": "laser fault",
+    "SIMULATION_FAILED": "the simulated sensor's measurement raised an exception",
 }
 
 # Three coordinates of this length still fit GRBL's 80-character line. Only values within

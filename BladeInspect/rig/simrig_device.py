@@ -97,7 +97,10 @@ class SimRigDevice:
         self._sensor_fault_sent = False
         self._busy_until = 0.0
         self._busy_done = False
-        self._held = []         # answers of a busy line, sent when it is done
+        self._held = []         # answers held while busy or measuring, sent when it is done
+        self._measurement = None
+        self._session = 0       # counts resets: a measurement from before one is dropped
+        self._wake_read, self._wake_write = os.pipe()
         self._stop = threading.Event()
         self._thread = None
         self._closed = False
@@ -129,16 +132,20 @@ class SimRigDevice:
 
     def _serve(self):
         while not self._stop.is_set() and not self._closed:
-            if self._held and time.monotonic() >= self._busy_until:
+            if self._measurement is not None and not self._measurement["thread"].is_alive():
+                self._measured()
+            if self._held and not self._holding():
                 for pty, text in self._held:
                     pty.outbox += text
                 self._held = []
-            readers = [p.master for p in self._ptys]
+            readers = [p.master for p in self._ptys] + [self._wake_read]
             writers = [p.master for p in self._ptys if p.outbox]
             try:
                 readable, writable, _ = select.select(readers, writers, [], 0.02)
             except (OSError, ValueError):
                 return
+            if self._wake_read in readable:
+                os.read(self._wake_read, 64)
             for pty in self._ptys:
                 if self._closed:
                     return
@@ -167,15 +174,25 @@ class SimRigDevice:
         if self._closed or self._silent:
             return
         text = (line + "\r\n").encode("ascii")
-        if time.monotonic() < self._busy_until:
+        if self._holding():
             self._held.append((pty, text))
         else:
             pty.outbox += text
+
+    def _holding(self):
+        """While a busy fault or a pass's measurement lasts, the machine counts as moving:
+        answers wait and the status says Run, as a real rig is still on its path."""
+        return self._measurement is not None or time.monotonic() < self._busy_until
 
     def _close_ptys(self):
         self._closed = True
         for pty in self._ptys:
             pty.close()
+        for fd in (self._wake_read, self._wake_write):
+            try:
+                os.close(fd)
+            except OSError:
+                pass    # closed by an earlier fault
 
     # -- input -----------------------------------------------------------------------------
 
@@ -190,7 +207,7 @@ class SimRigDevice:
                 if self._state == "Alarm":
                     self._send(pty, "[MSG:'$H'|'$X' to unlock]")
             if b"?" in data:
-                state = "Run" if time.monotonic() < self._busy_until else self._state
+                state = "Run" if self._holding() else self._state
                 if not self._silent:
                     pty.outbox += ("%s\r\n" % pr.format_status(state, self._position)
                                    ).encode("ascii") * data.count(b"?")
@@ -252,6 +269,9 @@ class SimRigDevice:
         self._feed = None
         self._trigger = False
         self._rx_pending = 0
+        self._session += 1
+        self._measurement = None
+        self._held = []
         self._armed = None
         self._stage = []
         self._angle = None
@@ -408,19 +428,42 @@ class SimRigDevice:
         if len(self._stage) < self._armed:
             return
         # The simulated reading is known only for the whole pass (its noise is drawn per
-        # pass), so the readings follow the last trigger rather than each one.
-        stage = np.array(self._stage, dtype=float)
-        reading, snr = self.sim_rig.measure(stage, self._angle, self.pass_index)
+        # pass), so the readings follow the last trigger rather than each one. Ray casting a
+        # CAD can take seconds: a worker does it while the loop keeps answering status.
+        measurement = {"stage": np.array(self._stage, dtype=float), "angle": self._angle,
+                       "pass_index": self.pass_index, "session": self._session}
+
+        def measure():
+            try:
+                measurement["result"] = self.sim_rig.measure(
+                    measurement["stage"], measurement["angle"], measurement["pass_index"])
+            except Exception as exc:     # reported to the host as a sensor error
+                measurement["error"] = "%s: %s" % (type(exc).__name__, exc)
+            try:
+                os.write(self._wake_write, b"!")
+            except OSError:
+                pass    # the device was closed meanwhile
+        measurement["thread"] = threading.Thread(target=measure, daemon=True)
+        self._measurement = measurement
+        self._armed = None
+        self._stage = []
+        measurement["thread"].start()
+
+    def _measured(self):
+        measurement, self._measurement = self._measurement, None
+        if measurement["session"] != self._session:
+            return
+        if "error" in measurement:
+            return self._sensor_say("E SIMULATION_FAILED %s" % measurement["error"][:200])
         self.pass_index += 1
         self.passes += 1
+        reading, snr = measurement["result"]
         prefix = pr.SENSOR_PREFIX if self._sensor is self._motion else ""
         text = "".join("%s%s\r\n" % (prefix, pr.format_reading(i, d, s))
                        for i, (d, s) in enumerate(zip(np.asarray(reading, float),
                                                        np.asarray(snr, float))))
         self._sensor.outbox += text.encode("ascii")
-        self._sensor_say("END %d" % len(stage))
-        self._armed = None
-        self._stage = []
+        self._sensor_say("END %d" % len(measurement["stage"]))
 
 
 def simulated_rig_for(nominal, seed=0, **rig_options):
