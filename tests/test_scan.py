@@ -174,6 +174,19 @@ class TestDemoBlade(unittest.TestCase):
         self.assertLess(np.mean(np.abs(dev) > bound), 0.02)
 
 
+class TestNothingLeftBehind(unittest.TestCase):
+    def test_bad_options_and_empty_table_leave_no_files(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            _, rig = make_rig()
+            with self.assertRaises(InputError):
+                scan_to_dir(os.path.join(tmp, "a"), rig, sides=3)
+            self.assertFalse(os.path.exists(os.path.join(tmp, "a")))
+            empty = SimulatedRig(TwistedEllipse(), tf.make_transform(np.eye(3), [0, 0, 500.0]))
+            with self.assertRaises(InputError):
+                scan_to_dir(os.path.join(tmp, "b"), empty, n_sections=1, search_radius=10.0)
+            self.assertEqual(os.listdir(os.path.join(tmp, "b")), [])
+
+
 class TestOpenRig(unittest.TestCase):
     def test_sim_is_clamped_by_the_seed(self):
         part = TwistedEllipse()

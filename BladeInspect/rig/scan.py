@@ -16,7 +16,7 @@ import tempfile
 
 import numpy as np
 
-from ..core.errors import InputError
+from ..core.errors import DeviceError, InputError
 from .strategy import ScanStrategy, StrategyState
 
 POINTS_FILE = "points.csv"
@@ -65,43 +65,56 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
     record_path = os.path.join(out_dir, RECORD_FILE)
     if os.path.exists(out_dir) and not os.path.isdir(out_dir):
         raise InputError("--out %s: exists and is not a folder" % out_dir)
-    os.makedirs(out_dir, exist_ok=True)
     has_record = os.path.exists(record_path)
     if not resume and (has_record or os.path.exists(points_path)):
         raise InputError("--out %s: holds a previous scan (use --resume to continue it, or "
                          "another folder)" % out_dir)
-    if resume and has_record:
-        record = _load_record(record_path)
-        _check_same_rig(record, rig, seed, record_path)
-        options = record["options"]
-        _truncate_points(points_path, record["checkpoint"]["points_bytes"])
-        state = StrategyState.from_dict(record["checkpoint"]["strategy"])
-    else:
-        if resume and os.path.exists(points_path):
+    fresh = not (resume and has_record)
+    if fresh:
+        if os.path.exists(points_path):
             raise InputError("--out %s: has %s but no %s to resume from"
                              % (out_dir, POINTS_FILE, RECORD_FILE))
         options = dict(strategy_options, n_sections=int(n_sections))
         record = _new_record(rig, seed, options)
+        state = None
+    else:
+        record = _load_record(record_path)
+        _check_same_rig(record, rig, seed, record_path)
+        options = record["options"]
+        state = StrategyState.from_dict(record["checkpoint"]["strategy"])
+    # Options are checked before anything is written.
+    strategy = ScanStrategy(rig, state=state, **_strategy_kwargs(options))
+    if fresh:
+        os.makedirs(out_dir, exist_ok=True)
         with open(points_path, "w") as f:
             f.write(POINTS_HEADER)
         record["checkpoint"]["points_bytes"] = os.path.getsize(points_path)
-        state = None
         _write_record(record_path, record)
-    strategy = ScanStrategy(rig, state=state, **_strategy_kwargs(options))
+    else:
+        _truncate_points(points_path, record["checkpoint"]["points_bytes"])
     start_elapsed = rig.elapsed_s
     base_simulated = record["simulated_s"]
-    for section in strategy.sections(progress):
-        _append_points(points_path, section)
-        record["sections"].append(_section_record(section))
-        record["points"] += int(len(section.snr))
-        record["passes"] += section.passes
-        record["simulated_s"] = base_simulated + (rig.elapsed_s - start_elapsed)
-        record["real_time_s"] = _real_time(rig, record)
-        record["section_y"] = [float(v) for v in strategy.section_y]
-        record["complete"] = strategy.state.next_section >= len(strategy.section_y)
-        record["checkpoint"] = {"strategy": strategy.state.to_dict(),
-                                "points_bytes": os.path.getsize(points_path)}
-        _write_record(record_path, record)
+    try:
+        for section in strategy.sections(progress):
+            _append_points(points_path, section)
+            record["sections"].append(_section_record(section))
+            record["points"] += int(len(section.snr))
+            record["passes"] += section.passes
+            record["simulated_s"] = base_simulated + (rig.elapsed_s - start_elapsed)
+            record["real_time_s"] = _real_time(rig, record)
+            record["section_y"] = [float(v) for v in strategy.section_y]
+            record["complete"] = strategy.state.next_section >= len(strategy.section_y)
+            record["checkpoint"] = {"strategy": strategy.state.to_dict(),
+                                    "points_bytes": os.path.getsize(points_path)}
+            _write_record(record_path, record)
+    except InputError as exc:
+        # A device failure leaves the scan to resume; a scan that found nothing to measure
+        # leaves nothing that looks like a result.
+        if fresh and not record["sections"] and not isinstance(exc, DeviceError):
+            for path in (points_path, record_path):
+                if os.path.exists(path):
+                    os.remove(path)
+        raise
     if progress is not None:
         progress(1.0, "scan complete: %d sections, %d points"
                  % (len(record["sections"]), record["points"]))
@@ -129,10 +142,8 @@ def _json_options(options):
     for k, v in options.items():
         if k == "kinematics":
             out[k] = None if v is None else v.to_dict()
-        elif isinstance(v, np.ndarray):
-            out[k] = v.tolist()
-        elif isinstance(v, (np.floating, np.integer)):
-            out[k] = v.item()
+        elif isinstance(v, (np.ndarray, list, tuple, np.floating, np.integer)):
+            out[k] = np.asarray(v).tolist()
         else:
             out[k] = v
     return out

@@ -12,7 +12,8 @@ Per section plane Y = y_k and per view (rotary angle):
   5. when a pass meets the criterion over the whole section and neither end grows, scan the
      curve once more at the final point spacing; only readings meeting the criterion are kept.
 Views of a section: the first side at the section's base angle, the edges at +-90 deg (edge up,
-as far as the angular coverage reaches) and the other side at +180 deg. The next section's
+as far as the angular coverage reaches; a thin edge shows only its nose, looked for finely
+where the side views' ends predict it) and the other side at +180 deg. The next section's
 base angle is the one that levelled this section's first side (its chord read from the points)
 carried on by the twist rate read between the last two sections, so every section is scanned
 nearly level. The first section levels itself the same way before it counts.
