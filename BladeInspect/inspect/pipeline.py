@@ -37,21 +37,10 @@ def _no_progress(fraction, message):
 # ---------------------------------------------------------------- inputs
 
 def load_nominal(cad_path=None, sample_spacing=None):
-    """The nominal geometry: a CAD file, a blade section table (.dat, NASA Rotor 67 format), or
-    the built-in demo blade when ``cad_path`` is None."""
-    from ..cad.nominal import nominal_from_shape
-    if cad_path is None:
-        from ..cad.demo_blade import make_demo_blade
-        model = make_demo_blade()
-        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing)
-    if not os.path.exists(cad_path):
-        raise InputError("%s: no such CAD file" % cad_path)
-    if cad_path.lower().endswith(".dat"):
-        from ..cad.rotor67 import make_rotor67_blade
-        model = make_rotor67_blade(cad_path)
-        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing)
-    from ..cad.load import load_shape
-    return nominal_from_shape(load_shape(cad_path), sample_spacing=sample_spacing)
+    """The nominal geometry (see cad.load.load_nominal): a CAD file, a section table, or the
+    demo blade when ``cad_path`` is None."""
+    from ..cad.load import load_nominal as load
+    return load(cad_path, sample_spacing=sample_spacing)
 
 
 def load_points(path):
