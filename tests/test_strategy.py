@@ -8,6 +8,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
+from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
 from BladeInspect.rig.strategy import ScanStrategy, fit_section_curve
 from tests.rig_parts import Sphere, TwistedEllipse
@@ -99,6 +100,27 @@ class TestScanOfTwistedBlade(unittest.TestCase):
                 self.assertLess(incline, 3.0)
             levels = np.array(strategy.state.level_angles)
             np.testing.assert_allclose(np.abs(np.diff(levels[:, 1])), step, atol=1.0)
+
+
+class TestCalibratedKinematics(unittest.TestCase):
+    def test_points_on_the_part_only_with_the_true_axis(self):
+        """A rig whose rotary axis and stages are off the nominal ones: with the calibrated
+        geometry the points of both sides lie on the part through the rig's true table pose;
+        with the nominal geometry they miss it."""
+        true = RigKinematics(axis_point=[0.4, 0.0, -0.3], axis_direction=[0.003, 1.0, 0.0],
+                             stage_scale=[2e-4, 0, -1e-4])
+        part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
+        pose = random_fixture_pose(np.random.default_rng(31), cad_center=(0, 0, 35.0))
+        results = {}
+        for name, believed in (("calibrated", true), ("nominal", RigKinematics())):
+            rig = SimulatedRig(part, pose, seed=31, kinematics=true)
+            sections = ScanStrategy(rig, n_sections=2, edges=False, kinematics=believed).run()
+            xyz = np.vstack([sec.table_xyz for sec in sections])
+            snr = np.concatenate([sec.snr for sec in sections])
+            dev = part.signed_distance(tf.apply_transform(pose, xyz))
+            results[name] = np.abs(dev) > 0.006 * np.sqrt(100.0 / snr) + 2e-4
+        self.assertLess(results["calibrated"].mean(), 0.02)
+        self.assertGreater(results["nominal"].mean(), 0.5)
 
 
 class TestDeterminism(unittest.TestCase):
