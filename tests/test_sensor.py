@@ -41,10 +41,11 @@ class TestReadings(unittest.TestCase):
             for inc_deg, dist in ((0.0, 44.0), (40.0, 47.0), (70.0, 41.0)):
                 d = np.full(n, dist)
                 reading, snr = s.read(d, np.full(n, np.radians(inc_deg)), rng)
-                expected_snr = 100 * np.cos(np.radians(inc_deg)) * (1 - 0.5 * ((dist - 44) / 8) ** 2)
+                expected_snr = (100 * np.cos(np.radians(inc_deg))
+                                * (1 - 0.5 * ((dist - 44) / 8) ** 2))
                 np.testing.assert_allclose(snr, expected_snr, rtol=1e-12)
                 err = reading - d
-                # Independent of the model's own sigma(): the spec at SNR 100 scaled by sqrt(100/SNR).
+                # Independent of the model's sigma(): the spec at SNR 100 times sqrt(100/SNR).
                 if kind == "uniform":
                     sigma = 0.006 / np.sqrt(3) * np.sqrt(100 / expected_snr)
                     bound = 0.006 * np.sqrt(100 / expected_snr)
@@ -96,11 +97,12 @@ class TestReadings(unittest.TestCase):
         inc = np.full(n, np.radians(84.0))
         low, snr = s.read(np.full(n, 44.0), inc, rng)
         p = 0.1 * (25 - 100 * np.cos(np.radians(84))) / 22
-        gross = np.abs(low - 44.0) > 0.09   # noise there stays below 0.019
+        gross = np.abs(low - 44.0) > 0.09   # noise there stays below 0.019 mm
         frac = np.count_nonzero(gross) / n
         self.assertAlmostEqual(frac, p, delta=4 * np.sqrt(p * (1 - p) / n))
         size = np.abs(low[gross] - 44.0)
-        self.assertTrue(np.all(size > 0.1 - 0.019) and np.all(size < 0.5 + 0.006 * np.sqrt(100 / 10.4)))
+        noise = 0.006 * np.sqrt(100 / 10.4)
+        self.assertTrue(np.all(size > 0.1 - noise) and np.all(size < 0.5 + noise))
 
     def test_quantised_to_resolution(self):
         s = SensorModel()
