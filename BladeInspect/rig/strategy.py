@@ -473,6 +473,8 @@ class ScanStrategy:
             hi = curve.length + (extension[1] if open_ends[1] else 0.0)
             s = self._samples(lo, hi, self.probe_spacing)
             stage, s = self._stage_path(curve(s), y, s)
+            if len(stage) < MIN_VIEW_POINTS:
+                break       # the curve left the stages' travel
             readings = self.rig.scan_path(stage, angle)  # step 4
             d = np.asarray(readings.reading_mm, dtype=float)
             valid = np.isfinite(d)
@@ -494,12 +496,17 @@ class ScanStrategy:
                 break
         curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)
         surface_z = float(np.median(z_all))
+        if final:
+            s = self._samples(0.0, curve.length, self.point_spacing)  # step 5
+            stage, s = self._stage_path(curve(s), y, s)
+        if len(stage) < MIN_VIEW_POINTS:
+            return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes,
+                              surface_z)
         if not final:
+            # Levelling only needs the points of the last rescan, not a final pass.
             keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.epsilon)
             return ViewResult(name, angle, stage[keep], d[keep],
                               np.asarray(readings.snr, dtype=float)[keep], passes, surface_z)
-        s = self._samples(0.0, curve.length, self.point_spacing)  # step 5
-        stage, s = self._stage_path(curve(s), y, s)
         readings = self.rig.scan_path(stage, angle)
         d = np.asarray(readings.reading_mm, dtype=float)
         passes.append(self._pass_info("final", readings, d))
