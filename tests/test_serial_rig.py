@@ -5,7 +5,6 @@ import unittest
 import numpy as np
 
 from BladeInspect.core.errors import DeviceError, InputError
-from BladeInspect.rig.base import AxisLimits
 from BladeInspect.rig.serial_rig import SerialRig
 from BladeInspect.rig.simrig_device import SimRigDevice
 from tests.serial_support import FakeSimulatedRig, section_path
@@ -150,7 +149,8 @@ class SimrigCommandTest(unittest.TestCase):
         import subprocess
         import tempfile
         import Part
-        from BladeInspect.rig.simrig_device import _load_nominal, simulated_rig_for
+        from BladeInspect.cad.load import load_nominal
+        from BladeInspect.rig.simulated import simulated_rig_for
         from tests.helpers import REPO
         folder = tempfile.TemporaryDirectory()
         self.addCleanup(folder.cleanup)
@@ -164,7 +164,7 @@ class SimrigCommandTest(unittest.TestCase):
             cwd=REPO, env=env, stdout=subprocess.PIPE, text=True)
         self.addCleanup(server.wait, 10)
         self.addCleanup(server.send_signal, signal.SIGTERM)
-        reference = simulated_rig_for(_load_nominal(cad), 3)     # while the server loads
+        reference = simulated_rig_for(load_nominal(cad), 3)     # while the server loads
         first = server.stdout.readline()
         self.assertRegex(first, r"^simulated rig \(seed 3\) on /dev/pts/\d+$")
         rig = SerialRig(first.split()[-1], timeout_s=10)

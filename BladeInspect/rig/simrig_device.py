@@ -466,26 +466,15 @@ class SimRigDevice:
         self._sensor_say("END %d" % len(measurement["stage"]))
 
 
-def simulated_rig_for(nominal, seed=0, **rig_options):
-    """A SimulatedRig of the nominal clamped at a random pose drawn from the seed: the span
-    (the bounding box's longest side) along the rotary axis, its centre near the axis."""
-    from .simulated import SimulatedRig, random_fixture_pose
-    corners = np.asarray(nominal.bbox_corners, dtype=float)
-    extent = corners.max(axis=0) - corners.min(axis=0)
-    span_axis = np.eye(3)[int(np.argmax(extent))]
-    centre = 0.5 * (corners.max(axis=0) + corners.min(axis=0))
-    pose = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=span_axis,
-                               cad_center=centre)
-    return SimulatedRig(nominal, pose, seed=seed, **rig_options)
-
-
 def run_simrig(nominal=None, seed=0, two_ports=False, stream=None, **rig_options):
     """Serve a SimulatedRig of ``nominal`` (None: the demo blade) on a pseudo-terminal, print
     the port to give ``--rig serial:...`` and serve until interrupted (Ctrl-C, SIGTERM)."""
     import signal
+    from ..cad.load import load_nominal
+    from .simulated import simulated_rig_for
     stream = stream or sys.stdout
     if nominal is None:
-        nominal = _load_nominal(None)
+        nominal = load_nominal(None)
     device = SimRigDevice(simulated_rig_for(nominal, seed, **rig_options), two_ports=two_ports)
     device.start()
     stream.write("simulated rig (seed %d) on %s\n" % (seed, device.port_url))
@@ -504,15 +493,7 @@ def run_simrig(nominal=None, seed=0, two_ports=False, stream=None, **rig_options
 
 
 def simrig_main(cad_path=None, seed=0):
-    """``./bladeinspect simrig [--cad CAD] [--seed S]``."""
-    return run_simrig(_load_nominal(cad_path), seed=seed)
-
-
-def _load_nominal(cad_path):
-    from ..cad.nominal import nominal_from_shape
-    if cad_path is None:
-        from ..cad.demo_blade import make_demo_blade
-        model = make_demo_blade()
-        return nominal_from_shape(model.shape, roles=model.roles)
-    from ..cad.load import load_shape
-    return nominal_from_shape(load_shape(cad_path))
+    """``./bladeinspect simrig [--cad CAD] [--seed S]``: the CAD (None: the demo blade) on
+    the simulated rig that ``scan --rig sim --seed S`` uses, so both scan the same points."""
+    from ..cad.load import load_nominal
+    return run_simrig(load_nominal(cad_path), seed=seed)
