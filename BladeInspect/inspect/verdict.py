@@ -2,10 +2,13 @@
 named by where they lie (paper 4.2-4.3).
 
 A measured point outside +-tolerance fails the part only when it belongs to a spot: a group of
-at least ``min_spot_points`` out-of-tolerance points each within ``spot_link_mm`` of another.
-A lone point out of tolerance is far more likely a sensor outlier (a speckle, a glint at
-grazing incidence) than a defect narrower than the point spacing; such points are counted and
-listed, not silently dropped. ``min_spot_points=1`` makes every point count.
+at least ``min_spot_points`` out-of-tolerance points linked through neighbourhoods (each is one
+of the ``spot_neighbours`` nearest measured points of another). Neighbourhoods rather than a
+fixed distance, so that a dense full scan and a few sparse section lines are judged alike.
+A lone point out of tolerance, among neighbours that are all within it, is far more likely a
+sensor outlier (a speckle, a glint at grazing incidence) than a defect narrower than the point
+spacing; such points are counted and listed, not silently dropped. ``min_spot_points=1``
+makes every point count.
 """
 
 import numpy as np
@@ -17,20 +20,29 @@ from ..core.errors import InputError
 from .sections import classify
 
 DEFAULT_TOLERANCE = 0.04
-SPOT_LINK_MM = 0.5
+SPOT_NEIGHBOURS = 8
 MIN_SPOT_POINTS = 3
 
 _ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction side",
               "pressure": "pressure side", "": "unknown side"}
 
 
-def _spots(xyz, link, min_points):
-    """Connected groups of points (each within ``link`` of another): (labels (n,), sizes)."""
-    n = len(xyz)
+def _spots(points, out_idx, neighbours):
+    """Groups of the out-of-tolerance points ``out_idx`` linked when one is among the other's
+    nearest measured points: (component label per out point, component sizes)."""
+    n = len(out_idx)
     if n == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    pairs = cKDTree(xyz).query_pairs(link, output_type="ndarray")
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    k = min(int(neighbours) + 1, len(points))
+    _, nn = cKDTree(points).query(points[out_idx], k=k)
+    nn = nn.reshape(n, k)
+    position = np.full(len(points), -1)
+    position[out_idx] = np.arange(n)
+    rows = np.repeat(np.arange(n), k)
+    cols = position[nn.ravel()]
+    linked = cols >= 0
+    graph = coo_matrix((np.ones(np.count_nonzero(linked)), (rows[linked], cols[linked])),
+                       shape=(n, n))
     _, labels = connected_components(graph, directed=False)
     return labels, np.bincount(labels)
 
@@ -55,18 +67,18 @@ def place_of(table, xyz):
     return k, pct, zone
 
 
-def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_link_mm=SPOT_LINK_MM,
+def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_neighbours=SPOT_NEIGHBOURS,
           min_spot_points=MIN_SPOT_POINTS, n_worst=5):
     """The verdict as JSON-ready data: overall pass, per-section pass (optical, and CMM when
     present), the out-of-tolerance spots worst first with their place, and a one-line summary."""
     tolerance = float(tolerance)
     if not np.isfinite(tolerance) or tolerance <= 0:
         raise InputError("tolerance: must be a positive number of mm, got %r" % (tolerance,))
-    if int(min_spot_points) < 1 or not spot_link_mm > 0:
-        raise InputError("verdict: min_spot_points >= 1 and spot_link_mm > 0 needed")
+    if int(min_spot_points) < 1 or int(spot_neighbours) < 1:
+        raise InputError("verdict: min_spot_points and spot_neighbours must be at least 1")
     dev = np.asarray(result.deviation, dtype=float)
     out_idx = np.flatnonzero(np.abs(dev) > tolerance)
-    labels, sizes = _spots(result.points_cad[out_idx], spot_link_mm, int(min_spot_points))
+    labels, sizes = _spots(result.points_cad, out_idx, spot_neighbours)
     in_spot = np.zeros(len(dev), dtype=bool)
     in_spot[out_idx] = sizes[labels] >= int(min_spot_points) if len(out_idx) else False
     isolated = out_idx[~in_spot[out_idx]]
@@ -141,7 +153,7 @@ def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_link_mm=SPOT_LINK_MM,
         "pct_points_out": 100.0 * n_out / max(len(dev), 1),
         "n_spots": len(spots),
         "n_isolated_out": int(len(isolated)),
-        "spot_link_mm": float(spot_link_mm),
+        "spot_neighbours": int(spot_neighbours),
         "min_spot_points": int(min_spot_points),
         "worst_spots": spot_out,
         "sections": sections_out,
