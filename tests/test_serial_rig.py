@@ -139,6 +139,36 @@ class SerialRigSimulatedTest(unittest.TestCase):
         assert_same_readings(self, rig.scan_path(path, 5.0), reference.scan_path(path, 5.0))
 
 
+class SerialScanToDirTest(unittest.TestCase):
+    def test_scan_folder_identical_to_in_process(self):
+        # The whole blind scan (probing, levelling, rescans, final passes) over two ports.
+        import os
+        import tempfile
+        from BladeInspect.rig.scan import scan_to_dir
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        from tests.rig_parts import TwistedEllipse
+
+        def simulated_rig():
+            pose = random_fixture_pose(np.random.default_rng(6), cad_center=(0, 0, 35.0))
+            return SimulatedRig(TwistedEllipse(), pose, seed=9)
+        options = dict(n_sections=2, point_spacing=0.5, span_range=(30.0, 90.0), edges=False)
+        folder = tempfile.TemporaryDirectory()
+        self.addCleanup(folder.cleanup)
+        expected = scan_to_dir(os.path.join(folder.name, "process"), simulated_rig(), **options)
+        device = SimRigDevice(simulated_rig(), two_ports=True).start()
+        self.addCleanup(device.stop)
+        rig = SerialRig(device.port_url)
+        self.addCleanup(rig.close)
+        got = scan_to_dir(os.path.join(folder.name, "serial"), rig, **options)
+        self.assertEqual((got["points"], got["passes"]), (expected["points"], expected["passes"]))
+        self.assertGreater(got["points"], 200)
+        texts = []
+        for name in ("process", "serial"):
+            with open(os.path.join(folder.name, name, "points.csv")) as f:
+                texts.append(f.read())
+        self.assertEqual(texts[0], texts[1])
+
+
 class SimrigCommandTest(unittest.TestCase):
     """``simrig_main`` in its own process, as ``./bladeinspect simrig --cad CAD --seed S`` runs
     it: the printed port reaches a rig holding that CAD, measuring as it does in process."""
