@@ -122,6 +122,10 @@ class SerialFaultTest(unittest.TestCase):
         self.scan_fails(self.device(Fault("sensor_error", CONNECT + HOME + MID_SCAN)),
                         r"sensor error LASER_FAULT \(laser fault\)")
 
+    def test_lost_reading(self):
+        self.scan_fails(self.device(Fault("lose_reading", CONNECT + HOME)),
+                        "sensor ended the pass with 59 of 60 readings")
+
     def test_sensor_out_of_range_request(self):
         device = self.device()
         rig = SerialRig(device.port_url, timeout_s=2)

@@ -27,7 +27,7 @@ SENSOR_MODEL = "BladeInspect-SimProbe"
 MAX_READINGS = 10_000_000
 # grblHAL's receive buffer: eight times GRBL 1.1's, so eight times fewer waits per pass.
 GRBLHAL_RX_BUFFER = 1024
-FAULT_KINDS = ("close", "garbage", "silent", "alarm", "sensor_error", "busy")
+FAULT_KINDS = ("close", "garbage", "silent", "alarm", "sensor_error", "busy", "lose_reading")
 
 
 @dataclass
@@ -36,7 +36,8 @@ class Fault:
     ``after_passes`` completed passes since the device started: ``close`` closes the pty, ``garbage`` answers every
     line from then on with noise, ``silent`` stops answering, ``alarm`` raises ALARM:<alarm>
     (1 hard limit), ``sensor_error`` makes the sensor report E <sensor_code>, ``busy`` holds
-    that line's answers for ``busy_s`` seconds while reporting Run (a long move)."""
+    that line's answers for ``busy_s`` seconds while reporting Run (a long move),
+    ``lose_reading`` drops the middle reading of the next pass (a line lost on the wire)."""
     kind: str
     after_lines: int = 0
     after_passes: int = 0
@@ -97,6 +98,7 @@ class SimRigDevice:
         self._sensor_fault_sent = False
         self._busy_until = 0.0
         self._busy_done = False
+        self._lose_reading = None   # True: drop a reading of the next pass; False: done
         self._held = []         # answers held while busy or measuring, sent when it is done
         self._measurement = None
         self._session = 0       # counts resets: a measurement from before one is dropped
@@ -237,6 +239,8 @@ class SimRigDevice:
             if fault.kind == "silent":
                 self._silent = True
                 return
+            if fault.kind == "lose_reading" and self._lose_reading is None:
+                self._lose_reading = True
             if fault.kind == "busy" and not self._busy_done:
                 self._busy_done = True
                 self._busy_until = time.monotonic() + fault.busy_s
@@ -459,9 +463,13 @@ class SimRigDevice:
         self.passes += 1
         reading, snr = measurement["result"]
         prefix = pr.SENSOR_PREFIX if self._sensor is self._motion else ""
-        text = "".join("%s%s\r\n" % (prefix, pr.format_reading(i, d, s))
-                       for i, (d, s) in enumerate(zip(np.asarray(reading, float),
-                                                       np.asarray(snr, float))))
+        lines = ["%s%s\r\n" % (prefix, pr.format_reading(i, d, s))
+                 for i, (d, s) in enumerate(zip(np.asarray(reading, float),
+                                                np.asarray(snr, float)))]
+        if self._lose_reading:
+            self._lose_reading = False
+            del lines[len(lines) // 2]
+        text = "".join(lines)
         self._sensor.outbox += text.encode("ascii")
         self._sensor_say("END %d" % len(measurement["stage"]))
 
