@@ -265,7 +265,9 @@ def run():
         Gui.runCommand("BladeInspect_Scan")
         settle(0.3)
         panel = _active_panel()
-        panel.sections.setValue(3)
+        # Two sections at a coarse point spacing keep the simulated scan to tens of seconds.
+        panel.sections.setValue(2)
+        panel.point_spacing.setValue(0.5)
         window_shot("task_panel_scan")
         panel.accept()
         scans = objects.find_objects(doc, "BladeInspect::Measurement")
@@ -278,6 +280,14 @@ def run():
         reg = commands.BY_NAME["BladeInspect_Register"].register(meas, blade)
         check("registration made", reg is not None, progress.MESSAGES[-1:])
         check("registration rms small", reg.RmsMm < 0.02, reg.RmsMm)
+        from BladeInspect.core import transforms as tf
+        scan_json = os.path.join(os.path.dirname(meas.SourceFile), "scan.json")
+        with open(scan_json) as fh:
+            truth = np.array(json.load(fh)["table_to_cad"])
+        error = tf.corner_displacement(objects.matrix_array(reg.MeasuredToCad), truth,
+                                       objects.nominal_of(blade).bbox_corners)
+        check("scan registered onto the rig's true fixture pose", error < 0.02,
+              "pose error %.4f mm, stated 1 sigma %.4f mm" % (error, reg.PoseUncertaintyMm))
         check("registration uncertainty stated", 0 < reg.PoseUncertaintyMm < 0.05,
               reg.PoseUncertaintyMm)
         commands.Register.show(reg)
@@ -359,10 +369,20 @@ def run():
         check("tolerance saved", abs(group.GetFloat("ToleranceMm") - 0.05) < 1e-12)
         check("sides saved", group.GetInt("Sides") == 1)
         check("colour limit falls back to tolerance", abs(settings.colour_limit() - 0.05) < 1e-12)
-        page.form.show()
-        page.form.resize(520, 420)
-        settle(0.3)
-        page.form.grab().save(os.path.join(OUT, "preferences.png"))
+        seen = {}
+
+        def look_and_close():
+            dialog = QtGui.QApplication.activeModalWidget()
+            if dialog is None:
+                return
+            seen["title"] = dialog.windowTitle()
+            seen["ours"] = bool(dialog.findChildren(QtGui.QDoubleSpinBox, "ToleranceMm"))
+            dialog.grab().save(os.path.join(OUT, "preferences.png"))
+            dialog.reject()
+        QtCore.QTimer.singleShot(1500, look_and_close)
+        Gui.runCommand("BladeInspect_Preferences")   # modal: returns when the timer closes it
+        settle(0.2)
+        check("preferences dialog shows the BladeInspect page", seen.get("ours"), seen)
 
     check("no tracebacks reached the user", not any(
         "Traceback" in text for _, text in progress.MESSAGES), progress.MESSAGES)

@@ -436,4 +436,6 @@ for _command in COMMANDS:
 
 def register_preferences():
     from .preferences import PreferencesPage
+    # The preferences dialog shows a group's icon by the name "preferences-<group>".
+    FreeCADGui.addIconPath(resources.ICON_DIR)
     FreeCADGui.addPreferencePage(PreferencesPage, "BladeInspect")
