@@ -3,7 +3,7 @@
 # Quiet and fast when everything is there already; uses sudo when not root.
 set -euo pipefail
 PACKAGES=(freecad python3-numpy python3-scipy python3-serial python3-matplotlib xvfb xauth
-          poppler-utils)
+          poppler-utils python3-distributed)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

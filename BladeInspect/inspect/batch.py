@@ -132,8 +132,9 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
               tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
-    Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns the summary rows in file order,
-    each with 'reused' True when the file was already done."""
+    Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
+    file order, each with 'reused' True when the file was already done, 'summary_csv': path,
+    'message': one line for the command line}."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
@@ -165,10 +166,16 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
         _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished)
     elif todo:
         _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished)
-    write_summary(summary_path, [rows[s] for s, _ in files])
-    progress(1.0, "%d files (%d already done) in %.1f s"
-             % (len(files), len(files) - len(todo), time.perf_counter() - t0))
-    return [rows[s] for s, _ in files]
+    ordered = [rows[s] for s, _ in files]
+    write_summary(summary_path, ordered)
+    count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)
+             for k in ("pass", "fail")}
+    message = ("%d files: %d pass, %d fail, %d error (%d already done, %.1f s); %s"
+               % (len(files), count["pass"], count["fail"],
+                  sum(1 for r in ordered if r["status"] == "error"),
+                  len(files) - len(todo), time.perf_counter() - t0, summary_path))
+    progress(1.0, message)
+    return {"rows": ordered, "summary_csv": summary_path, "message": message}
 
 
 def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished):

@@ -181,11 +181,11 @@ def figure_histogram(result, band_edges):
                 " +-%s: %.2f %%" % (name, pct), fontsize=9, va="top")
     for e in band_edges:
         ax.axvline(e, color="0.6", linewidth=0.8)
-    ax.set_xlabel("signed deviation (mm), + outside material")
+    ax.set_xlabel("signed deviation (mm), + outside material; the end bins hold all beyond")
     ax.set_ylabel("points")
-    ax.set_title("Deviation histogram: mean %+.4f mm, sigma %.4f mm, RMS %.4f mm "
-                 "(grey: Table 3 band edges; values beyond the axis are in the end bins)"
-                 % (mean, sigma, stats["rms"]), fontsize=10)
+    ax.set_title("Deviations: mean %+.4f mm, sigma %.4f mm, RMS %.4f mm; dashed +-sigma, "
+                 "dotted +-3 sigma, grey the Table 3 bands" % (mean, sigma, stats["rms"]),
+                 fontsize=10)
     return fig
 
 
@@ -215,11 +215,23 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
     if magnification is None:
         # the tolerance is drawn as 2 % of the chord: whiskers readable, profile recognisable
         magnification = _nice_magnification(0.02 * chord / tolerance)
-    fig, ax = plt.subplots(figsize=(11, 5.0))
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.1, top=0.92)
+    outline = [sec.plane_coords(poly) for poly in (sec.profile.polylines
+                                                     if sec.profile is not None else [])]
+    if sec.cmm_xyz is not None and len(sec.cmm_xyz):
+        outline.append(sec.plane_coords(sec.cmm_xyz))
+    if len(sec.point_index):
+        outline.append(sec.plane_coords(result.points_cad[sec.point_index]))
+    both = np.vstack(outline) if outline else np.zeros((1, 2))
+    margin = 2.0 * tolerance * magnification + 1.0
+    width_mm = np.ptp(both[:, 0]) + 2 * margin
+    height_mm = np.ptp(both[:, 1]) + 2 * margin
+    # the figure takes the profile's own proportions, so equal axes leave no empty band
+    fig_w = 11.0
+    fig_h = float(np.clip(fig_w * 0.9 * height_mm / max(width_mm, 1e-6) + 1.1, 2.8, 9.0))
+    fig, ax = plt.subplots(figsize=(fig_w, fig_h))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.7 / fig_h, top=1 - 0.45 / fig_h)
     if sec.profile is not None:
-        for poly in sec.profile.polylines:
-            p2 = sec.plane_coords(poly)
+        for p2 in outline[:len(sec.profile.polylines)]:
             ax.plot(p2[:, 0], p2[:, 1], color="0.15", linewidth=1.0)
             for sign in (-1, 1):
                 band = _offset(p2, sign * tolerance * magnification)
@@ -250,16 +262,17 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
                     ha="right", va="center", fontweight="bold")
         ax.annotate("TE", (sec.profile.chord, 0.0), xytext=(12, 0), textcoords="offset points",
                     ha="left", va="center", fontweight="bold")
-    ax.set_aspect("equal")
-    ax.autoscale_view()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlim(both[:, 0].min() - margin, both[:, 0].max() + margin)
+    ax.set_ylim(both[:, 1].min() - margin, both[:, 1].max() + margin)
     ax.set_xlabel("along the chord from the leading edge (mm)")
     ax.set_ylabel("across (mm)")
     o = sec.optical
     figures = ("n %d, max |dev| %.4f mm, RMS %.4f mm" % (o["n"], o["max_abs_mm"], o["rms_mm"])
                if o["n"] else "no measured points")
-    ax.set_title("Section %s at %.0f %% span: %s; deviations x%g, dashed: +-%.3f mm"
-                 % (sec.label, sec.height_pct, figures, magnification, tolerance), fontsize=10)
-    _add_legend(fig, ax, tolerance)
+    ax.set_title("Section %s at %.0f %% span: %s; deviations x%g in the deviation map's "
+                 "colours, dashed: +-%.3f mm" % (sec.label, sec.height_pct, figures,
+                                                 magnification, tolerance), fontsize=10)
     return fig
 
 
