@@ -63,6 +63,11 @@ class SerialRigFakeTest(unittest.TestCase):
         rig.move_to(x=1.0)
         self.assertEqual(rig.position(), (1.0, 150.0, 100.0, 0.0))
 
+    def test_controller_without_homing(self):
+        device, rig = self.open(homing=False)
+        rig.move_to(x=2.5)         # $H answered error:5: unlocked where it stands, then moved
+        self.assertEqual(rig.position(), (2.5, 150.0, 100.0, 0.0))
+
     def test_host_checks_limits_before_sending(self):
         device, rig = self.open()
         rig.home()

@@ -127,6 +127,7 @@ class SerialRig(Rig):
         self._timing_depth = 0
         self._failure = None
         self._homed = False
+        self._homing_disabled = False
         self._target = None
         self._status = None
         self._banner = None
@@ -153,8 +154,12 @@ class SerialRig(Rig):
     # -- Rig interface --------------------------------------------------------------------
 
     def home(self):
+        """Homes the machine ($H); a controller without homing switches (error:5) is only
+        unlocked ($X), its position taken as it stands."""
         with self._timed():
             self._stream(["$H"], timeout_s=max(self.timeout_s, HOME_TIMEOUT_S))
+            if self._homing_disabled:
+                self._stream(["$X"])
             self._stream(["G90G21"])
             self._homed = True
             self._target = self._query_status().position
@@ -367,6 +372,9 @@ class SerialRig(Rig):
             self._answered("motion", line)
         elif kind == pr.ERROR:
             sent = self._answered("motion", line)
+            if sent == "$H" and payload == 5:
+                self._homing_disabled = True
+                return True
             what = "soft limit: " if payload == 15 else ""
             raise DeviceError("serial:%s: %scontroller answered %s to %s"
                               % (self.port_url, what, pr.describe_error(payload), sent))

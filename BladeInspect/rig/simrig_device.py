@@ -75,14 +75,16 @@ class SimRigDevice:
     two (motion, sensor) with ``two_ports``. ``limits`` overrides the controller's soft limits
     (a controller set up tighter than the host believes). ``rx_buffer`` is the receive buffer
     it reports in ``$I`` and holds the host to: 128 bytes as GRBL 1.1, 1024 as grblHAL (the
-    default: a rig fed at the sensor's 9000 points/s needs a controller of that class)."""
+    default: a rig fed at the sensor's 9000 points/s needs a controller of that class).
+    ``homing=False``: a controller without homing switches ($H answers error:5)."""
 
     def __init__(self, sim_rig, two_ports=False, fault=None, limits=None,
-                 rx_buffer=GRBLHAL_RX_BUFFER):
+                 rx_buffer=GRBLHAL_RX_BUFFER, homing=True):
         self.sim_rig = sim_rig
         self.fault = fault
         self.limits = limits if limits is not None else getattr(sim_rig, "limits", None)
         self.rx_buffer = int(rx_buffer)
+        self.homing = bool(homing)
         self.lines_received = 0
         self.overflows = 0          # bytes beyond the controller's RX buffer: a host bug
         self.passes = 0
@@ -90,7 +92,8 @@ class SimRigDevice:
         self._motion = _Pty()
         self._sensor = _Pty() if two_ports else self._motion
         self._ptys = [self._motion] if self._sensor is self._motion else [self._motion, self._sensor]
-        self._homed = False
+        # Without homing switches GRBL starts unlocked ($22=0).
+        self._homed = not self.homing
         self._alarm_latched = False
         self._position = (tuple(float(v) for v in sim_rig.position())
                           if hasattr(sim_rig, "position") else (0.0, 0.0, 0.0, 0.0))
@@ -366,6 +369,8 @@ class SimRigDevice:
 
     def _system_command(self, line):
         if line == "$H":
+            if not self.homing:
+                return self._reply("error:5")
             if hasattr(self.sim_rig, "home"):
                 self.sim_rig.home()
             if hasattr(self.sim_rig, "position"):
