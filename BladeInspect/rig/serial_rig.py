@@ -2,8 +2,8 @@
 protocol (docs/protocol.md), on one shared port or two (``MOTION,SENSOR``).
 
 Motion is streamed with GRBL's character counting: lines go out as long as the bytes not yet
-answered fit the controller's 128-byte receive buffer, so a pass of K points costs one sensor
-round trip plus a stream, not K exchanges. Every failure ends in one DeviceError naming the
+answered fit the controller's receive buffer (128 bytes on GRBL 1.1, as ``$I`` reports), so a
+pass of K points costs one sensor round trip plus a stream, not K exchanges. Every failure ends in one DeviceError naming the
 port and what went wrong; the driver never retries, since the strategy above it decides.
 """
 
@@ -81,18 +81,6 @@ class _Port:
                 out.append(text)
         return out
 
-    def wait_readable(self, ports, timeout):
-        """Block until one of the ports may have data or the timeout passes."""
-        fds = [p._fileno for p in ports]
-        if all(fd is not None for fd in fds):
-            try:
-                select.select(fds, [], [], timeout)
-            except (OSError, ValueError) as exc:
-                raise self.lost(exc)
-        else:
-            # Ports without a file descriptor (loop://, sockets): poll briefly.
-            time.sleep(min(timeout, 0.002))
-
     def close(self):
         try:
             self.serial.close()
@@ -100,11 +88,29 @@ class _Port:
             pass    # the port may be gone already; closing must not mask the original error
 
 
+def _wait_readable(ports, timeout):
+    """Block until one of the ports may have data or the timeout passes."""
+    fds = [p._fileno for p in ports]
+    if all(fd is not None for fd in fds):
+        try:
+            select.select(fds, [], [], timeout)
+        except (OSError, ValueError) as exc:
+            raise ports[0].lost(exc)
+    else:
+        # Ports without a file descriptor (loop://, sockets): poll briefly.
+        time.sleep(min(timeout, 0.002))
+
+
 class SerialRig(Rig):
     """A four-axis rig with its conoscopic sensor over pyserial. ``port_url`` is one port
-    (pty path, /dev/ttyUSB0, loop://, ...) carrying both protocols, or ``MOTION,SENSOR``."""
+    (pty path, /dev/ttyUSB0, loop://, ...) carrying both protocols, or ``MOTION,SENSOR``.
+    ``timeout_s``: longest silence while an answer is awaited (homing gets HOME_TIMEOUT_S).
+    ``feed_mm_min``: feed along a scan path (the simulated rig's 20 mm/s by default).
+    ``rx_buffer``: the controller's receive buffer, when ``$I`` does not tell it.
+    ``limits``/``sensor``: the travel checked before sending and the sensor model the
+    strategy plans with (default: the sensor's own ID fields on SensorModel defaults)."""
 
-    def __init__(self, port_url, timeout_s=5, baud=115200, feed_mm_min=600.0,
+    def __init__(self, port_url, timeout_s=5, baud=115200, feed_mm_min=1200.0,
                  rx_buffer=None, limits=None, sensor=None):
         if timeout_s is None or not timeout_s > 0:
             raise InputError("timeout_s: must be a positive number of seconds, got %r" % timeout_s)
@@ -352,7 +358,7 @@ class SerialRig(Rig):
                 self._polls += 1
                 next_poll = now + poll
             wake = deadline if self._connecting else min(deadline, next_poll)
-            self._motion.wait_readable(self._ports, max(0.0, wake - now))
+            _wait_readable(self._ports, max(0.0, wake - now))
 
     def _handle(self, port, line):
         """Act on one line; False only for a poll's answer that shows no motion."""
