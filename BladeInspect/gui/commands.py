@@ -314,9 +314,15 @@ class DeviationMap(_Command):
         obj = progress.run("Deviation map",
                            lambda p: objects.make_deviation_map(doc, registration, limit))
         if obj is not None:
+            # The map shows the points on the CAD; the measurement and its reconstruction lie
+            # in the measured frame elsewhere and would only pull the view away.
             measurement = registration.Measurement
-            if measurement is not None and measurement.ViewObject is not None:
-                measurement.ViewObject.Visibility = False
+            for other in doc.Objects:
+                in_measured_frame = other == measurement or (
+                    objects.proxy_type(other) == objects.Reconstruction.Type
+                    and other.Measurement == measurement)
+                if measurement is not None and in_measured_frame and other.ViewObject:
+                    other.ViewObject.Visibility = False
             _recompute_gui(doc)
         return obj
 

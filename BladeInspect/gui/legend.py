@@ -3,9 +3,11 @@ space (its own orthographic camera), left out of the scene's bounding box so "fi
 the blade, not the legend. It draws the values and colours the DeviationMap object computed."""
 from pivy import coin
 
-# Legend geometry in the camera's normalised units: the view spans y in [-1, 1].
-BAR_X = (-0.97, -0.90)
+# Legend geometry in normalised view coordinates: the view spans [-1, 1] in x and in y
+# whatever its aspect, so the legend keeps to the left edge in any window.
+BAR_X = (-0.975, -0.945)
 BAR_Y = (-0.75, 0.75)
+LABEL_WIDTH = 0.25
 
 
 def _skip_bounding_group():
@@ -24,6 +26,8 @@ def legend_node(values, colours, title="Deviation [mm]", font_size=14):
     hud = coin.SoAnnotation()
     group.addChild(hud)
     camera = coin.SoOrthographicCamera()
+    camera.viewportMapping = coin.SoCamera.LEAVE_ALONE
+    camera.aspectRatio = 1.0
     camera.height = 2.0
     camera.position = (0.0, 0.0, 5.0)
     camera.nearDistance = 1.0
@@ -49,7 +53,7 @@ def legend_node(values, colours, title="Deviation [mm]", font_size=14):
     n = len(values)
     x0, x1 = BAR_X
     ys = [BAR_Y[0] + (BAR_Y[1] - BAR_Y[0]) * i / (n - 1) for i in range(n)]
-    hud.addChild(_backing((x0 - 0.03, BAR_Y[0] - 0.06), (x1 + 0.30, BAR_Y[1] + 0.12)))
+    hud.addChild(_backing((x0 - 0.015, BAR_Y[0] - 0.06), (x1 + LABEL_WIDTH, BAR_Y[1] + 0.12)))
     material = coin.SoMaterial()
     material.diffuseColor.setValues(0, 2 * n, [tuple(c) for c in colours for _ in (0, 1)])
     hud.addChild(material)
@@ -79,7 +83,7 @@ def legend_node(values, colours, title="Deviation [mm]", font_size=14):
     digits = 3 if max(abs(v) for v in values) < 1.0 else 2
     for value, y in zip(values, ys):
         label = "%+.*f" % (digits, value) if abs(value) > 1e-12 else "%.*f" % (digits, 0.0)
-        hud.addChild(_text((x1 + 0.02, y - 0.015, 0.0), label))
+        hud.addChild(_text((x1 + 0.01, y - 0.015, 0.0), label))
     hud.addChild(_text((x0, BAR_Y[1] + 0.06, 0.0), title))
     return group
 
