@@ -190,6 +190,8 @@ class SimRigDevice:
         return self._measurement is not None or time.monotonic() < self._busy_until
 
     def _close_ptys(self):
+        if self._closed:
+            return      # closing a descriptor twice could close one reused meanwhile
         self._closed = True
         for pty in self._ptys:
             pty.close()
