@@ -365,6 +365,41 @@ class TestDemoBlade(DocumentCase):
         self.assertEqual(objects._roles_from_map(obj.FaceRoles), roles)
 
 
+class TestSettings(unittest.TestCase):
+    """The preferences reach the code through FreeCAD's parameters; values are restored after."""
+
+    def setUp(self):
+        from BladeInspect.app import settings
+        self.settings = settings
+        self.group = FreeCAD.ParamGet(settings.PARAM_PATH)
+        self.saved = {name: settings.value(name) for name in settings.SETTINGS}
+
+    def tearDown(self):
+        for name, value in self.saved.items():
+            self.settings.store(name, value)
+
+    def test_values_round_trip_through_freecads_parameters(self):
+        s = self.settings
+        s.store("StandoffMm", 50.5)
+        s.store("Sections", 7)
+        self.assertEqual(self.group.GetFloat("StandoffMm"), 50.5)
+        self.assertEqual(self.group.GetInt("Sections"), 7)
+        self.assertEqual(s.value("Sections"), 7)
+        s.store("WorkingRangeMm", 6.0)
+        s.store("SensorAccuracyMm", 0.004)
+        sensor = s.sensor_model()
+        self.assertEqual((sensor.standoff, sensor.half_range, sensor.accuracy),
+                         (50.5, 6.0, 0.004))
+
+    def test_colour_limit_falls_back_to_the_tolerance(self):
+        s = self.settings
+        s.store("ToleranceMm", 0.03)
+        s.store("ColourLimitMm", 0.0)
+        self.assertEqual(s.colour_limit(), 0.03)
+        s.store("ColourLimitMm", 0.1)
+        self.assertEqual(s.colour_limit(), 0.1)
+
+
 class TestPackaging(unittest.TestCase):
     def test_package_xml_declares_the_workbench(self):
         ns = {"p": "https://wiki.freecad.org/Package_Metadata"}

@@ -47,3 +47,10 @@ def colour_limit():
     """The deviation at which the colour map saturates: its own setting, else the tolerance."""
     limit = value("ColourLimitMm")
     return limit if limit > 0 else value("ToleranceMm")
+
+
+def sensor_model():
+    """The rig's sensor as the preferences describe it (rig.sensor.SensorModel)."""
+    from ..rig.sensor import SensorModel
+    return SensorModel(standoff=value("StandoffMm"), half_range=value("WorkingRangeMm"),
+                       accuracy=value("SensorAccuracyMm"), rate_hz=value("PointsPerSecond"))

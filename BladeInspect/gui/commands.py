@@ -157,7 +157,7 @@ class ConnectRig(_Command):
                 raise InputError("simulated rig: load a CAD or build the demo blade first")
             nominal = objects.nominal_of(nominal_obj) if nominal_obj is not None else None
             p(0.5, "opening %s" % spec)
-            RIG.connect(open_rig(spec, nominal, seed), spec)
+            RIG.connect(open_rig(spec, nominal, seed, sensor=settings.sensor_model()), spec)
             return RIG.rig
         rig = progress.run("Connect rig", job)
         if rig is not None:
