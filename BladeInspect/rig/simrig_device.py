@@ -109,6 +109,7 @@ class SimRigDevice:
         self._stop = threading.Event()
         self._thread = None
         self._closed = False
+        self._reset_sensor()
         self._reset()
 
     @property
@@ -278,15 +279,21 @@ class SimRigDevice:
         self._feed = None
         self._trigger = False
         self._rx_pending = 0
+        self._motion.inbox = b""
+        self._motion.outbox.clear()
+        self._held = [(pty, text) for pty, text in self._held if pty is not self._motion]
+        if self._sensor is self._motion:
+            # On the shared line the reset reaches the sensor too; a sensor on its own port
+            # keeps its acquisition (the host stops it when it connects).
+            self._reset_sensor()
+
+    def _reset_sensor(self):
         self._session += 1
         self._measurement = None
         self._held = []
         self._armed = None
         self._stage = []
         self._angle = None
-        for pty in self._ptys:
-            pty.inbox = b""
-            pty.outbox.clear()
 
     def _reply(self, text):
         self._send(self._motion, text)
