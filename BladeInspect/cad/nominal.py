@@ -1,0 +1,478 @@
+"""The nominal CAD as arrays: every face as an exact (rational) B-spline, dense samples, and the
+exact signed point-to-CAD distance with an OpenCASCADE fallback for the cases the fast path
+cannot decide.
+
+Faces are converted with ``Face.toNurbs()`` (BRepBuilderAPI_NurbsConvert): planes, cylinders,
+spheres, surfaces of revolution and offsets become exact rational B-splines, and the face's
+trimming curves are carried into the new parameterisation. ``Surface.toBSpline()`` is not
+used: for analytic surfaces it is an approximation (degree 14 for a cylinder, ~1e-10 off).
+
+Fast path of ``signed_distance``: a k-d tree over the samples gives, for each point, the nearby
+faces and a start (u, v) on each; Newton on every candidate face (vectorised per face), the
+smallest distance wins. A candidate is only trusted when Newton converged to a point inside
+the face's trimmed domain, away from its boundary; a point whose winner lies on a face edge
+(clamped at the parameter box) or that a doubtful candidate might beat goes to OCC
+(``Shape.distToShape``), point by point. The fraction that did is reported.
+"""
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+import FreeCAD
+import Part
+
+from ..core import bspline
+from ..core.bspline import SurfaceData
+from ..core.errors import InputError
+from ..core.trim import TrimDomain
+
+# Number of nearest samples whose faces become Newton candidates for a point.
+K_CANDIDATES = 8
+# Samples per face and per direction at least, whatever the spacing.
+MIN_SAMPLES_PER_SIDE = 12
+# Total samples aimed at when no spacing is given.
+DEFAULT_SAMPLE_COUNT = 60000
+# Points per trimming edge when discretising its pcurve.
+PCURVE_SAMPLES = 400
+# Relative cosine above which the gradient at a bound means "the minimum lies outside".
+CLAMP_COSINE = 1e-7
+# Newton results farther than this from the nearest sample's distance are distrusted (mm).
+SAMPLE_SLACK = 1e-9
+# Points per chunk in signed_distance (bounds the (chunk, K) candidate arrays).
+POINT_CHUNK = 65536
+
+
+@dataclass
+class Samples:
+    xyz: np.ndarray        # (M, 3) points on the faces, inside their trimmed domains
+    normal: np.ndarray     # (M, 3) outward unit normals
+    face: np.ndarray       # (M,) face index
+    uv: np.ndarray         # (M, 2) parameters on that face's SurfaceData
+    weight: np.ndarray     # (M,) area each sample stands for (mm^2)
+
+
+@dataclass
+class DistanceResult:
+    closest: np.ndarray    # (N, 3) closest points on the CAD
+    face: np.ndarray       # (N,) index into Nominal.faces
+    uv: np.ndarray         # (N, 2) parameters of the closest point on that face's SurfaceData
+    normal: np.ndarray     # (N, 3) outward unit normal there (at an edge: the direction p - c, signed)
+    distance: np.ndarray   # (N,) signed distance, + outside material / on the normal's side
+    fallback: Optional[np.ndarray] = None   # (N,) True where OCC decided
+
+    @property
+    def fallback_fraction(self):
+        if self.fallback is None or len(self.fallback) == 0:
+            return 0.0
+        return float(np.count_nonzero(self.fallback)) / len(self.fallback)
+
+
+@dataclass
+class FaceDomain:
+    """A face's trimmed domain in its SurfaceData's (u, v)."""
+    index: Optional[TrimDomain]      # the discretised boundary, or None for the whole box
+    margin: float                    # uv distance to the boundary below which we do not decide
+    planar_scale: Optional[float]    # length per parameter unit when the face is a plane
+
+
+def _flat_knots(knots, mults):
+    return np.repeat(np.asarray(knots, float), np.asarray(mults, int))
+
+
+def surface_data_from_bspline(bs, u_range, v_range, closed_u=False, closed_v=False):
+    """SurfaceData of a Part.BSplineSurface (a periodic one is made non-periodic on a copy)."""
+    bs = bs.copy()
+    if bs.isUPeriodic():
+        bs.setUNotPeriodic()
+    if bs.isVPeriodic():
+        bs.setVNotPeriodic()
+    poles = np.array([[[p.x, p.y, p.z] for p in row] for row in bs.getPoles()], dtype=float)
+    weights = np.array(bs.getWeights(), dtype=float)
+    return SurfaceData(
+        degree_u=bs.UDegree, degree_v=bs.VDegree,
+        knots_u=_flat_knots(bs.getUKnots(), bs.getUMultiplicities()),
+        knots_v=_flat_knots(bs.getVKnots(), bs.getVMultiplicities()),
+        poles=poles, weights=weights, u_range=np.array(u_range[:2], float),
+        v_range=np.array(v_range[:2], float), closed_u=closed_u, closed_v=closed_v)
+
+
+def _nurbs_face(face):
+    """The face with an exact B-spline surface and its pcurves in that surface's parameters."""
+    if isinstance(face.Surface, Part.BSplineSurface):
+        return face
+    converted = face.toNurbs().Faces
+    if len(converted) != 1 or not isinstance(converted[0].Surface, Part.BSplineSurface):
+        raise InputError("CAD face of type %s could not be converted to a B-spline"
+                         % type(face.Surface).__name__)
+    return converted[0]
+
+
+def _surface_of_face(nface):
+    u0, u1, v0, v1 = nface.ParameterRange
+    bs = nface.Surface
+    closed = []
+    for periodic, period, lo, hi in ((bs.isUPeriodic(), bs.UPeriod, u0, u1),
+                                     (bs.isVPeriodic(), bs.VPeriod, v0, v1)):
+        closed.append(bool(periodic and abs((hi - lo) - period()) <= 1e-9 * max(1.0, period())))
+    surf = surface_data_from_bspline(bs, (u0, u1), (v0, v1), closed_u=closed[0], closed_v=closed[1])
+    # Wrapping is only safe when the box is exactly the knot range of the non-periodic copy.
+    p, q = surf.degree_u, surf.degree_v
+    if surf.closed_u and (abs(surf.knots_u[p] - u0) > 1e-9 or abs(surf.knots_u[-p - 1] - u1) > 1e-9):
+        surf.closed_u = False
+    if surf.closed_v and (abs(surf.knots_v[q] - v0) > 1e-9 or abs(surf.knots_v[-q - 1] - v1) > 1e-9):
+        surf.closed_v = False
+    return surf
+
+
+def _face_domain(nface, surf, planar):
+    (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    su, sv = u1 - u0, v1 - v0
+    tol_u, tol_v = 1e-9 * max(1.0, su), 1e-9 * max(1.0, sv)
+    polylines = []
+    max_chord = 0.0
+    on_box = True
+    for wire in nface.Wires:
+        for edge in wire.Edges:
+            pc = nface.curveOnSurface(edge)
+            if pc is None:
+                raise InputError("CAD face has an edge without a curve on its surface")
+            curve, a, b = pc
+            t = np.linspace(a, b, PCURVE_SAMPLES + 1)
+            pts = np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
+            mids = np.array([[q.x, q.y] for q in (curve.value(x) for x in 0.5 * (t[1:] + t[:-1]))])
+            chord = np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1)
+            max_chord = max(max_chord, float(chord.max()))
+            on_u = (np.all(np.abs(pts[:, 0] - u0) <= tol_u) or np.all(np.abs(pts[:, 0] - u1) <= tol_u))
+            on_v = (np.all(np.abs(pts[:, 1] - v0) <= tol_v) or np.all(np.abs(pts[:, 1] - v1) <= tol_v))
+            if not (on_u or on_v):
+                on_box = False
+            polylines.append(pts)
+            # A seam edge is listed once but bounds the domain on both sides of the period.
+            if surf.closed_u and on_u:
+                polylines.append(pts + [su if np.abs(pts[0, 0] - u0) <= tol_u else -su, 0.0])
+            if surf.closed_v and on_v:
+                polylines.append(pts + [0.0, sv if np.abs(pts[0, 1] - v0) <= tol_v else -sv])
+    # A Part.Plane's (u, v) are lengths along orthonormal axes, and NurbsConvert keeps them.
+    planar_scale = 1.0 if planar else None
+    if on_box:
+        return FaceDomain(None, 0.0, planar_scale)
+    segments = np.concatenate([np.stack([p[:-1], p[1:]], axis=1) for p in polylines])
+    margin = 4.0 * max_chord + 1e-9 * max(su, sv)
+    return FaceDomain(TrimDomain(segments), margin, planar_scale)
+
+
+def point_in_domain(domain, uv):
+    """(inside (N,) bool, boundary distance (N,) in uv, exact below domain.index.reach and
+    capped there) of parameter pairs against a face's domain."""
+    n = len(uv)
+    if domain.index is None:
+        return np.ones(n, bool), np.full(n, np.inf)
+    return domain.index.query(uv)
+
+
+def _extent(surf, n=9):
+    """Rough lengths of the face along u and along v (longest iso-curve of an n x n grid)."""
+    u = np.linspace(*surf.u_range, n)
+    v = np.linspace(*surf.v_range, n)
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    (S,) = bspline.evaluate(surf, uu.ravel(), vv.ravel(), order=0)
+    S = S.reshape(n, n, 3)
+    lu = np.linalg.norm(np.diff(S, axis=0), axis=2).sum(axis=0).max()
+    lv = np.linalg.norm(np.diff(S, axis=1), axis=2).sum(axis=1).max()
+    return lu, lv
+
+
+class Nominal:
+    """The nominal CAD: faces, their exact surfaces, dense samples and the distance queries."""
+
+    def __init__(self, shape, faces, nurbs_faces, surfaces, domains, reversed_, samples,
+                 bbox_corners, roles):
+        self.shape = shape
+        self.faces = faces
+        self.surfaces = surfaces
+        self.samples = samples
+        self.bbox_corners = bbox_corners
+        self.roles = roles
+        self._nurbs_faces = nurbs_faces
+        self._domains = domains
+        self._reversed = np.asarray(reversed_, bool)
+        self._tree = cKDTree(samples.xyz)
+        self._solids = list(shape.Solids)
+        self._tessellation = None
+
+    # ------------------------------------------------------------------ exact distance
+
+    def signed_distance(self, points):
+        """Exact signed distance of (N,3) points to the CAD faces -> DistanceResult."""
+        points = _as_points(points, "signed_distance: points")
+        n = len(points)
+        out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
+                             np.empty((n, 3)), np.empty(n), np.zeros(n, bool))
+        for s in range(0, n, POINT_CHUNK):
+            self._signed_distance_chunk(points[s:s + POINT_CHUNK], out, s)
+        return out
+
+    def _signed_distance_chunk(self, points, out, offset):
+        n = len(points)
+        k = min(K_CANDIDATES, len(self.samples.xyz))
+        sample_dist, idx = self._tree.query(points, k=k, workers=-1)
+        if k == 1:
+            sample_dist, idx = sample_dist[:, None], idx[:, None]
+        faces = self.samples.face[idx]
+        # First occurrence of each face in a point's k nearest samples (nearest sample first).
+        first = np.ones_like(faces, dtype=bool)
+        for j in range(1, k):
+            first[:, j] = np.all(faces[:, j:j + 1] != faces[:, :j], axis=1)
+        pi, cj = np.nonzero(first)
+        pf = faces[pi, cj]
+        start = self.samples.uv[idx[pi, cj]]
+        m = len(pi)
+        dist = np.full(m, np.inf)
+        lower = np.full(m, np.inf)       # a lower bound of the candidate's true face distance
+        trusted = np.zeros(m, bool)
+        on_edge = np.zeros(m, bool)
+        closest = np.empty((m, 3))
+        uv = np.empty((m, 2))
+        normal = np.empty((m, 3))
+        for f in np.unique(pf):
+            sel = np.flatnonzero(pf == f)
+            surf = self.surfaces[f]
+            p = points[pi[sel]]
+            u, v, c, conv = bspline.project_points(surf, p, start[sel, 0], start[sel, 1])
+            S, Su, Sv = bspline.evaluate(surf, u, v, order=1)
+            r = S - p
+            d = np.linalg.norm(r, axis=1)
+            clamped = self._clamped(surf, u, v, r, Su, Sv, d)
+            nrm = np.cross(Su, Sv)
+            nlen = np.linalg.norm(nrm, axis=1)
+            degenerate = nlen <= 1e-12 * np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1) + 1e-300
+            nrm /= np.where(nlen > 0, nlen, 1.0)[:, None]
+            if self._reversed[f]:
+                nrm = -nrm
+            inside, bdist = point_in_domain(self._domains[f], np.column_stack([u, v]))
+            decided = bdist > self._domains[f].margin
+            ok = conv & inside & decided & ~degenerate
+            dist[sel], closest[sel], uv[sel, 0], uv[sel, 1], normal[sel] = d, S, u, v, nrm
+            trusted[sel] = ok
+            on_edge[sel] = clamped
+            low = np.where(conv, d, 0.0)
+            dom = self._domains[f]
+            if dom.planar_scale is not None:
+                # On a plane the trimmed face is at least as far as the in-plane gap to its
+                # boundary, beside the height above the plane.
+                gap = np.where(inside, 0.0, np.maximum(bdist - dom.margin, 0.0)) * dom.planar_scale
+                low = np.where(conv, np.hypot(d, gap), 0.0)
+            lower[sel] = low
+        # Per point: the best trusted candidate; doubtful candidates must not be able to beat it.
+        best_d = np.full(n, np.inf)
+        np.minimum.at(best_d, pi[trusted], dist[trusted])
+        is_best = trusted & (dist == best_d[pi])
+        best = np.full(n, -1)
+        best[pi[is_best]] = np.flatnonzero(is_best)
+        threat = ~trusted & (lower < best_d[pi] - 1e-12)
+        need = np.zeros(n, bool)
+        need[pi[threat]] = True
+        need |= best < 0
+        good = ~need
+        need[good] |= on_edge[best[good]]
+        need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
+        good = ~need
+        b = best[good]
+        rows = offset + np.flatnonzero(good)
+        c = closest[b]
+        nrm = normal[b]
+        sign = np.where(np.einsum("ij,ij->i", points[good] - c, nrm) < 0, -1.0, 1.0)
+        out.closest[rows] = c
+        out.face[rows] = pf[b]
+        out.uv[rows] = uv[b]
+        out.normal[rows] = nrm
+        out.distance[rows] = sign * dist[b]
+        out.fallback[rows] = False
+        hard = np.flatnonzero(need)
+        if len(hard):
+            self._occ_into(points[hard], out, offset + hard)
+
+    @staticmethod
+    def _clamped(surf, u, v, r, Su, Sv, d):
+        """True where the foot point sits on the parameter box with the distance still falling
+        outward: the closest point of the face is on its boundary edge."""
+        (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+        gu = np.einsum("ij,ij->i", r, Su)
+        gv = np.einsum("ij,ij->i", r, Sv)
+        tu = CLAMP_COSINE * d * np.linalg.norm(Su, axis=1)
+        tv = CLAMP_COSINE * d * np.linalg.norm(Sv, axis=1)
+        eu = 1e-12 * (u1 - u0)
+        ev = 1e-12 * (v1 - v0)
+        out = np.zeros(len(u), bool)
+        if not surf.closed_u:
+            out |= ((u <= u0 + eu) & (gu > tu)) | ((u >= u1 - eu) & (gu < -tu))
+        if not surf.closed_v:
+            out |= ((v <= v0 + ev) & (gv > tv)) | ((v >= v1 - ev) & (gv < -tv))
+        return out
+
+    # ------------------------------------------------------------------ OCC reference
+
+    def signed_distance_occ(self, points):
+        """The slow independent reference: per point, Shape.distToShape on the whole shape; the
+        sign from isInside for solids, else from the nearest face's normal (Face.normalAt)."""
+        points = _as_points(points, "signed_distance_occ: points")
+        n = len(points)
+        out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
+                             np.empty((n, 3)), np.empty(n), np.ones(n, bool))
+        self._occ_into(points, out, np.arange(n))
+        return out
+
+    def _occ_into(self, points, out, rows):
+        for p, row in zip(points, rows):
+            d, f, c, nrm = self._occ_point(p)
+            out.closest[row] = c
+            out.face[row] = f
+            out.normal[row] = nrm
+            out.distance[row] = d
+            out.fallback[row] = True
+        # Parameters on our SurfaceData: project the exact closest points (they are on face f).
+        faces = out.face[rows]
+        for f in np.unique(faces):
+            sel = rows[faces == f]
+            _, idx = self._tree.query(out.closest[sel], k=1)
+            start = self.samples.uv[idx]
+            same = self.samples.face[idx] == f
+            if not np.all(same):
+                start = np.where(same[:, None], start, [[np.mean(self.surfaces[f].u_range),
+                                                          np.mean(self.surfaces[f].v_range)]])
+            u, v, _, _ = bspline.project_points(self.surfaces[f], out.closest[sel], start[:, 0], start[:, 1])
+            out.uv[sel] = np.column_stack([u, v])
+
+    def _occ_point(self, p):
+        vec = FreeCAD.Vector(*p)
+        dist, pairs, info = self.shape.distToShape(Part.Vertex(vec))
+        c = np.array(pairs[0][0], dtype=float)
+        kind, index, param = info[0][0], info[0][1], info[0][2]
+        if kind == "Face":
+            face_index = int(index)
+            face_normal = np.array(self.faces[face_index].normalAt(*param), dtype=float)
+        else:
+            face_index, face_normal = self._nearest_face_at(c, p)
+        diff = p - c
+        if self._solids:
+            inside = any(s.isInside(vec, 1e-9, True) for s in self._solids)
+            sign = -1.0 if inside else 1.0
+        else:
+            sign = -1.0 if np.dot(diff, face_normal) < 0 else 1.0
+        if kind == "Face" or dist <= 1e-12:
+            nrm = face_normal / np.linalg.norm(face_normal)
+        else:
+            nrm = sign * diff / dist
+        return sign * dist, face_index, c, nrm
+
+    def _nearest_face_at(self, c, p):
+        """The face an edge/vertex point belongs to that is nearest to p, and its normal there;
+        ties (the faces meeting at the edge) average their normals."""
+        vc = Part.Vertex(FreeCAD.Vector(*c))
+        vp = Part.Vertex(FreeCAD.Vector(*p))
+        best, best_d, normals = None, np.inf, []
+        for i, face in enumerate(self.faces):
+            if face.distToShape(vc)[0] > 1e-7:
+                continue
+            dp, _, info = face.distToShape(vp)
+            if info[0][0] == "Face":
+                nrm = np.array(face.normalAt(*info[0][2]), dtype=float)
+            else:
+                uv = face.Surface.parameter(FreeCAD.Vector(*c))
+                nrm = np.array(face.normalAt(*uv), dtype=float)
+            normals.append(nrm)
+            if dp < best_d:
+                best, best_d = i, dp
+        if best is None:
+            return int(np.argmin([f.distToShape(vc)[0] for f in self.faces])), np.zeros(3)
+        return best, np.sum(normals, axis=0)
+
+    # ------------------------------------------------------------------ rays
+
+    def raycast(self, origins, directions, deflection=None):
+        """First hit of each ray o + t d (t >= 0) on the CAD faces -> (t (N,) NaN on a miss,
+        face (N,) -1 on a miss, outward normal (N,3)). Directions need not be unit: t is in
+        units of |d| (mm for unit directions). See cad.raycast for the method."""
+        from .raycast import cast
+        return cast(self, origins, directions, deflection)
+
+
+def _as_points(points, what):
+    points = np.asarray(points, dtype=float)
+    if points.ndim == 1 and points.size == 3:
+        points = points[None]
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise InputError("%s must be (N, 3), got shape %s" % (what, points.shape))
+    if not np.all(np.isfinite(points)):
+        raise InputError("%s contain NaN or infinite coordinates" % what)
+    return points
+
+
+def _bbox_corners(shape):
+    try:
+        bb = shape.optimalBoundingBox()
+    except Exception:          # older OCC builds lack it; the plain box is only looser
+        bb = shape.BoundBox
+    xs, ys, zs = (bb.XMin, bb.XMax), (bb.YMin, bb.YMax), (bb.ZMin, bb.ZMax)
+    return np.array([[x, y, z] for x in xs for y in ys for z in zs], dtype=float)
+
+
+def _sample_face(surf, domain, reverse, spacing):
+    lu, lv = _extent(surf)
+    nu = max(MIN_SAMPLES_PER_SIDE, int(np.ceil(lu / spacing)))
+    nv = max(MIN_SAMPLES_PER_SIDE, int(np.ceil(lv / spacing)))
+    (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    du, dv = (u1 - u0) / nu, (v1 - v0) / nv
+    # Cell centres: never on a boundary or a degenerate pole.
+    u = u0 + (np.arange(nu) + 0.5) * du
+    v = v0 + (np.arange(nv) + 0.5) * dv
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    uv = np.column_stack([uu.ravel(), vv.ravel()])
+    if domain.index is not None:
+        inside, _ = point_in_domain(domain, uv)
+        uv = uv[inside]
+    S, Su, Sv = bspline.evaluate(surf, uv[:, 0], uv[:, 1], order=1)
+    nrm = np.cross(Su, Sv)
+    area = np.linalg.norm(nrm, axis=1)
+    keep = area > 0
+    nrm = nrm[keep] / area[keep, None]
+    if reverse:
+        nrm = -nrm
+    return S[keep], nrm, uv[keep], area[keep] * du * dv
+
+
+def nominal_from_shape(shape, roles=None, sample_spacing=None):
+    """Nominal of a solid, shell or compound of (open) faces.
+
+    sample_spacing: distance between samples in mm; by default chosen so the whole CAD gets
+    about DEFAULT_SAMPLE_COUNT samples (at least MIN_SAMPLES_PER_SIDE^2 per face).
+    """
+    if shape is None or shape.isNull() or len(shape.Faces) == 0:
+        raise InputError("CAD shape has no faces")
+    if sample_spacing is not None and not (np.isfinite(sample_spacing) and sample_spacing > 0):
+        raise InputError("sample_spacing: expected a positive length in mm, got %r" % (sample_spacing,))
+    faces = list(shape.Faces)
+    nurbs, surfaces, domains, reversed_ = [], [], [], []
+    for face in faces:
+        nface = _nurbs_face(face)
+        surf = _surface_of_face(nface)
+        nurbs.append(nface)
+        surfaces.append(surf)
+        domains.append(_face_domain(nface, surf, isinstance(face.Surface, Part.Plane)))
+        reversed_.append(face.Orientation == "Reversed")
+    if sample_spacing is None:
+        area = sum(f.Area for f in faces)
+        sample_spacing = max(np.sqrt(area / DEFAULT_SAMPLE_COUNT), 1e-6)
+    parts = [_sample_face(surfaces[i], domains[i], reversed_[i], sample_spacing)
+             for i in range(len(faces))]
+    samples = Samples(
+        xyz=np.concatenate([p[0] for p in parts]),
+        normal=np.concatenate([p[1] for p in parts]),
+        face=np.concatenate([np.full(len(p[0]), i) for i, p in enumerate(parts)]),
+        uv=np.concatenate([p[2] for p in parts]),
+        weight=np.concatenate([p[3] for p in parts]))
+    return Nominal(shape, faces, nurbs, surfaces, domains, reversed_, samples,
+                   _bbox_corners(shape), {k: list(v) for k, v in (roles or {}).items()})
