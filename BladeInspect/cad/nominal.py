@@ -201,6 +201,7 @@ class Nominal:
         self._reversed = np.asarray(reversed_, bool)
         self._tree = cKDTree(samples.xyz)
         self._solids = list(shape.Solids)
+        self._face_compound = Part.makeCompound(faces)
         self._tessellation = None
 
     # ------------------------------------------------------------------ exact distance
@@ -316,7 +317,7 @@ class Nominal:
     # ------------------------------------------------------------------ OCC reference
 
     def signed_distance_occ(self, points):
-        """The slow independent reference: per point, Shape.distToShape on the whole shape; the
+        """The slow independent reference: per point, Shape.distToShape on all the faces; the
         sign from isInside for solids, else from the nearest face's normal (Face.normalAt)."""
         points = _as_points(points, "signed_distance_occ: points")
         n = len(points)
@@ -348,7 +349,8 @@ class Nominal:
 
     def _occ_point(self, p):
         vec = FreeCAD.Vector(*p)
-        dist, pairs, info = self.shape.distToShape(Part.Vertex(vec))
+        # Against the faces, not the solid: a solid is at distance 0 from any point inside it.
+        dist, pairs, info = self._face_compound.distToShape(Part.Vertex(vec))
         c = np.array(pairs[0][0], dtype=float)
         kind, index, param = info[0][0], info[0][1], info[0][2]
         if kind == "Face":

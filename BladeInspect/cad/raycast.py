@@ -285,7 +285,7 @@ def cast(nominal, origins, directions, deflection=None):
     corners = nominal.bbox_corners
     diag = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
     if deflection is None:
-        deflection = max(diag * 2e-4, 1e-4)
+        deflection = max(diag * 1e-3, 1e-4)
     tess = nominal._tessellation
     if tess is None or tess.deflection != deflection:
         tess = nominal._tessellation = Tessellation(nominal, deflection)
