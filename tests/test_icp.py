@@ -146,8 +146,9 @@ class TestICP(unittest.TestCase):
         rng = np.random.default_rng(10)
         d = 1.5 + rng.uniform(-0.2, 0.2, 1000)
         rho, scale = icp.robust_weights(d, np.ones(1000), icp.ICPOptions())
-        self.assertTrue(np.all(rho == 1.0))
-        self.assertAlmostEqual(scale, 1.4826 * np.median(np.abs(d)))
+        self.assertTrue(np.all(rho > 0.5))
+        self.assertGreaterEqual(np.mean(rho == 1.0), 0.5)
+        self.assertAlmostEqual(scale, np.median(d) / 3.0)   # half the points within k_full
         # At convergence, a few gross errors among 6 um noise get no weight, the rest full.
         d = rng.uniform(-0.006, 0.006, 1000)
         d[:20] = rng.uniform(0.1, 0.5, 20)

@@ -7,8 +7,9 @@ w_i = a_i * rho_i:
   (DESIGN.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the mean makes
   a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
 * rho_i in [0, 1] — a redescending robust weight of the standardised residual
-  z_i = d_i sqrt(a_i) / s, where s = 1.4826 * median |d sqrt(a)| is a robust scale
-  re-estimated at every iteration. rho = 1 for |z| <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
+  u_i = |z_i| / s with z_i = d_i sqrt(a_i) and s = max(1.4826 MAD(z), median |z| / k_full),
+  a robust scale re-estimated at every iteration (see _robust_deviation). rho = 1 for
+  u <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
   Flat in the core, so the good points are fitted by plain weighted least squares (the
   efficient estimator, and the covariance formula below is exact for them); gross outliers and
   real defects (many sigma away) weigh exactly 0. Two refinements (see robust_weights): a_i is
@@ -107,11 +108,19 @@ def _taper(u, options):
     return np.where(u < options.k_zero, (1.0 - x ** 2) ** 2, 0.0)
 
 
-def _robust_scale(values, options):
-    """Robust sigma of values that should scatter about 0: 1.4826 * median |v|. About 0, not
-    about their median, because the weights judge |v| itself: from a rough start, residuals
-    offset to one side must widen the scale, not be rejected all together."""
-    return max(MAD_TO_SIGMA * np.median(np.abs(values)), options.min_scale)
+def _robust_deviation(values, usable, options):
+    """|v| / s of every value (inf where not usable), and the robust scale s.
+
+    s = 1.4826 MAD (about the median), but never below median |v| / k_full, so that at least
+    half of the points keep full weight. The MAD alone lets ICP leave a wrong pose that fits
+    part of the points (their median sits near those, the rest are rejected); the floor keeps
+    residuals that all sit to one side, from a start shifted along the surface normal, from
+    being rejected all together.
+    """
+    v = np.abs(values[usable])
+    scale = max(MAD_TO_SIGMA * np.median(np.abs(values[usable] - np.median(values[usable]))),
+                np.median(v) / options.k_full, options.min_scale)
+    return np.where(usable, np.abs(values) / scale, np.inf), scale
 
 
 def robust_weights(distances, a, options, neighbourhoods=None):
@@ -133,14 +142,14 @@ def robust_weights(distances, a, options, neighbourhoods=None):
     # SNR lowers a point's weight, it does not excuse its residual).
     z = np.where(usable, distances * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2)),
                  np.inf)
-    scale = _robust_scale(z[usable], options)
-    rho = _taper(np.abs(z) / scale, options)
+    u, scale = _robust_deviation(z, usable, options)
+    rho = _taper(u, options)
     if neighbourhoods is not None:
         limit = options.k_full * scale
         local = neighbourhoods.means(np.clip(z, -limit, limit), usable)
         finite = np.isfinite(local)
         if finite.any():
-            rho = rho * _taper(np.abs(local) / _robust_scale(local[finite], options), options)
+            rho = rho * _taper(_robust_deviation(local, finite, options)[0], options)
     return rho, scale
 
 
