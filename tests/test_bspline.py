@@ -98,8 +98,9 @@ class EvaluateAgainstOCC(unittest.TestCase):
         full = bspline.evaluate(surf, u, v, order=2)
         (S,) = bspline.evaluate(surf, u, v, order=0)
         S1, Su, Sv = bspline.evaluate(surf, u, v, order=1)
-        np.testing.assert_array_equal(S, full[0])
-        np.testing.assert_array_equal(Su, full[1])
+        np.testing.assert_allclose(S, full[0], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(S1, full[0], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(Su, full[1], rtol=0, atol=1e-11)
 
     def test_exact_nurbs_of_analytic_faces(self):
         """Surface of revolution, cylinder, sphere, torus through Face.toNurbs (rational,

@@ -242,8 +242,7 @@ class Nominal:
             sel = np.flatnonzero(pf == f)
             surf = self.surfaces[f]
             p = points[pi[sel]]
-            u, v, c, conv = bspline.project_points(surf, p, start[sel, 0], start[sel, 1])
-            S, Su, Sv = bspline.evaluate(surf, u, v, order=1)
+            u, v, S, Su, Sv, conv = bspline.project(surf, p, start[sel, 0], start[sel, 1])
             r = S - p
             d = np.linalg.norm(r, axis=1)
             clamped = self._clamped(surf, u, v, r, Su, Sv, d)

@@ -131,30 +131,36 @@ def basis_derivatives(knots, degree, span, t, n):
     return ders
 
 
+_COMBOS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
+
+
 def _evaluate_chunk(surf, u, v, order):
     p, q = surf.degree_u, surf.degree_v
     su = find_span(surf.knots_u, p, u)
     sv = find_span(surf.knots_v, q, v)
     Nu = basis_derivatives(surf.knots_u, p, su, u, order)
     Nv = basis_derivatives(surf.knots_v, q, sv, v, order)
-    iu = su[:, None] - p + np.arange(p + 1)
-    iv = sv[:, None] - q + np.arange(q + 1)
-    block = surf.homogeneous()[iu[:, :, None], iv[:, None, :]]      # (N, p+1, q+1, 3|4)
-    # D[(k, l)] = d^(k+l) / du^k dv^l of the (homogeneous) surface.
-    D = {}
-    for k in range(order + 1):
-        tmp = np.einsum("na,nabc->nbc", Nu[:, k], block)
-        for l in range(order + 1 - k):
-            D[k, l] = np.einsum("nb,nbc->nc", Nv[:, l], tmp)
+    combos = _COMBOS[:(1, 3, 6)[order]]
+    ks = [k for k, _ in combos]
+    ls = [l for _, l in combos]
+    # Tensor-product weights of every derivative (k, l) over the (p+1)(q+1) active poles, then
+    # one batched matrix product with the gathered (homogeneous) poles.
+    W = (Nu[:, ks, :, None] * Nv[:, ls, None, :]).reshape(len(u), len(combos), -1)
+    hom = surf.homogeneous()
+    nv = hom.shape[1]
+    flat = ((su[:, None] - p + np.arange(p + 1))[:, :, None] * nv
+            + (sv[:, None] - q + np.arange(q + 1))[:, None, :]).reshape(len(u), -1)
+    block = hom.reshape(-1, hom.shape[2])[flat]                    # (N, (p+1)(q+1), 3|4)
+    Dall = np.matmul(W, block)                                      # (N, combos, 3|4)
+    D = {kl: Dall[:, i] for i, kl in enumerate(combos)}
     if not surf.rational:
-        out = [D[0, 0], D[1, 0], D[0, 1]]
-        if order >= 2:
-            out += [D[2, 0], D[1, 1], D[0, 2]]
-        return out
+        return [D[kl] for kl in combos]
     A = {kl: d[:, :3] for kl, d in D.items()}
     w = {kl: d[:, 3:4] for kl, d in D.items()}
     w0 = w[0, 0]
     S = A[0, 0] / w0
+    if order == 0:
+        return [S]
     Su = (A[1, 0] - w[1, 0] * S) / w0
     Sv = (A[0, 1] - w[0, 1] * S) / w0
     out = [S, Su, Sv]
@@ -180,11 +186,11 @@ def evaluate(surf, u, v, order=1):
     n_out = 1 if order == 0 else (3 if order == 1 else 6)
     n = len(u)
     if n <= CHUNK:
-        out = _evaluate_chunk(surf, u, v, max(order, 1))[:n_out]
+        out = _evaluate_chunk(surf, u, v, order)
         return tuple(out)
     out = [np.empty((n, 3)) for _ in range(n_out)]
     for s in range(0, n, CHUNK):
-        part = _evaluate_chunk(surf, u[s:s + CHUNK], v[s:s + CHUNK], max(order, 1))
+        part = _evaluate_chunk(surf, u[s:s + CHUNK], v[s:s + CHUNK], order)
         for o, pv in zip(out, part):
             o[s:s + CHUNK] = pv
     return tuple(out)
@@ -203,28 +209,65 @@ def project_points(surf, points, u0, v0, max_iter=40, tol=1e-11):
     Minimises |S(u,v) - p|^2 / 2: gradient g = ((S-p).Su, (S-p).Sv), full Hessian with the
     second derivatives. Where the Hessian is not positive definite (far on the concave side)
     the Gauss-Newton matrix (first derivatives only, always PSD) takes its place, and steps that
-    do not reduce the distance are halved. A parameter at a bound whose gradient points out of
-    the box is held there (projected Newton), so the result is the closest point of the box
-    patch, possibly on its boundary. Closed directions wrap around the seam instead.
+    increase the distance are halved. A parameter at a bound whose gradient points out of the
+    box is held there (projected Newton), so the result is the closest point of the box patch,
+    possibly on its boundary. Closed directions wrap around the seam instead. Newton is local:
+    the start must lie in the foot point's basin.
 
-    Returns (u, v, closest (N,3), converged (N,) bool); converged means the last 3D step was
-    below `tol` mm (Newton's quadratic convergence puts the error far below that).
+    Returns (u, v, closest (N,3), converged (N,) bool); converged means the next Newton step
+    would move the point less than `tol` mm (quadratic convergence puts the error far below).
     """
+    u, v, S, _, _, converged = project(surf, points, u0, v0, max_iter, tol)
+    return u, v, S, converged
+
+
+def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
+    """project_points, also returning the first derivatives at the result:
+    (u, v, S, Su, Sv, converged)."""
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     n = len(points)
-    u = _wrap_or_clamp(np.asarray(u0, dtype=float).copy() * np.ones(n), *surf.u_range, surf.closed_u)
-    v = _wrap_or_clamp(np.asarray(v0, dtype=float).copy() * np.ones(n), *surf.v_range, surf.closed_v)
-    converged = np.zeros(n, dtype=bool)
-    closest = np.empty((n, 3))
-    active = np.arange(n)
     (ulo, uhi), (vlo, vhi) = surf.u_range, surf.v_range
+    u = _wrap_or_clamp(np.asarray(u0, dtype=float) * np.ones(n), ulo, uhi, surf.closed_u)
+    v = _wrap_or_clamp(np.asarray(v0, dtype=float) * np.ones(n), vlo, vhi, surf.closed_v)
+    out_S, out_Su, out_Sv = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    converged = np.zeros(n, dtype=bool)
+    # Last accepted iterate of each point, for backtracking when a step made things worse.
+    prev_u, prev_v = u.copy(), v.copy()
+    prev_f = np.full(n, np.inf)
+    last_du, last_dv = np.zeros(n), np.zeros(n)
+    scale = np.ones(n)
+    active = np.arange(n)
+    eps_u = 1e-14 * (uhi - ulo)
+    eps_v = 1e-14 * (vhi - vlo)
     for _ in range(max_iter):
         if len(active) == 0:
             break
         ua, va, pa = u[active], v[active], points[active]
         S, Su, Sv, Suu, Suv, Svv = evaluate(surf, ua, va, order=2)
         r = S - pa
-        f0 = np.einsum("ij,ij->i", r, r)
+        f = np.einsum("ij,ij->i", r, r)
+        worse = f > prev_f[active] * (1 + 1e-12) + 1e-24
+        if worse.any():
+            w = active[worse]
+            scale[w] *= 0.5
+            stuck = scale[w] < 1.0 / 256
+            # Cannot go lower from the last accepted iterate: it is the numerical minimum.
+            ws = w[stuck]
+            u[ws], v[ws] = prev_u[ws], prev_v[ws]
+            converged[ws] = True
+            wm = w[~stuck]
+            u[wm] = _wrap_or_clamp(prev_u[wm] + scale[wm] * last_du[wm], ulo, uhi, surf.closed_u)
+            v[wm] = _wrap_or_clamp(prev_v[wm] + scale[wm] * last_dv[wm], vlo, vhi, surf.closed_v)
+            if len(ws):
+                out_S[ws], out_Su[ws], out_Sv[ws] = evaluate(surf, u[ws], v[ws], order=1)
+            keep = ~worse
+            active_next_retry = wm
+            active = active[keep]
+            ua, va, pa = ua[keep], va[keep], pa[keep]
+            S, Su, Sv, Suu, Suv, Svv = S[keep], Su[keep], Sv[keep], Suu[keep], Suv[keep], Svv[keep]
+            r, f = r[keep], f[keep]
+        else:
+            active_next_retry = active[:0]
         gu = np.einsum("ij,ij->i", r, Su)
         gv = np.einsum("ij,ij->i", r, Sv)
         a = np.einsum("ij,ij->i", Su, Su)
@@ -240,10 +283,6 @@ def project_points(surf, points, u0, v0, max_iter=40, tol=1e-11):
         hu = np.where(indefinite, a, hu)
         hb = np.where(indefinite, b, hb)
         hv = np.where(indefinite, c, hv)
-        # Bound constraints: a parameter held at its bound when the descent direction leaves
-        # the box there.
-        eps_u = 1e-14 * (uhi - ulo)
-        eps_v = 1e-14 * (vhi - vlo)
         hold_u = np.zeros(len(active), bool) if surf.closed_u else \
             ((ua <= ulo + eps_u) & (gu > 0)) | ((ua >= uhi - eps_u) & (gu < 0))
         hold_v = np.zeros(len(active), bool) if surf.closed_v else \
@@ -255,43 +294,28 @@ def project_points(surf, points, u0, v0, max_iter=40, tol=1e-11):
         only_v = hold_u & ~hold_v
         only_u = hold_v & ~hold_u
         both = hold_u & hold_v
-        du = np.where(only_v, 0.0, du)
-        dv = np.where(only_v, -gv / (hv1 + 1e-300), dv)
-        dv = np.where(only_u, 0.0, dv)
-        du = np.where(only_u, -gu / (hu1 + 1e-300), du)
-        du = np.where(both, 0.0, du)
-        dv = np.where(both, 0.0, dv)
-        # Backtracking on the distance: at most a few halvings, accepted when not worse.
-        step = np.ones(len(active))
+        du = np.where(only_v | both, 0.0, np.where(only_u, -gu / (hu1 + 1e-300), du))
+        dv = np.where(only_u | both, 0.0, np.where(only_v, -gv / (hv1 + 1e-300), dv))
         un = _wrap_or_clamp(ua + du, ulo, uhi, surf.closed_u)
         vn = _wrap_or_clamp(va + dv, vlo, vhi, surf.closed_v)
-        for _half in range(8):
-            (Sn,) = evaluate(surf, un, vn, order=0)
-            rn = Sn - pa
-            fn = np.einsum("ij,ij->i", rn, rn)
-            worse = fn > f0 * (1 + 1e-12) + 1e-24
-            if not np.any(worse):
-                break
-            step = np.where(worse, step * 0.5, step)
-            un = np.where(worse, _wrap_or_clamp(ua + step * du, ulo, uhi, surf.closed_u), un)
-            vn = np.where(worse, _wrap_or_clamp(va + step * dv, vlo, vhi, surf.closed_v), vn)
-        else:
-            un = np.where(worse, ua, un)
-            vn = np.where(worse, va, vn)
-            Sn = np.where(worse[:, None], S, Sn)
-        # Length in space of the parameter step actually taken (seam jumps excluded).
-        dua = un - ua
-        dva = vn - va
+        # Length in space of the step about to be taken (a seam jump is no step).
+        dua, dva = un - ua, vn - va
         if surf.closed_u:
             dua = np.where(np.abs(dua) > 0.5 * (uhi - ulo), 0.0, dua)
         if surf.closed_v:
             dva = np.where(np.abs(dva) > 0.5 * (vhi - vlo), 0.0, dva)
-        moved = np.linalg.norm(dua[:, None] * Su + dva[:, None] * Sv, axis=1)
-        u[active], v[active] = un, vn
-        closest[active] = Sn
-        done = moved <= tol
-        converged[active[done]] = True
-        active = active[~done]
+        step = np.linalg.norm(dua[:, None] * Su + dva[:, None] * Sv, axis=1)
+        done = step <= tol
+        d_idx = active[done]
+        converged[d_idx] = True
+        out_S[d_idx], out_Su[d_idx], out_Sv[d_idx] = S[done], Su[done], Sv[done]
+        go = ~done
+        g_idx = active[go]
+        prev_u[g_idx], prev_v[g_idx], prev_f[g_idx] = ua[go], va[go], f[go]
+        last_du[g_idx], last_dv[g_idx] = du[go], dv[go]
+        scale[g_idx] = 1.0
+        u[g_idx], v[g_idx] = un[go], vn[go]
+        active = np.concatenate([g_idx, active_next_retry])
     if len(active):
-        (closest[active],) = evaluate(surf, u[active], v[active], order=0)
-    return u, v, closest, converged
+        out_S[active], out_Su[active], out_Sv[active] = evaluate(surf, u[active], v[active], order=1)
+    return u, v, out_S, out_Su, out_Sv, converged
