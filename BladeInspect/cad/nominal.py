@@ -235,6 +235,7 @@ class Nominal:
         lower = np.full(m, np.inf)       # a lower bound of the candidate's true face distance
         trusted = np.zeros(m, bool)
         on_edge = np.zeros(m, bool)
+        converged_pair = np.zeros(m, bool)
         closest = np.empty((m, 3))
         uv = np.empty((m, 2))
         normal = np.empty((m, 3))
@@ -258,6 +259,7 @@ class Nominal:
             dist[sel], closest[sel], uv[sel, 0], uv[sel, 1], normal[sel] = d, S, u, v, nrm
             trusted[sel] = ok
             on_edge[sel] = clamped
+            converged_pair[sel] = conv
             low = np.where(conv, d, 0.0)
             dom = self._domains[f]
             if dom.planar_scale is not None:
@@ -272,19 +274,42 @@ class Nominal:
         is_best = trusted & (dist == best_d[pi])
         best = np.full(n, -1)
         best[pi[is_best]] = np.flatnonzero(is_best)
-        threat = ~trusted & (lower < best_d[pi] - 1e-12)
+        has_best = best >= 0
+        bp = np.where(has_best[pi], best[pi], 0)
+        # On an edge: the face across it reaches the same closest point (clamped there too, or,
+        # for a plane trimmed by that edge, the point lies in its plane). Such a partner is no
+        # threat, and the two outward normals together give the sign (their sum is the edge's
+        # pseudo-normal, which is right for any point whose closest point is on the edge).
+        planar = np.array([d.planar_scale is not None for d in self._domains])[pf]
+        partner = (has_best[pi] & on_edge[bp] & (np.arange(m) != bp) & converged_pair
+                   & ((on_edge & (np.linalg.norm(closest - closest[bp], axis=1) < 1e-7))
+                      | (planar & (np.abs(np.einsum("ij,ij->i", closest[bp] - closest, normal))
+                                   < 1e-9))))
+        threat = ~trusted & ~partner & (lower < best_d[pi] - 1e-12)
         need = np.zeros(n, bool)
         need[pi[threat]] = True
-        need |= best < 0
+        need |= ~has_best
+        n_partner = np.bincount(pi[partner], minlength=n)
+        partner_normal = np.zeros((n, 3))
+        np.add.at(partner_normal, pi[partner], normal[partner])
         good = ~need
-        need[good] |= on_edge[best[good]]
+        edge = np.zeros(n, bool)
+        edge[good] = on_edge[best[good]]
+        need |= edge & (n_partner != 1)
         need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
         good = ~need
         b = best[good]
         rows = offset + np.flatnonzero(good)
         c = closest[b]
-        nrm = normal[b]
-        sign = np.where(np.einsum("ij,ij->i", points[good] - c, nrm) < 0, -1.0, 1.0)
+        nrm = normal[b].copy()
+        e = edge[good]
+        pseudo = nrm + np.where(e[:, None], partner_normal[good], 0.0)
+        diff = points[good] - c
+        sign = np.where(np.einsum("ij,ij->i", diff, pseudo) < 0, -1.0, 1.0)
+        if e.any():
+            # At an edge the distance runs along p - c, not along either face's normal.
+            de = np.maximum(dist[b][e], 1e-300)
+            nrm[e] = sign[e, None] * diff[e] / de[:, None]
         out.closest[rows] = c
         out.face[rows] = pf[b]
         out.uv[rows] = uv[b]
