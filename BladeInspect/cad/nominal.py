@@ -15,7 +15,8 @@ the face's trimmed domain, away from its boundary; a point whose winner lies on 
 (``Shape.distToShape``), point by point. The fraction that did is reported.
 """
 
-from dataclasses import dataclass, field
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -42,7 +43,9 @@ CLAMP_COSINE = 1e-7
 # Newton results farther than this from the nearest sample's distance are distrusted (mm).
 SAMPLE_SLACK = 1e-9
 # Points per chunk in signed_distance (bounds the (chunk, K) candidate arrays).
-POINT_CHUNK = 65536
+POINT_CHUNK = 32768
+# Threads for the numpy fast path.
+THREADS = 2
 
 
 @dataclass
@@ -212,14 +215,24 @@ class Nominal:
         n = len(points)
         out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
                              np.empty((n, 3)), np.empty(n), np.zeros(n, bool))
-        for s in range(0, n, POINT_CHUNK):
-            self._signed_distance_chunk(points[s:s + POINT_CHUNK], out, s)
+        starts = range(0, n, POINT_CHUNK)
+        work = lambda s: self._signed_distance_chunk(points[s:s + POINT_CHUNK], out, s)
+        # numpy releases the GIL in its array loops: chunks on two threads use both cores.
+        # OCC is only called afterwards, from this thread.
+        if len(starts) > 1:
+            with ThreadPoolExecutor(max_workers=THREADS) as pool:
+                hard = list(pool.map(work, starts))
+        else:
+            hard = [work(s) for s in starts]
+        hard = np.concatenate(hard) if hard else np.zeros(0, int)
+        if len(hard):
+            self._occ_into(points[hard], out, hard)
         return out
 
     def _signed_distance_chunk(self, points, out, offset):
         n = len(points)
         k = min(K_CANDIDATES, len(self.samples.xyz))
-        sample_dist, idx = self._tree.query(points, k=k, workers=-1)
+        sample_dist, idx = self._tree.query(points, k=k)
         if k == 1:
             sample_dist, idx = sample_dist[:, None], idx[:, None]
         faces = self.samples.face[idx]
@@ -316,9 +329,7 @@ class Nominal:
         out.normal[rows] = nrm
         out.distance[rows] = sign * dist[b]
         out.fallback[rows] = False
-        hard = np.flatnonzero(need)
-        if len(hard):
-            self._occ_into(points[hard], out, offset + hard)
+        return offset + np.flatnonzero(need)
 
     @staticmethod
     def _clamped(surf, u, v, r, Su, Sv, d):
