@@ -19,6 +19,8 @@ from .errors import InputError
 
 # Parameters are evaluated in chunks so the (chunk, p+1, q+1, 4) pole gathers stay small.
 CHUNK = 32768
+# Newton steps shorter than this (mm) are the last: applied to first order, not re-evaluated.
+FINAL_STEP = 1e-5
 
 
 @dataclass
@@ -214,8 +216,9 @@ def project_points(surf, points, u0, v0, max_iter=40, tol=1e-11):
     possibly on its boundary. Closed directions wrap around the seam instead. Newton is local:
     the start must lie in the foot point's basin.
 
-    Returns (u, v, closest (N,3), converged (N,) bool); converged means the next Newton step
-    would move the point less than `tol` mm (quadratic convergence puts the error far below).
+    Returns (u, v, closest (N,3), converged (N,) bool); converged means the last full Newton
+    step moved the point less than FINAL_STEP (applied to first order: the error left is of
+    order step^2 x curvature), or less than `tol` for a Gauss-Newton step.
     """
     u, v, S, _, _, converged = project(surf, points, u0, v0, max_iter, tol)
     return u, v, S, converged
@@ -304,11 +307,16 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
             dua = np.where(np.abs(dua) > 0.5 * (uhi - ulo), 0.0, dua)
         if surf.closed_v:
             dva = np.where(np.abs(dva) > 0.5 * (vhi - vlo), 0.0, dva)
-        step = np.linalg.norm(dua[:, None] * Su + dva[:, None] * Sv, axis=1)
-        done = step <= tol
+        move = dua[:, None] * Su + dva[:, None] * Sv
+        step = np.linalg.norm(move, axis=1)
+        # A short full-Newton step is taken to first order instead of another evaluation: with
+        # quadratic convergence the error left is of order step^2 x curvature (< 1e-10 mm).
+        done = (step <= tol) | (~indefinite & (step <= FINAL_STEP))
         d_idx = active[done]
         converged[d_idx] = True
-        out_S[d_idx], out_Su[d_idx], out_Sv[d_idx] = S[done], Su[done], Sv[done]
+        u[d_idx], v[d_idx] = un[done], vn[done]
+        out_S[d_idx] = S[done] + move[done]
+        out_Su[d_idx], out_Sv[d_idx] = Su[done], Sv[done]
         go = ~done
         g_idx = active[go]
         prev_u[g_idx], prev_v[g_idx], prev_f[g_idx] = ua[go], va[go], f[go]
