@@ -31,6 +31,8 @@ PAIR_CHUNK = 400000
 # Above this many direction groups, rays are grouped by their dominant axis instead.
 MAX_GROUPS = 48
 NEWTON_ITERATIONS = 30
+# A neighbour face's exact hit replaces a doubtful tessellated one within this many deflections.
+NEIGHBOUR_SLACK = 20.0
 
 
 class Tessellation:
@@ -204,9 +206,13 @@ def _refine(nominal, f, o, d, t):
     on_f = nominal.samples.face[idx] == f
     first = np.argmax(on_f, axis=1)
     start = nominal.samples.uv[idx[np.arange(len(x)), first]]
-    missing = ~on_f.any(axis=1)
-    if missing.any():
-        start[missing] = [np.mean(surf.u_range), np.mean(surf.v_range)]
+    missing = np.flatnonzero(~on_f.any(axis=1))
+    if len(missing):
+        # Nearest sample of this face by brute force: only for the few retried rays.
+        mine = np.flatnonzero(nominal.samples.face == f)
+        for i in missing:
+            j = mine[np.argmin(np.linalg.norm(nominal.samples.xyz[mine] - x[i], axis=1))]
+            start[i] = nominal.samples.uv[j]
     u, v, _, _ = bspline.project_points(surf, x, start[:, 0], start[:, 1])
     converged = np.zeros(len(x), bool)
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
@@ -312,6 +318,27 @@ def cast(nominal, origins, directions, deflection=None):
         good = rows[ok]
         t_out[good], face_out[good], normal_out[good] = t[ok], f, nrm[ok]
         doubtful.extend(rows[~ok])
+    # A tessellation hit near a face's edge may belong to the face across it: try the other
+    # faces near the tessellated hit; the nearest valid exact hit there is the first one when it
+    # lies within the tessellation's error of the tessellated hit.
+    doubtful = np.array(doubtful, dtype=int)
+    if len(doubtful):
+        best_t = np.full(len(doubtful), np.inf)
+        best_f = np.full(len(doubtful), -1)
+        best_n = np.full((len(doubtful), 3), np.nan)
+        for f in range(len(nominal.faces)):
+            others = np.flatnonzero(tess.face[tri[doubtful]] != f)
+            if len(others) == 0:
+                continue
+            rows = doubtful[others]
+            t, nrm, ok = _refine(nominal, f, origins[rows], unit[rows], t_hit[rows].copy())
+            ok &= (np.abs(t - t_hit[rows]) < NEIGHBOUR_SLACK * deflection) & (t < best_t[others])
+            k = others[ok]
+            best_t[k], best_f[k], best_n[k] = t[ok], f, nrm[ok]
+        found = np.isfinite(best_t)
+        rows = doubtful[found]
+        t_out[rows], face_out[rows], normal_out[rows] = best_t[found], best_f[found], best_n[found]
+        doubtful = doubtful[~found]
     for i in doubtful:
         t, f, nrm = _occ_ray(nominal, origins[i], unit[i], t1[i] + pad)
         t_out[i], face_out[i], normal_out[i] = t, f, nrm
