@@ -75,7 +75,7 @@ def main():
         e1 = np.array([np.cos(a), 0.0, np.sin(a)])
         m = N_RAYS // n_pass
         c = 0.5 * (lo + hi)
-        u = rng.uniform(-0.6, 0.6, m) * np.linalg.norm(hi - lo)
+        u = rng.uniform(-0.3, 0.3, m) * np.linalg.norm(hi - lo)
         y = rng.uniform(lo[1], hi[1], m)
         o = c - 100 * d + u[:, None] * e1 + (y - c[1])[:, None] * np.array([0, 1.0, 0])
         origins.append(o)

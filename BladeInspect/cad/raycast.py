@@ -213,27 +213,32 @@ def _refine(nominal, f, o, d, t):
         for i in missing:
             j = mine[np.argmin(np.linalg.norm(nominal.samples.xyz[mine] - x[i], axis=1))]
             start[i] = nominal.samples.uv[j]
-    u, v, _, _ = bspline.project_points(surf, x, start[:, 0], start[:, 1])
+    u, v = start[:, 0].copy(), start[:, 1].copy()
     converged = np.zeros(len(x), bool)
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    active = np.arange(len(x))
     for _ in range(NEWTON_ITERATIONS):
-        S, Su, Sv = bspline.evaluate(surf, u, v, order=1)
-        F = S - x
-        J = np.stack([Su, Sv, -d], axis=2)
-        try:
-            step = np.linalg.solve(J, -F[..., None])[..., 0]
-        except np.linalg.LinAlgError:
+        if len(active) == 0:
             break
-        u = u + step[:, 0]
-        v = v + step[:, 1]
-        t = t + step[:, 2]
-        u = u0 + np.mod(u - u0, u1 - u0) if surf.closed_u else np.clip(u, u0, u1)
-        v = v0 + np.mod(v - v0, v1 - v0) if surf.closed_v else np.clip(v, v0, v1)
-        x = o + t[:, None] * d
-        moved = np.linalg.norm(step[:, 0:1] * Su + step[:, 1:2] * Sv, axis=1)
-        converged = moved < 1e-11
-        if converged.all():
-            break
+        ua, va, ta, oa, da = u[active], v[active], t[active], o[active], d[active]
+        S, Su, Sv = bspline.evaluate(surf, ua, va, order=1)
+        F = oa + ta[:, None] * da - S
+        # Cramer's rule on [Su Sv -d] (du dv dt) = F; a ray parallel to the surface is left.
+        bc = np.cross(Sv, -da)
+        det = np.einsum("ij,ij->i", Su, bc)
+        ok = np.abs(det) > 1e-14 * np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1)
+        det = np.where(ok, det, 1.0)
+        du = np.einsum("ij,ij->i", F, bc) / det
+        dv = np.einsum("ij,ij->i", Su, np.cross(F, -da)) / det
+        dt = np.einsum("ij,ij->i", Su, np.cross(Sv, F)) / det
+        un, vn = ua + du, va + dv
+        u[active] = u0 + np.mod(un - u0, u1 - u0) if surf.closed_u else np.clip(un, u0, u1)
+        v[active] = v0 + np.mod(vn - v0, v1 - v0) if surf.closed_v else np.clip(vn, v0, v1)
+        t[active] = ta + dt
+        moved = np.linalg.norm(du[:, None] * Su + dv[:, None] * Sv, axis=1)
+        done = (moved < 1e-11) | ~ok
+        converged[active[done & ok]] = True
+        active = active[~done]
     S, Su, Sv = bspline.evaluate(surf, u, v, order=1)
     residual = np.linalg.norm(S - (o + t[:, None] * d), axis=1)
     nrm = np.cross(Su, Sv)
