@@ -38,6 +38,9 @@ MIN_SAMPLES_PER_SIDE = 12
 DEFAULT_SAMPLE_COUNT = 60000
 # Points per trimming edge when discretising its pcurve.
 PCURVE_SAMPLES = 400
+MAX_PCURVE_SAMPLES = 25600
+# Aimed chord error of the discretised trimming curves, relative to the parameter range.
+CHORD_TARGET = 1e-6
 # Relative cosine above which the gradient at a bound means "the minimum lies outside".
 CLAMP_COSINE = 1e-7
 # Newton results farther than this from the nearest sample's distance are distrusted (mm).
@@ -143,11 +146,17 @@ def _face_domain(nface, surf, planar):
             if pc is None:
                 raise InputError("CAD face has an edge without a curve on its surface")
             curve, a, b = pc
-            t = np.linspace(a, b, PCURVE_SAMPLES + 1)
-            pts = np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
-            mids = np.array([[q.x, q.y] for q in (curve.value(x) for x in 0.5 * (t[1:] + t[:-1]))])
-            chord = np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1)
-            max_chord = max(max_chord, float(chord.max()))
+            count = PCURVE_SAMPLES
+            while True:
+                t = np.linspace(a, b, count + 1)
+                pts = np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
+                mids = np.array([[q.x, q.y] for q in (curve.value(x) for x in 0.5 * (t[1:] + t[:-1]))])
+                chord = float(np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1).max())
+                # The margin of undecided points grows with the chord error: refine until small.
+                if chord <= CHORD_TARGET * max(su, sv) or count >= MAX_PCURVE_SAMPLES:
+                    break
+                count *= 4
+            max_chord = max(max_chord, chord)
             on_u = (np.all(np.abs(pts[:, 0] - u0) <= tol_u) or np.all(np.abs(pts[:, 0] - u1) <= tol_u))
             on_v = (np.all(np.abs(pts[:, 1] - v0) <= tol_v) or np.all(np.abs(pts[:, 1] - v1) <= tol_v))
             if not (on_u or on_v):
