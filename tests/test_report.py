@@ -152,18 +152,32 @@ class RunReportTest(unittest.TestCase):
         self.assertEqual(self.summary["verdict"], doc["verdict"])
 
     def test_document_reopens_with_colours(self):
+        """The workbench's own objects, reopened from the file: one colour per point, the
+        colours those of the deviations, the pose, the section profiles and the verdict."""
         import FreeCAD
+        from BladeInspect.app import objects
+        from BladeInspect.core import colormap
         doc = FreeCAD.openDocument(os.path.join(self.out, "inspection.FCStd"))
         try:
-            cloud = doc.getObject("Deviations")
-            self.assertEqual(cloud.TypeId, "Points::FeatureCustom")
+            maps = objects.find_objects(doc, "BladeInspect::DeviationMap")
+            self.assertEqual(len(maps), 1)
+            cloud = maps[0]
             self.assertEqual(len(cloud.Color), len(self.known))
             self.assertEqual(cloud.Points.CountPoints, len(self.known))
-            nominal = doc.getObject("Nominal")
+            expected = colormap.deviation_colors(np.asarray(cloud.Deviation), 0.04)
+            # the file stores colours as 8-bit RGBA
+            np.testing.assert_allclose(np.asarray(cloud.Color)[:, :3], expected,
+                                       atol=0.5 / 255 + 1e-6)
+            reg = objects.find_objects(doc, "BladeInspect::Registration")[0]
+            with open(os.path.join(self.out, "result.json")) as fh:
+                T = np.array(json.load(fh)["measured_to_cad"])
+            np.testing.assert_allclose(objects.matrix_array(reg.MeasuredToCad), T, atol=1e-9)
+            nominal = objects.find_objects(doc, "BladeInspect::DemoBlade")[0]
             self.assertAlmostEqual(nominal.Shape.Volume, self.nominal.shape.Volume, places=6)
-            sections = doc.getObject("Sections").Group
-            self.assertEqual(len(sections), 5)
-            self.assertTrue(all(s.Shape.Edges for s in sections))
+            profiles = doc.getObject("SectionProfiles")
+            self.assertEqual(list(profiles.Sections), ["1", "2", "3", "4", "5"])
+            self.assertIn("PASS", profiles.Verdict)
+            self.assertFalse([o.Name for o in doc.Objects if "Touched" in o.State])
         finally:
             FreeCAD.closeDocument(doc.Name)
 

@@ -1,15 +1,12 @@
 """inspection.FCStd: the inspection as a FreeCAD document, written headless.
 
-Objects: the nominal CAD (Part::Feature "Nominal"), the registered points coloured by deviation
-(Points::FeatureCustom "Deviations" with an added App::PropertyColorList "Color", one colour per
-point, and the signed deviations beside it: FreeCAD shows per-point colours from that property
-when the view's display mode is "Color"), and the nominal section curves (Part::Feature per
-section, in a "Sections" group). The pose and verdict are properties of the "Deviations" object
-so a document on its own says what it shows.
-
-Plain document objects rather than the workbench's FeaturePython objects: a file written on a
-line PC must open anywhere, even where the workbench is not installed, and nothing in it needs
-recomputing.
+The document holds the workbench's own objects (BladeInspect.app.objects), so it opens in the
+workbench exactly as if the inspection had been done there: the nominal (DemoBlade or
+CadModel), the Measurement (the points as read, in their own frame), the Registration holding
+the result (linked to both, so it re-registers only if one of them changes), the DeviationMap
+(a Points::FeaturePython whose App::PropertyColorList "Color" has one colour per point, from
+core.colormap) and the nominal section profiles. The verdict is stored beside the section
+profiles. Nothing is recomputed on opening: each object carries the signature of its inputs.
 """
 
 import json
@@ -17,86 +14,62 @@ import os
 
 import numpy as np
 
-from ..core import colormap
+from ..core import transforms as tf
 from ..core.errors import InputError
+from ..core.pointio import PointSet
 
 
-def _fc():
-    import FreeCAD
-    import Part
-    import Points
-    return FreeCAD, Part, Points
-
-
-def _polyline_shape(Part, FreeCAD, polylines):
-    edges = []
-    for poly in polylines:
-        pts = [FreeCAD.Vector(*p) for p in np.asarray(poly, dtype=float)]
-        if len(pts) >= 2:
-            edges.append(Part.makePolygon(pts))
-    return Part.makeCompound(edges)
+def _measured_pointset(result):
+    """The points as they were read (input frame), with SNR and extra columns."""
+    xyz = tf.apply_transform(tf.invert_transform(np.asarray(result.measured_to_cad)),
+                             np.asarray(result.points_cad, dtype=float))
+    return PointSet(xyz=xyz, snr=result.snr, columns=dict(result.columns),
+                    n_rows_skipped=int(result.n_rows_skipped), source=result.source)
 
 
 def write_inspection_document(path, nominal, result, sections, tolerance=0.04, verdict=None,
-                              name="Inspection"):
-    """Save the inspection document at ``path`` (.FCStd) and close it. Returns the path."""
-    FreeCAD, Part, Points = _fc()
+                              cad_path=None, name="Inspection"):
+    """Save the inspection document at ``path`` (.FCStd) and close it. ``cad_path`` is the CAD
+    file the nominal came from (None: the built-in demo blade). Returns the path."""
+    import FreeCAD
+    from ..app import objects
     if not str(path).lower().endswith(".fcstd"):
         raise InputError("%s: an inspection document must be an .FCStd file" % path)
     # hidden: when the GUI is up (a report run from the workbench) no 3D view opens for it
     doc = FreeCAD.newDocument(name, hidden=True)
     try:
-        cad = doc.addObject("Part::Feature", "Nominal")
-        cad.Shape = nominal.shape
-        cad.Label = "Nominal CAD"
-
-        cloud = doc.addObject("Points::FeatureCustom", "Deviations")
-        cloud.Label = "Deviations (colour +-%.3f mm)" % tolerance
-        xyz = np.asarray(result.points_cad, dtype=float)
-        cloud.Points = Points.Points([tuple(p) for p in xyz.tolist()])
-        cloud.addProperty("App::PropertyColorList", "Color", "Deviation",
-                          "Colour of every point: blue -limit, green 0, red +limit")
-        colors = colormap.deviation_colors(result.deviation, tolerance)
-        cloud.Color = [tuple(c) for c in colors.tolist()]
-        cloud.addProperty("App::PropertyFloatList", "Deviation", "Deviation",
-                          "Signed deviation of every point, + outside material, mm")
-        cloud.Deviation = np.asarray(result.deviation, dtype=float).tolist()
-        cloud.addProperty("App::PropertyFloat", "ColorLimit", "Deviation",
-                          "Deviation at which the colours saturate, mm")
-        cloud.ColorLimit = float(tolerance)
-        cloud.addProperty("App::PropertyMatrix", "MeasuredToCad", "Registration",
-                          "Measured -> CAD transform of the points (as in result.json)")
-        cloud.MeasuredToCad = FreeCAD.Matrix(*np.asarray(result.measured_to_cad,
-                                                          dtype=float).ravel().tolist())
-        cloud.addProperty("App::PropertyFloat", "PoseUncertaintyMm", "Registration",
-                          "1 sigma at the worst corner of the CAD's bounding box, mm")
-        cloud.PoseUncertaintyMm = float(result.pose_uncertainty_mm)
-        cloud.addProperty("App::PropertyFloat", "RmsMm", "Registration",
-                          "RMS of the inliers' deviations, mm")
-        cloud.RmsMm = float(result.rms_mm)
-        if verdict is not None:
-            cloud.addProperty("App::PropertyString", "Verdict", "Verdict",
-                              "Pass/fail summary against the profile tolerance")
-            cloud.Verdict = verdict["summary"]
-            cloud.addProperty("App::PropertyString", "VerdictJson", "Verdict",
-                              "The verdict as in result.json")
-            cloud.VerdictJson = json.dumps(verdict)
-
-        group = doc.addObject("App::DocumentObjectGroup", "Sections")
-        for sec in sections.sections:
-            if sec.profile is None or not sec.profile.polylines:
-                continue
-            obj = doc.addObject("Part::Feature", "Section%s" % _safe(sec.label))
-            obj.Shape = _polyline_shape(Part, FreeCAD, sec.profile.polylines)
-            obj.Label = "Section %s (%.0f %% span)" % (sec.label, sec.height_pct)
-            group.addObject(obj)
-        doc.recompute()
+        if cad_path is None:
+            cad = objects.make_demo_blade(doc)
+        else:
+            cad = objects.make_cad_model(doc, os.path.abspath(cad_path))
+        measurement = objects.make_measurement(doc, _measured_pointset(result),
+                                               source_file=_existing(result.source))
+        registration = objects.make_registration(doc, result, measurement=measurement,
+                                                 nominal=cad)
+        deviation_map = objects.make_deviation_map(doc, registration, tolerance)
+        deviation_map.Label = "Deviations (colour +-%.3f mm)" % tolerance
+        if any(s.profile is not None and s.profile.polylines for s in sections.sections):
+            profiles = objects.make_section_profiles(doc, sections, registration=registration)
+            profiles.addProperty("App::PropertyString", "SectionTableJson", "Sections",
+                                 "The section table (Table 2) as in result.json")
+            profiles.SectionTableJson = json.dumps(sections.to_json())
+            if verdict is not None:
+                profiles.addProperty("App::PropertyString", "Verdict", "Verdict",
+                                     "Pass/fail against the profile tolerance")
+                profiles.Verdict = verdict["summary"]
+                profiles.addProperty("App::PropertyString", "VerdictJson", "Verdict",
+                                     "The verdict as in result.json")
+                profiles.VerdictJson = json.dumps(verdict)
+        # every object was built from its inputs just now: nothing to recompute on opening
+        for obj in doc.Objects:
+            obj.purgeTouched()
         doc.saveAs(os.path.abspath(path))
     finally:
         FreeCAD.closeDocument(doc.Name)
     return path
 
 
-def _safe(label):
-    return "".join(ch if ch.isalnum() else "_" for ch in str(label))
-
+def _existing(path):
+    # A Measurement re-reads its source file when that changes; a source that is not a file
+    # (a synthetic cloud) is not linked.
+    return path if path and os.path.isfile(path) else ""

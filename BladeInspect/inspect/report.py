@@ -25,7 +25,7 @@ from . import sections as sections_mod
 from . import verdict as verdict_mod
 
 # Enough points for a faithful picture; more only costs time and PDF size.
-MAX_VIEW_POINTS = 60000
+MAX_VIEW_POINTS = 120000
 MAX_WHISKERS = 1500
 DPI = 110
 PDF_DPI = 150
@@ -123,7 +123,7 @@ def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
     return image.reshape(height, width, 4), extent
 
 
-def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS * 4, seed=0):
+def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
     """Three orthographic views of the points coloured by deviation, with the colour legend."""
     plt, _, _ = _mpl()
     xyz = result.points_cad
@@ -562,7 +562,7 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
             progress(0.95, "FreeCAD document")
             from .document import write_inspection_document
             write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
-                                      tolerance=tolerance)
+                                      tolerance=tolerance, verdict=verdict, cad_path=cad_path)
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance},
