@@ -2,8 +2,7 @@
 CAD-planned sections measured by the simulated rig, and (when the inspect workflow is
 available) the whole loop.
 
-Run: PYTHONPATH=. /usr/bin/python3 bench/bench_closed_loop.py [--trials N] [--skip-plan]
-(with /usr/lib/freecad-python3/lib on PYTHONPATH for the planning part)."""
+Run: /usr/bin/python3 bench/bench_closed_loop.py [--trials N] [--skip-plan] [--inspect-seeds N]"""
 
 import argparse
 import os
@@ -98,14 +97,50 @@ def planning_figures(seeds):
                  t_scan, rig.elapsed_s, plane_err, standoff_err, n_missing))
 
 
+def inspect_figures(seeds):
+    import tempfile
+    from BladeInspect.core import transforms as tf
+    from BladeInspect.inspect.closed_loop import run_inspect
+    from BladeInspect.inspect.pipeline import load_nominal
+    from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
+    print("== inspect loop: demo blade, random fixture pose, 30 um bump, sections 10..90 %")
+    nominal = load_nominal(None)
+    centre = nominal.samples.xyz[np.argmin(np.linalg.norm(
+        nominal.samples.xyz - [0.0, 5.0, 35.0], axis=1))]
+    for seed in seeds:
+        truth = random_fixture_pose(np.random.default_rng(seed))
+        rig = SimulatedRig(nominal, truth, error_field=make_bump(centre, 6.0, 0.03), seed=seed)
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            out = run_inspect(None, os.path.join(tmp, "out"), rig=rig, nominal=nominal,
+                              seed=seed, document=False)
+            wall = time.perf_counter() - t0
+        res = out["result"]
+        err = tf.corner_displacement(res.measured_to_cad, truth, nominal.bbox_corners)
+        planned = res.columns["phase"] == "planned"
+        # Planned points as measured (table frame) put into the CAD by the simulator's truth.
+        cad_true = tf.apply_transform(truth, tf.apply_transform(
+            tf.invert_transform(res.measured_to_cad), res.points_cad[planned]))
+        dists = np.min([np.abs((cad_true - s.plane_point) @ s.plane_normal)
+                        for s in out["plan"].sections], axis=0)
+        print("   seed %d: pose error %.2f um, bound %.2f um (ratio %.2f); bound after blind "
+              "%.2f um; planned points %d, max |plane dist| by truth %.4f mm; re-plans %d; "
+              "wall %.1f s"
+              % (seed, err * 1e3, res.pose_uncertainty_mm * 1e3,
+                 err / res.pose_uncertainty_mm, out["uncertainty_after_blind_mm"] * 1e3,
+                 int(planned.sum()), dists.max(), len(out["replans"]) - 1, wall))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--trials", type=int, default=20)
     parser.add_argument("--skip-plan", action="store_true")
+    parser.add_argument("--inspect-seeds", type=int, default=3)
     args = parser.parse_args()
     calibration_figures(args.trials)
     if not args.skip_plan:
         planning_figures((21, 22, 23))
+    inspect_figures(range(41, 41 + args.inspect_seeds))
 
 
 if __name__ == "__main__":
