@@ -187,6 +187,16 @@ def run():
         check("register active with blade and points",
               commands.BY_NAME["BladeInspect_Register"].IsActive())
         Gui.Selection.clearSelection()
+
+        def click_cancel():
+            buttons = Gui.getMainWindow().statusBar().findChildren(QtGui.QPushButton)
+            [b for b in buttons if b.text() == "Cancel"][-1].click()
+        QtCore.QTimer.singleShot(0, click_cancel)   # fires at the job's first progress report
+        cancelled = commands.BY_NAME["BladeInspect_Register"].register(meas, blade)
+        check("registration cancelled by its Cancel button", cancelled is None and
+              progress.MESSAGES[-1] == ("Register", "cancelled"), progress.MESSAGES[-1:])
+        check("cancelled registration leaves no object",
+              not objects.find_objects(doc, "BladeInspect::Registration"))
         Gui.runCommand("BladeInspect_Register")
         regs = objects.find_objects(doc, "BladeInspect::Registration")
         check("registration made", len(regs) == 1, progress.MESSAGES[-1:])

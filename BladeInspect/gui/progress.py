@@ -54,17 +54,19 @@ class StatusProgress:
         self.status.addPermanentWidget(self.bar)
         self.status.addPermanentWidget(self.button)
         self.messages = []
-        self(0.0, "starting")
+        self.show(0.0, "starting")
 
     def cancel(self):
         self.cancelled = True
 
-    def __call__(self, fraction, message):
+    def show(self, fraction, message):
         self.bar.setValue(int(round(1000 * min(max(fraction, 0.0), 1.0))))
-        text = "%s: %s" % (self.title, message)
         self.messages.append((fraction, message))
-        self.status.showMessage(text)
+        self.status.showMessage("%s: %s" % (self.title, message))
         QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+
+    def __call__(self, fraction, message):
+        self.show(fraction, message)
         if self.cancelled:
             raise Cancelled("%s cancelled" % self.title)
 
