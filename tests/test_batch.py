@@ -51,7 +51,7 @@ class BatchTest(unittest.TestCase):
         with open(os.path.join(cls.scans, "notes.md"), "w") as fh:
             fh.write("not a point file\n")
         cls.out = os.path.join(cls.tmp, "lot")
-        cls.run = B.run_batch(None, cls.scans, cls.out, workers=2)
+        cls.lot = B.run_batch(None, cls.scans, cls.out, workers=2)
         cls.summary = read_summary(os.path.join(cls.out, "summary.csv"))
 
     @classmethod
@@ -74,7 +74,7 @@ class BatchTest(unittest.TestCase):
                              "inspection.FCStd"} <= files)
         self.assertFalse(os.path.exists(os.path.join(self.out, "broken", "result.json")))
         self.assertEqual(sorted(os.listdir(self.out)), ["blade_a", "blade_b", "summary.csv"])
-        self.assertIn("1 pass, 1 fail, 1 error", self.run["message"])
+        self.assertIn("1 pass, 1 fail, 1 error", self.lot["message"])
 
     def test_per_section_columns(self):
         a = self.summary[0]
