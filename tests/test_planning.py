@@ -68,9 +68,10 @@ class TestPlanOnSimulatedRig(unittest.TestCase):
             off_plane = (measured - section.plane_point) @ section.plane_normal
             self.assertLess(np.max(np.abs(off_plane)), 0.01)
             # The simulator's SNR comes from its own ray's normal: it must be what was planned
-            # (to 0.01 deg of incidence; the two normals meet at the faces' shared edges).
+            # (to about 0.3 deg of incidence: on an edge of 0.3 mm radius a hit a micrometre or
+            # so from the target already turns the normal by that much).
             np.testing.assert_allclose(readings.snr, section.expected_snr[path.points],
-                                       rtol=1e-3)
+                                       rtol=5e-3)
         for counts in seen:
             self.assertTrue(np.all(counts == 1), "every planned point is on exactly one path")
         for section in plan.sections:

@@ -40,6 +40,7 @@ LINE_OF_SIGHT_TOLERANCE_MM = 0.01
 # the angle between a blade surface and a cross-section plane makes them converge in a few.
 SECTION_PROJECTIONS = 8
 SECTION_TOLERANCE_MM = 1e-6
+NORMAL_PROBE_MM = 0.01
 # Consecutive section points farther apart than this many spacings start a new path.
 PATH_GAP_SPACINGS = 3.0
 
@@ -213,7 +214,18 @@ def nominal_section(nominal, plane_point, plane_normal, spacing):
         if np.max(np.abs(off_plane)) < SECTION_TOLERANCE_MM:
             break
         p = res.closest - np.outer(off_plane, n)
-    return res.closest, res.normal, contours
+    return res.closest, _surface_normals(nominal, res.closest), contours
+
+
+def _surface_normals(nominal, points):
+    """Outward normals at points on the CAD. The distance query's normal of a point lying on
+    the surface is the direction to it, undefined at that distance (on a face's edge it comes
+    out arbitrary): ask instead about points lifted off the surface along the nearest sample's
+    normal, whose closest points are the same and whose direction is the surface normal."""
+    from scipy.spatial import cKDTree
+    _, idx = cKDTree(nominal.samples.xyz).query(points)
+    lifted = points + NORMAL_PROBE_MM * nominal.samples.normal[idx]
+    return nominal.signed_distance(lifted).normal
 
 
 # ---------------------------------------------------------------- angles
