@@ -46,7 +46,17 @@ class TestInspectLoop(unittest.TestCase):
                                error_field=cls.bump, seed=31)
         cls.tmp = tempfile.mkdtemp(prefix="bi-inspect-")
         cls.out = os.path.join(cls.tmp, "out")
-        cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=nominal,
+        # A CMM's points of the same sections (CAD frame, the same bump, 1 um noise).
+        from BladeInspect.rig.planning import nominal_section
+        rng = np.random.default_rng(5)
+        cmm = []
+        for h in HEIGHTS:
+            p, n, _ = nominal_section(nominal, (0.0, 0.0, 0.7 * h), (0.0, 0.0, 1.0), 0.5)
+            cmm.append(p + n * (cls.bump(p) + rng.uniform(-0.001, 0.001, len(p)))[:, None])
+        cls.cmm = np.vstack(cmm)
+        cmm_path = os.path.join(cls.tmp, "cmm.csv")
+        np.savetxt(cmm_path, cls.cmm, delimiter=",", header="x,y,z", comments="", fmt="%.6f")
+        cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=nominal, cmm=cmm_path,
                                   section_heights=HEIGHTS, seed=31, document=False,
                                   scan_options={"n_sections": 5})
         with open(os.path.join(cls.out, "result.json")) as fh:
@@ -112,6 +122,11 @@ class TestInspectLoop(unittest.TestCase):
             expected_rms = np.sqrt(np.mean(field[mine] ** 2))
             self.assertAlmostEqual(sec["optical"]["max_abs_mm"], expected_max, delta=0.002)
             self.assertAlmostEqual(sec["optical"]["rms_mm"], expected_rms, delta=0.002)
+            # The CMM's columns stand beside, read from its own points.
+            cmm = self.cmm[np.abs((self.cmm - p) @ n) < 0.25]
+            self.assertEqual(sec["cmm"]["n"], len(cmm))
+            self.assertAlmostEqual(sec["cmm"]["max_abs_mm"], np.max(np.abs(self.bump(cmm))),
+                                   delta=0.002)
         # The bump is really seen at 30 % and not at 70 %.
         self.assertGreater(self.result_json["sections"][0]["optical"]["max_abs_mm"], 0.02)
         self.assertLess(self.result_json["sections"][1]["optical"]["max_abs_mm"], 0.005)
