@@ -28,6 +28,12 @@ from .result import RegistrationResult
 COARSE_SUBSAMPLE = 1500
 FINE_SUBSAMPLE = 30000
 FULL_CLOUD_STEPS = 3
+# The coarse stage searches around its best candidate when that candidate's median residual is
+# above this (several times a point sensor's noise, well below any misalignment worth keeping).
+SEARCH_MEDIAN_MM = 0.015
+SEARCH_ROUNDS = 4
+SEARCH_SHIFTS_MM = (-6.0, -3.0, 3.0, 6.0)
+SEARCH_TURNS_DEG = (-8.0, -4.0, 4.0, 8.0)
 
 
 def _no_progress(fraction, message):
@@ -118,29 +124,62 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
     pts, w = measured_xyz[sub], None if weights is None else weights[sub]
     closest = _sample_closest_fn(nominal)
     options = icp_mod.ICPOptions(max_iter=30)
+
+    def refine(T):
+        fit = icp_mod.icp(pts, w, closest, T, options)
+        # Median |residual| over all points: every measured point lies on the part, so a wrong
+        # pose cannot look good by trimming away what it does not explain.
+        return float(np.median(np.abs(fit.distances))), fit.transform
+
     ranked = []
     for i, T in enumerate(candidates):
-        progress(i / len(candidates), "coarse registration: candidate %d of %d"
+        progress(0.8 * i / len(candidates), "coarse registration: candidate %d of %d"
                  % (i + 1, len(candidates)))
-        fit = icp_mod.icp(pts, w, closest, T, options)
-        inlier_fraction = float(np.mean(fit.inlier))
-        ranked.append((float(fit.rms) if inlier_fraction > 0.5 else np.inf,
-                       inlier_fraction, i, T, fit.transform))
-    # A candidate that explains most points with a small residual wins; among those the smaller
-    # residual. Trimming alone would let a wrong pose that fits a few points look good.
-    best = min(ranked, key=lambda r: (r[0] if r[1] > 0.8 else np.inf, -r[1], r[0]))
+        score, refined = refine(T)
+        ranked.append((score, i, T, refined))
+    best = min(ranked, key=lambda r: r[0])
+    score, refined = best[0], best[3]
+    search = {"start_median_mm": score, "tried": 0, "rounds": 0}
+    if score > SEARCH_MEDIAN_MM:
+        # A sparse scan (few sections on a nearly helical blade) can leave the right candidate
+        # in a neighbouring minimum that is far above the sensor's noise: look around it.
+        for round_ in range(SEARCH_ROUNDS):
+            progress(0.8 + 0.2 * round_ / SEARCH_ROUNDS, "coarse registration: local search")
+            improved = False
+            for step in _search_steps(axes_n):
+                s, T = refine(step @ refined)
+                search["tried"] += 1
+                if s < 0.8 * score:
+                    score, refined, improved = s, T, True
+            search["rounds"] = round_ + 1
+            if not improved or score <= SEARCH_MEDIAN_MM:
+                break
+    search["final_median_mm"] = score
     return {
-        "measured_to_cad": best[4],
-        "pca_measured_to_cad": best[3],
+        "measured_to_cad": refined,
+        "pca_measured_to_cad": best[2],
         "eigenvalues": {"measured": axes_m.eigenvalues.tolist(),
                         "nominal": axes_n.eigenvalues.tolist()},
         "candidates": [{"measured_to_cad": T.tolist(), "refined_to_cad": Tr.tolist(),
-                        "residual_mm": (None if not np.isfinite(r) else r),
-                        "inlier_fraction": f}
-                       for r, f, _, T, Tr in ranked],
-        "chosen": int(best[2]),
+                        "residual_mm": r}
+                       for r, _, T, Tr in ranked],
+        "chosen": int(best[1]),
+        "local_search": search,
         "warning": warning,
     }
+
+
+def _search_steps(axes):
+    """Small rigid moves about the nominal's centroid: shifts along and turns about each
+    principal axis, in both directions."""
+    c = axes.centroid
+    for k in range(3):
+        a = axes.axes[:, k]
+        for d in SEARCH_SHIFTS_MM:
+            yield tf.make_transform(np.eye(3), d * a)
+        for ang in SEARCH_TURNS_DEG:
+            R = tf.rotation_from_vector(np.radians(ang) * a)
+            yield tf.make_transform(R, c - R @ c)
 
 
 # ---------------------------------------------------------------- fine
@@ -228,6 +267,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
         "eigenvalues": coarse["eigenvalues"],
         "candidates": coarse["candidates"],
         "chosen": coarse["chosen"],
+        "local_search": coarse["local_search"],
         "pca_source": "reconstruction" if pca_points is not None else "points",
         "warning": coarse["warning"],
     }
