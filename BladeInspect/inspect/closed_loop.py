@@ -165,14 +165,22 @@ def _pointset(xyz, snr, columns, source):
 def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGHTS,
                 complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
-                scan_options=None):
+                scan_options=None, on_plan=None):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (rig.scan.scan_to_dir, e.g. n_sections).
+    ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
     Returns a summary dict. All files appear in out_dir together, or none on an error."""
     from ..rig import scan as scan_mod
     from ..rig.kinematics import RigKinematics
     from ..rig.planning import plan_sections
+    if on_plan is not None:
+        plan_only = plan_sections
+
+        def plan_sections(*args, **kwargs):
+            plan = plan_only(*args, **kwargs)
+            on_plan(plan)
+            return plan
     from . import pipeline
     from . import sections as sections_mod
     from . import verdict as verdict_mod
