@@ -13,9 +13,10 @@ class BladeInspectWorkbench(FreeCADGui.Workbench):
         self.__class__.Icon = resources.icon_path("BladeInspect")
 
     def Initialize(self):
-        from BladeInspect.gui import commands
+        from BladeInspect.gui import commands, loop_commands
         self.appendToolbar("BladeInspect", commands.TOOLBAR)
-        self.appendMenu("BladeInspect", commands.MENU)
+        self.appendToolbar("BladeInspect loop", loop_commands.NAMES)
+        self.appendMenu("BladeInspect", commands.MENU + ["Separator"] + loop_commands.NAMES)
         commands.register_preferences()
 
     def Activated(self):

@@ -1,0 +1,416 @@
+"""The closed-loop commands (issue 8, item 5): inspect a blade, calibrate the rig, add a CMM file
+to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
+function as the command line (run_inspect, run_calibration, section_table, run_simulation)
+through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
+or a cancel leaves the document as it was."""
+import os
+import tempfile
+
+import numpy as np
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtGui
+
+from ..app import loop, objects, settings
+from ..core.errors import InputError
+from . import commands, progress, taskpanels
+from .session import RIG
+
+CMM_FILTER = "CMM files (*.csv *.txt *.dat);;All files (*)"
+RIG_FILTER = "Rig calibration (*.json);;All files (*)"
+
+# Results shown to the user, newest last: (title, text). Tests read them.
+RESULTS = []
+# The RIG.json the last calibration wrote: the inspect panel offers it.
+LAST_RIG_FILE = [None]
+# Callables told of each plan once it is drawn, before its paths run: listener(plan, obj).
+# Tests photograph the view there.
+PLAN_LISTENERS = []
+
+
+def ask_save_file(title, filters, default_name):
+    path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), title,
+                                                default_name, filters)
+    return path or None
+
+
+def show_result(title, text):
+    RESULTS.append((title, text))
+    FreeCAD.Console.PrintMessage("BladeInspect: %s: %s\n" % (title, text))
+    if progress.SHOW_DIALOGS and FreeCAD.GuiUp:
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Information, "BladeInspect: " + title, text,
+                                QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
+        box.setModal(False)
+        box.finished.connect(lambda *_: progress._open_boxes.remove(box))
+        progress._open_boxes.append(box)
+        box.show()
+
+
+def parse_heights(text):
+    """Section heights typed as "10, 30, 50" (% of span)."""
+    parts = [t for t in text.replace(";", ",").replace(" ", ",").split(",") if t]
+    try:
+        heights = [float(t) for t in parts]
+    except ValueError:
+        raise InputError("section heights: %r is not a comma-separated list of numbers"
+                         % text) from None
+    if not heights:
+        raise InputError("section heights: at least one height is needed")
+    bad = [h for h in heights if not (np.isfinite(h) and 0.0 <= h <= 100.0)]
+    if bad:
+        raise InputError("section heights: %g is outside 0-100 %% of the span" % bad[0])
+    return heights
+
+
+def output_folder(doc, kind):
+    """A new folder for a command's files: beside the saved document, else a temporary one."""
+    if doc.FileName:
+        base = os.path.splitext(doc.FileName)[0] + "_" + kind
+        os.makedirs(base, exist_ok=True)
+        return tempfile.mkdtemp(prefix=kind + "-", dir=base)
+    return tempfile.mkdtemp(prefix="bladeinspect-%s-" % kind)
+
+
+def _hide_measured_frame(doc, measurement):
+    """The measurement lies in the table or a random frame, away from the CAD and its map."""
+    if measurement.ViewObject is not None:
+        measurement.ViewObject.Visibility = False
+
+
+def _show_table(title, table, note):
+    from ..inspect.report import section_rows
+    header, rows = section_rows(table)
+    notes = [note] + list(table.warnings)
+    FreeCADGui.Control.closeDialog()
+    FreeCADGui.Control.showDialog(taskpanels.TablePanel(title, header, rows,
+                                                        "; ".join(n for n in notes if n)))
+
+
+# ---------------------------------------------------------------- task panels
+
+class InspectPanel(taskpanels._Panel):
+    """Nominal section heights, tolerance, seed and the rig calibration file."""
+    title = "Inspect"
+
+    def __init__(self, on_accept):
+        super().__init__()
+        from ..inspect.closed_loop import DEFAULT_HEIGHTS
+        self.on_accept = on_accept
+        self.heights = QtGui.QLineEdit(", ".join("%g" % h for h in DEFAULT_HEIGHTS))
+        self.heights.setToolTip("Nominal sections to measure, % of the span from hub to tip")
+        self.tolerance = taskpanels._spin(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm")
+        self.seed = taskpanels._spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.seed.setToolTip("Fixture pose of the simulated rig and the registration's sampling")
+        self.rig_file = QtGui.QLineEdit(LAST_RIG_FILE[0] or "")
+        self.rig_file.setToolTip("RIG.json from Calibrate; empty: the nominal kinematics")
+        self.layout.addRow("Section heights (%)", self.heights)
+        self.layout.addRow("Tolerance", self.tolerance)
+        self.layout.addRow("Seed", self.seed)
+        self.layout.addRow("Rig calibration", self.rig_file)
+        self.layout.addRow(QtGui.QLabel("Rig: " + (RIG.spec if RIG.connected else
+                                                    "simulated (none connected)")))
+
+    def options(self):
+        return {"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
+                "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None}
+
+    def accept(self):
+        options = self.options()   # read before closing: closing deletes the widgets
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(**options)
+        return True
+
+
+class CalibratePanel(taskpanels.ConnectRigPanel):
+    """The rig (simulated or a serial port), the reference sphere's diameter and, for the
+    simulated rig, the axis errors to inject."""
+    title = "Calibrate rig"
+
+    def __init__(self, on_accept):
+        from ..rig.calibration import DEFAULT_DIAMETER
+        super().__init__(on_accept)
+        self.diameter = taskpanels._spin(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
+        self.offset = taskpanels._spin(0.0, 0.0, 10.0, 3, "mm")
+        self.tilt = taskpanels._spin(0.0, 0.0, 5.0, 3, "deg")
+        self.layout.addRow("Sphere diameter", self.diameter)
+        self.layout.addRow("Axis offset (simulated)", self.offset)
+        self.layout.addRow("Axis tilt (simulated)", self.tilt)
+        self.kind.currentIndexChanged.connect(self._update_errors)
+        self._update_errors()
+
+    def _update_errors(self, *_):
+        simulated = self.kind.currentIndex() == 0
+        self.offset.setEnabled(simulated)
+        self.tilt.setEnabled(simulated)
+
+    def accept(self):
+        options = {"rig_spec": self.spec(), "seed": self.seed.value(),
+                   "sphere_diameter": self.diameter.value()}
+        if options["rig_spec"] == "sim":
+            options.update(axis_offset_mm=self.offset.value(), axis_tilt_deg=self.tilt.value())
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(**options)
+        return True
+
+
+class SimulatePanel(taskpanels._Panel):
+    """The simulation test bed's options (inspect.simulate.simulate_measurement)."""
+    title = "Simulation test bed"
+
+    def __init__(self, on_accept):
+        super().__init__()
+        self.on_accept = on_accept
+        self.points = taskpanels._spin(20000, 10, 2000000)
+        self.noise = QtGui.QComboBox()
+        self.noise.addItems(["uniform", "normal"])
+        self.outliers = taskpanels._spin(0.0, 0.0, 0.5, 3)
+        self.seed = taskpanels._spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.layout.addRow("Surface points", self.points)
+        self.layout.addRow("Measurement error", self.noise)
+        self.layout.addRow("Outlier fraction", self.outliers)
+        self.layout.addRow("Seed", self.seed)
+
+    def options(self):
+        return {"seed": self.seed.value(), "n_points": self.points.value(),
+                "noise": self.noise.currentText(), "outlier_fraction": self.outliers.value()}
+
+    def accept(self):
+        options = self.options()
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(**options)
+        return True
+
+
+# ---------------------------------------------------------------- commands
+
+class Inspect(commands._Command):
+    name = "BladeInspect_Inspect"
+    menu = "Inspect..."
+    tip = ("The whole loop: blind section scan, registration, paths planned from the CAD at "
+           "its nominal sections (drawn before they run), their scan, Table 2 and verdict")
+
+    def ready(self):
+        return commands.find_nominal() is not None
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(InspectPanel(self.start))
+
+    def start(self, heights_text, tolerance, seed, rig_file=None):
+        try:
+            heights = parse_heights(heights_text)
+        except InputError as exc:
+            progress.report_error("Inspect", str(exc))
+            return None
+        summary = self.inspect(commands.find_nominal(), heights, tolerance, seed, rig_file)
+        if summary is not None:
+            self.show(summary)
+        return summary
+
+    def inspect(self, nominal_obj, heights, tolerance, seed, rig_file=None):
+        """run_inspect on the nominal with the connected rig (else the simulated one); the plan
+        drawn as it is made; the points, registration, deviation map and section profiles
+        added. Returns run_inspect's summary with the new objects under "objects", or None."""
+        from ..core.pointio import read_points
+        from ..inspect.closed_loop import run_inspect
+        doc = nominal_obj.Document
+        out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
+
+        def draw(plan):
+            obj = loop.show_plan(doc, plan)
+            doc.recompute()
+            commands.fit_view()
+            QtGui.QApplication.processEvents()
+            for listener in PLAN_LISTENERS:
+                listener(plan, obj)
+
+        def job(p):
+            if rig_file and not os.path.isfile(rig_file):
+                raise InputError("rig calibration %s: no such file" % rig_file)
+            with objects.building(doc, "Inspect"):
+                summary = run_inspect(
+                    getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
+                    section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
+                    progress=p, rig=RIG.rig if RIG.connected else None,
+                    nominal=objects.nominal_of(nominal_obj), document=False, on_plan=draw)
+                result = summary["result"]
+                p(0.95, "adding the inspection to the document")
+                points_csv = os.path.join(out_dir, "points.csv")
+                pointset = read_points(points_csv)
+                if len(pointset.xyz) != len(result.points_cad):
+                    raise InputError("%s: %d rows, the registration has %d points"
+                                     % (points_csv, len(pointset.xyz), len(result.points_cad)))
+                measurement = objects.make_measurement(doc, pointset, name="InspectionPoints",
+                                                       source_file=points_csv)
+                registration = objects.make_registration(doc, result, measurement, nominal_obj,
+                                                         seed, name="Inspection")
+                n_blind = int(np.count_nonzero(result.columns["phase"] == "blind"))
+                loop.mark_inspection(registration, heights, n_blind, out_dir)
+                deviation_map = objects.make_deviation_map(doc, registration,
+                                                           settings.colour_limit())
+                profiles = objects.make_section_profiles(doc, summary["sections"], registration)
+            _hide_measured_frame(doc, measurement)
+            summary["objects"] = {"measurement": measurement, "registration": registration,
+                                  "deviation_map": deviation_map, "profiles": profiles,
+                                  "plan": doc.getObject("PlannedPaths")}
+            return summary
+        summary = progress.run("Inspect", job)
+        if summary is not None:
+            doc.recompute()
+            commands.fit_view()
+        return summary
+
+    @staticmethod
+    def show(summary):
+        note = ("%s. Pose uncertainty %.2f um after the planned scan (%.2f um after the blind "
+                "scan). Files in %s" % (summary["verdict"]["summary"],
+                                        1e3 * summary["pose_uncertainty_mm"],
+                                        1e3 * summary["uncertainty_after_blind_mm"],
+                                        summary["out_dir"]))
+        _show_table("Inspection: Table 2 at the nominal sections", summary["sections"], note)
+
+
+class Calibrate(commands._Command):
+    name = "BladeInspect_Calibrate"
+    menu = "Calibrate rig..."
+    tip = ("Measure a reference sphere at several rotary angles, find the rotary axis and "
+           "write RIG.json (simulated rig or a serial port)")
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(CalibratePanel(self.start))
+
+    def start(self, **options):
+        out_path = ask_save_file("Write the rig calibration", RIG_FILTER, "RIG.json")
+        if out_path:
+            return self.calibrate(out_path, **options)
+        return None
+
+    def calibrate(self, out_path, rig_spec="sim", sphere_diameter=None, seed=0,
+                  **simulated_errors):
+        from ..rig.calibration import DEFAULT_DIAMETER, run_calibration
+        if rig_spec != "sim" and RIG.connected and RIG.spec == rig_spec:
+            # The calibration opens the port itself; the scan session would hold it busy.
+            RIG.disconnect()
+        diameter = DEFAULT_DIAMETER if sphere_diameter is None else sphere_diameter
+        result = progress.run("Calibrate", lambda p: run_calibration(
+            out_path, rig_spec=rig_spec, sphere_diameter=diameter, seed=seed, progress=p,
+            **simulated_errors))
+        if result is not None:
+            LAST_RIG_FILE[0] = out_path
+            show_result("Calibrate", calibration_text(result, out_path))
+        return result
+
+
+def calibration_text(result, out_path):
+    lines = ["Rotary axis through (%.4f, %.4f, %.4f) mm, direction (%.7f, %.7f, %.7f)."
+             % (tuple(result["axis_point"]) + tuple(result["axis_direction"])),
+             "Tilt from +Y: %.4f deg about Z, %.4f deg about X. Sphere measured %.4f mm "
+             "(nominal %.4f); circle residual RMS %.4f mm."
+             % (result["axis_tilt_about_z_deg"], result["axis_tilt_about_x_deg"],
+                result["measured_diameter_mm"], result["sphere_diameter_mm"],
+                result["circle_residual_rms_mm"])]
+    truth = result.get("truth")
+    if truth:
+        p, d = np.array(result["axis_point"]), np.array(result["axis_direction"])
+        tp, td = np.array(truth["axis_point"]), np.array(truth["axis_direction"])
+        off = (p - tp) - np.dot(p - tp, td) * td
+        angle = np.degrees(np.arccos(np.clip(abs(np.dot(d, td)), -1.0, 1.0)))
+        lines.append("Against the simulator's truth: axis position %.2f um, direction %.5f deg."
+                     % (1e3 * np.linalg.norm(off), angle))
+    lines.append("Written to %s." % out_path)
+    return "\n".join(lines)
+
+
+class AddCmm(commands._Command):
+    name = "BladeInspect_AddCmm"
+    menu = "Add CMM file..."
+    tip = ("Compare a CMM file's sections with the optical ones (Table 2): for an inspection, "
+           "at its nominal sections")
+
+    def ready(self):
+        reg = commands.find_input((objects.Registration.Type,))
+        return reg is not None and reg.Nominal is not None
+
+    def Activated(self):
+        path = commands.ask_open_file("CMM file", CMM_FILTER)
+        if path:
+            table = self.add(commands.find_input((objects.Registration.Type,)), path)
+            if table is not None:
+                self.show(table)
+
+    def add(self, registration, cmm_path):
+        def job(p):
+            p(0.2, "reading %s and cutting the sections" % os.path.basename(cmm_path))
+            table, _ = loop.cmm_section_table(registration, cmm_path)
+            return table
+        return progress.run("Add CMM file", job)
+
+    @staticmethod
+    def show(table):
+        _show_table("Table 2: optical and CMM", table, "CMM: %s" % table.cmm_source)
+
+
+class Simulate(commands._Command):
+    name = "BladeInspect_Simulate"
+    menu = "Simulation test bed..."
+    tip = ("The paper's simulation test bed: points from the CAD (or the demo blade) at a "
+           "random pose with measurement error, registered blind; pose error against its bound")
+
+    def Activated(self):
+        FreeCADGui.Control.showDialog(SimulatePanel(self.simulate))
+
+    def simulate(self, seed=0, **options):
+        """run_simulation on the document's nominal, else a new demo blade; adds the simulated
+        measurement, its registration and deviation map. Returns (report, registration)."""
+        from ..inspect.simulate import run_simulation
+        doc = commands.active_document()
+
+        def job(p):
+            with objects.building(doc, "Simulation test bed"):
+                nominal_obj = commands.find_nominal()
+                if nominal_obj is None:
+                    p(0.0, "building the demo blade")
+                    nominal_obj = objects.make_demo_blade(doc)
+                    doc.recompute()
+                result, report, pointset = run_simulation(
+                    objects.nominal_of(nominal_obj), seed=seed, progress=p, **options)
+                result.cad_source = nominal_obj.Label
+                measurement = objects.make_measurement(doc, pointset, name="SimulatedScan")
+                registration = objects.make_registration(doc, result, measurement, nominal_obj,
+                                                         seed, name="SimulatedRegistration")
+                for prop, tip, value in (
+                        ("PoseErrorMm", "Pose error against the simulator's truth (largest "
+                         "bounding-box corner displacement), mm", report["pose_error_mm"]),
+                        ("PoseErrorOverBound", "Pose error / its Cramer-Rao bound",
+                         report["pose_error_over_bound"])):
+                    registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
+                    setattr(registration, prop, value)
+                deviation_map = objects.make_deviation_map(doc, registration,
+                                                           settings.colour_limit())
+            _hide_measured_frame(doc, measurement)
+            return report, registration, deviation_map
+        outcome = progress.run("Simulation test bed", job)
+        if outcome is None:
+            return None
+        report, registration, _ = outcome
+        doc.recompute()
+        commands.fit_view()
+        show_result("Simulation test bed", simulation_text(report))
+        return report, registration
+
+
+def simulation_text(report):
+    return ("Pose error %.3f um = %.2f x its bound (%.3f um). Residual RMS %.4f mm (injected "
+            "%.4f), min %.4f, max %.4f mm; paper: RMS 0.0019, min -0.0053, max 0.006."
+            % (1e3 * report["pose_error_mm"], report["pose_error_over_bound"],
+               1e3 * report["pose_uncertainty_mm"], report["residual_rms_mm"],
+               report["noise_rms_injected_mm"], report["residual_min_mm"],
+               report["residual_max_mm"]))
+
+
+COMMANDS = [Inspect(), Calibrate(), AddCmm(), Simulate()]
+NAMES = [c.name for c in COMMANDS]
+BY_NAME = {c.name: c for c in COMMANDS}
+
+for _command in COMMANDS:
+    FreeCADGui.addCommand(_command.name, _command)
