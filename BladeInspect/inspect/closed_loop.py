@@ -191,7 +191,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
     if complete:
-        raise InputError("--complete: the complete scan is not available in this version")
+        from ..rig.complete import _check_step
+        pitch = _check_step(pitch, "--pitch")
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
     timing = {}
     t0 = time.perf_counter()
@@ -206,11 +207,17 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
         with pipeline.AtomicOutput(out_dir) as out:
             work = tempfile.mkdtemp(prefix="blind-", dir=out.tmp)
             try:
-                summary = _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data,
-                                tolerance, out, work, timing, progress, plan_sections,
-                                scan_mod, pipeline, sections_mod, verdict_mod, write_report,
-                                document, dict(scan_options or {}),
-                                cad_path or "built-in demo blade")
+                if complete:
+                    summary = _complete_loop(nominal, rig, kinematics, heights, seed, epsilon,
+                                             cmm_data, tolerance, pitch, out, work, timing,
+                                             progress, document, dict(scan_options or {}),
+                                             cad_path or "built-in demo blade")
+                else:
+                    summary = _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data,
+                                    tolerance, out, work, timing, progress, plan_sections,
+                                    scan_mod, pipeline, sections_mod, verdict_mod, write_report,
+                                    document, dict(scan_options or {}),
+                                    cad_path or "built-in demo blade")
             finally:
                 shutil.rmtree(work, ignore_errors=True)
     finally:
@@ -341,3 +348,118 @@ def _blind_column(pointset, name, n):
     if values is None:
         return np.full(n, np.nan)
     return np.asarray(values, dtype=float)
+
+
+def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
+                   out, work, timing, progress, document, scan_options, cad_label):
+    """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
+    the whole blade rastered every ``pitch`` mm (rig.complete) from that pose, ICP on every
+    point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
+    from ..rig import scan as scan_mod
+    from ..rig.complete import plan_complete, scan_complete
+    from . import pipeline
+    from . import sections as sections_mod
+    from . import verdict as verdict_mod
+    from .report import write_report
+    t0 = time.perf_counter()
+    progress(0.0, "blind section scan")
+    scan_options.setdefault("epsilon", epsilon)
+    blind_summary = scan_mod.scan_to_dir(work, rig, seed=seed, kinematics=kinematics,
+                                         progress=lambda f, m: progress(0.15 * f, m),
+                                         **scan_options)
+    blind = read_points(os.path.join(work, "points.csv"))
+    with open(os.path.join(work, "scan.json")) as fh:
+        scan_record = json.load(fh)
+    timing["blind_scan"] = time.perf_counter() - t0
+    blind_rig_s = float(rig.elapsed_s)
+
+    t0 = time.perf_counter()
+    first = pipeline.register(nominal, blind, seed=seed,
+                              progress=lambda f, m: progress(0.15 + 0.1 * f, m))
+    timing["register_blind"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    progress(0.25, "planning the complete raster from the CAD")
+    plan = plan_complete(nominal, first.measured_to_cad, rig.sensor, rig.limits, pitch=pitch,
+                         kinematics=kinematics)
+    timing["plan"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    xyz_c, snr_c, line_c, angle_c, _, reading_c, pass_records = scan_complete(
+        rig, plan, kinematics, lambda f, m: progress(0.3 + 0.3 * f, m))
+    timing["complete_scan"] = time.perf_counter() - t0
+    complete_rig_s = float(rig.elapsed_s) - blind_rig_s
+    worst = float(np.max(np.abs(reading_c - plan.standoff_mm))) if len(reading_c) else np.inf
+    if len(xyz_c) < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
+        raise InputError("inspect --complete: the raster does not find the blade where the "
+                         "blind scan's registration put it (%d of %d planned points read, "
+                         "standoff off by up to %.2f mm)" % (len(xyz_c), plan.n_points, worst))
+
+    t0 = time.perf_counter()
+    xyz = np.vstack([blind.xyz, xyz_c])
+    snr = np.concatenate([blind.snr, snr_c])
+    fit = pipeline.fine_register(xyz, snr, nominal, first.measured_to_cad,
+                                 progress=lambda f, m: progress(0.65, m))
+    timing["register_all"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    n_blind = len(blind.xyz)
+    blind_sections = _blind_column(blind, "section", n_blind)
+    first_line = (np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
+    columns = {"section": np.concatenate([blind_sections, first_line + line_c]),
+               "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
+                                            angle_c]),
+               "phase": np.array(["blind"] * n_blind + ["complete"] * len(xyz_c))}
+    everything = _pointset(xyz, snr, columns, "inspect --complete: blind and complete scans")
+    result = _result_from_fit(nominal, everything, fit, first.coarse, dict(timing),
+                              list(first.warnings))
+    result.cad_source = cad_label
+    span_axis, _ = sections_mod.span_axis_of(nominal)
+    rows = np.arange(n_blind, n_blind + len(xyz_c))
+    # _subset drops the section column (raster lines are not the nominal planes), so the table
+    # takes the points within its band of each plane.
+    table = sections_mod.section_table(_subset(result, rows), nominal, heights_pct=heights,
+                                       span_axis=span_axis, cmm=cmm_data)
+    for sec in table.sections:
+        sec.point_index = sec.point_index + n_blind
+    verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    timing["sections"] = time.perf_counter() - t0
+
+    progress(0.85, "writing the report")
+    t0 = time.perf_counter()
+    write_points_csv(out.path("points.csv"), xyz, {"snr": snr, **columns})
+    plan.to_json(out.path("plan.json"))
+    scan_record["phases"] = {
+        "blind": {"points": n_blind, "summary": blind_summary, "rig_s": blind_rig_s},
+        "complete": {"points": int(len(xyz_c)), "planned_points": plan.n_points,
+                     "pitch_mm": plan.pitch_mm, "angles_deg": plan.angles_deg.tolist(),
+                     "passes": pass_records, "rig_s": complete_rig_s,
+                     "simulated_s": timing["complete_scan"],
+                     "sensor_rate_s": len(xyz_c) / float(rig.sensor.rate_hz)}}
+    with open(out.path("scan.json"), "w") as fh:
+        json.dump(scan_record, fh, indent=1, default=pipeline._json_default)
+    files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
+                         title="BladeInspect inspection (complete scan, pitch %g mm)" % pitch)
+    if document:
+        from .document import write_inspection_document
+        write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
+                                  tolerance=tolerance)
+    timing["write"] = time.perf_counter() - t0
+    result.timing_s = timing
+    sections_doc = [dict(sec.to_json(), height_pct=sec.height_pct,
+                         plane={"point": sec.origin.tolist(), "normal": sec.normal.tolist()})
+                    for sec in table.sections]
+    extra = {"sections": sections_doc, "section_table": table.to_json(), "verdict": verdict,
+             "tolerance_mm": tolerance,
+             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
+             "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
+             "n_points_by_phase": {"blind": n_blind, "complete": int(len(xyz_c))},
+             "complete": {"pitch_mm": plan.pitch_mm, "rig_s": complete_rig_s,
+                          "simulated_s": timing["complete_scan"]},
+             "rig_time_s": float(rig.elapsed_s)}
+    pipeline.write_register_outputs(None, result, extra=extra, output=out)
+    progress(1.0, verdict["summary"])
+    return {"result": result, "blind_result": first, "plan": plan, "sections": table,
+            "verdict": verdict, "files": files,
+            "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
+            "pose_uncertainty_mm": result.pose_uncertainty_mm,
+            "complete_rig_s": complete_rig_s, "complete_simulated_s": timing["complete_scan"]}

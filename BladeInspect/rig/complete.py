@@ -35,7 +35,7 @@ CAST_CLEARANCE_MM = 1.0
 CAST_REACH_MM = 1.5
 # One pass of the rig holds whole lines up to about this many points: a serial device's
 # message stays bounded, while the simulator's cost per pass stays negligible.
-MAX_PASS_POINTS = 20000
+MAX_PASS_POINTS = 100000
 
 
 @dataclass

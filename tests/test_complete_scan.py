@@ -1,0 +1,187 @@
+"""The complete scan (rig.complete, `inspect --complete`) of the demo blade at a coarse pitch,
+judged by the simulator's truth pose and by OCC's own distance and normals, not by the ray
+cast the plan itself is made from."""
+import json
+import os
+import shutil
+import tempfile
+import unittest
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from BladeInspect.core import transforms as tf
+from BladeInspect.core.errors import InputError
+
+PITCH = 2.0
+SEED = 11
+# A CAD sample is covered when a measured point lies this close: half the pitch to the nearest
+# line (lines lean up to 5 deg off the sections), plus half a reading step along a surface
+# leaning up to 40 deg from the beam, plus margin.
+COVER_RADIUS_MM = 0.5 * PITCH / np.cos(np.radians(5.0)) + 0.5 * 0.25 / np.cos(np.radians(40.0)) \
+    + 0.1
+EDGE_ZONE_MM = 1.0
+
+
+def demo_nominal():
+    from tests.test_planning import demo_nominal as cached
+    return cached()
+
+
+class TestCompleteRaster(unittest.TestCase):
+    """Plan and scan at the truth pose: what the raster measures is the blade, all of it."""
+
+    @classmethod
+    def setUpClass(cls):
+        from BladeInspect.rig.complete import plan_complete, scan_complete
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        cls.nominal = demo_nominal()
+        cls.truth = random_fixture_pose(np.random.default_rng(SEED))
+        cls.rig = SimulatedRig(cls.nominal, cls.truth, seed=SEED)
+        cls.plan = plan_complete(cls.nominal, cls.truth, cls.rig.sensor, cls.rig.limits,
+                                 pitch=PITCH, kinematics=cls.rig.kinematics)
+        (cls.xyz, cls.snr, cls.line, cls.angle, cls.rows, cls.reading,
+         cls.records) = scan_complete(cls.rig, cls.plan, cls.rig.kinematics)
+        cls.cad = tf.apply_transform(cls.truth, cls.xyz)
+
+    def test_every_planned_point_read_once(self):
+        self.assertEqual(len(self.xyz), self.plan.n_points)
+        rows = np.sort(np.concatenate([p.rows for p in self.plan.passes]))
+        np.testing.assert_array_equal(rows, np.arange(self.plan.n_points))
+        for p in self.plan.passes:
+            self.assertTrue(np.all(self.plan.angle_deg[p.rows] == p.angle_deg))
+        self.assertGreaterEqual(len(self.plan.angles_deg), 3)
+
+    def noise_bound(self):
+        """The sensor model's largest error at the plan's 40 deg incidence limit: the noise
+        grows as sqrt(snr_ref / snr), plus the reading's resolution."""
+        sensor = self.rig.sensor
+        snr = float(sensor.snr(np.array([sensor.standoff]), np.array([np.radians(40.0)]))[0])
+        return sensor.accuracy * np.sqrt(sensor.snr_ref / snr) + sensor.resolution
+
+    def test_points_on_the_cad_within_sensor_noise(self):
+        d = self.nominal.signed_distance(self.cad).distance
+        self.assertLess(np.max(np.abs(d)), self.noise_bound())
+        # OCC's own distance on a subset, independent of the fast distance code.
+        sub = np.random.default_rng(1).choice(len(self.cad), 60, replace=False)
+        occ = self.nominal.signed_distance_occ(self.cad[sub]).distance
+        self.assertLess(np.max(np.abs(occ)), self.noise_bound())
+
+    def test_standoff_within_epsilon(self):
+        # At the true pose every reading is the standoff up to the sensor's noise.
+        err = np.abs(self.reading - self.rig.sensor.standoff)
+        self.assertLess(err.max(), self.noise_bound())
+
+    def test_lines_every_pitch_along_the_axis(self):
+        steps = np.diff(self.plan.line_y)
+        np.testing.assert_allclose(steps, PITCH, atol=1e-9)
+        stage_y = self.plan.stage_xyz[:, 1]
+        np.testing.assert_allclose(stage_y, self.plan.line_y[self.plan.line], atol=1e-9)
+
+    def test_both_sides_and_both_edges_covered(self):
+        nominal = self.nominal
+        s = nominal.samples
+        tree = cKDTree(self.cad)
+        near, _ = tree.query(s.xyz, distance_upper_bound=COVER_RADIUS_MM)
+        covered = np.isfinite(near)
+        for role in ("suction", "pressure"):
+            on = np.isin(s.face, nominal.roles[role])
+            self.assertGreater(covered[on].mean(), 0.99, role)
+            self.assertTrue(np.isin(self.plan.face, nominal.roles[role]).any())
+        # Edges: per span band of the demo blade (span along CAD z, chord along x), the
+        # samples within EDGE_ZONE_MM of the chord's two ends.
+        blade = np.isin(s.face, nominal.roles["suction"] + nominal.roles["pressure"])
+        for z in np.arange(5.0, 70.0, 10.0):
+            band = blade & (np.abs(s.xyz[:, 2] - z) < 1.0)
+            x = s.xyz[band, 0]
+            for name, zone in (("leading", x < x.min() + EDGE_ZONE_MM),
+                               ("trailing", x > x.max() - EDGE_ZONE_MM)):
+                self.assertGreater(covered[band][zone].mean(), 0.98, "%s edge at z=%g"
+                                   % (name, z))
+
+    def test_each_point_from_its_most_head_on_angle(self):
+        # OCC's normal at the nearest CAD point, turned into the machine at every planned angle:
+        # the angle a point was measured from must face it best (ties within 0.5 deg).
+        sub = np.random.default_rng(2).choice(len(self.cad), 80, replace=False)
+        occ = self.nominal.signed_distance_occ(self.cad[sub])
+        normal_table = occ.normal @ tf.invert_transform(self.truth)[:3, :3].T
+        kin = self.rig.kinematics
+        cos = np.array([normal_table @ kin.rotation(a)[2] for a in self.plan.angles_deg])
+        used = np.searchsorted(self.plan.angles_deg, self.angle[sub])
+        chosen = cos[used, np.arange(len(sub))]
+        self.assertTrue(np.all(chosen >= cos.max(axis=0) - np.sin(np.radians(0.5))))
+        self.assertTrue(np.all(chosen >= np.cos(np.radians(40.0)) - 1e-6))
+
+    def test_bad_pitch(self):
+        from BladeInspect.rig.complete import plan_complete
+        for bad in (0.0, -1.0, float("nan"), "abc"):
+            with self.assertRaises(InputError):
+                plan_complete(self.nominal, self.truth, self.rig.sensor, self.rig.limits,
+                              pitch=bad)
+
+
+class TestInspectComplete(unittest.TestCase):
+    """`inspect --complete` end to end at a coarse pitch: files, phases, times, pose."""
+
+    @classmethod
+    def setUpClass(cls):
+        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        cls.nominal = demo_nominal()
+        cls.truth = random_fixture_pose(np.random.default_rng(SEED + 1))
+        cls.rig = SimulatedRig(cls.nominal, cls.truth, seed=SEED)
+        cls.tmp = tempfile.mkdtemp(prefix="bi-complete-")
+        cls.out = os.path.join(cls.tmp, "out")
+        cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=cls.nominal,
+                                  complete=True, pitch=PITCH, seed=SEED, document=False,
+                                  scan_options={"n_sections": 5})
+        with open(os.path.join(cls.out, "scan.json")) as fh:
+            cls.scan_json = json.load(fh)
+        with open(os.path.join(cls.out, "result.json")) as fh:
+            cls.result_json = json.load(fh)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_files_and_phases(self):
+        from BladeInspect.core.pointio import read_points
+        names = set(os.listdir(self.out))
+        for name in ("points.csv", "plan.json", "scan.json", "result.json", "deviations.csv",
+                     "report.html"):
+            self.assertIn(name, names)
+        points = read_points(os.path.join(self.out, "points.csv"))
+        self.assertEqual(set(points.columns["phase"].tolist()), {"blind", "complete"})
+        n_complete = int(np.count_nonzero(points.columns["phase"] == "complete"))
+        self.assertEqual(n_complete, self.scan_json["phases"]["complete"]["points"])
+        self.assertEqual(len(self.result_json["sections"]), 5)
+
+    def test_times_reported(self):
+        phase = self.scan_json["phases"]["complete"]
+        # The real rig's time: at least the sensor's acquisition at its rate.
+        self.assertGreaterEqual(phase["rig_s"], phase["points"] / self.rig.sensor.rate_hz)
+        self.assertAlmostEqual(phase["rig_s"] + self.scan_json["phases"]["blind"]["rig_s"],
+                               self.rig.elapsed_s, places=6)
+        self.assertGreater(phase["simulated_s"], 0.0)
+
+    def test_pose_and_points_by_truth(self):
+        from BladeInspect.core.pointio import read_points
+        pose = np.asarray(self.summary["result"].measured_to_cad)
+        points = read_points(os.path.join(self.out, "points.csv"))
+        complete = points.xyz[points.columns["phase"] == "complete"]
+        moved = np.linalg.norm(tf.apply_transform(pose, complete)
+                               - tf.apply_transform(self.truth, complete), axis=1)
+        self.assertLess(moved.max(), 0.002)
+        d = self.nominal.signed_distance(tf.apply_transform(self.truth, complete)).distance
+        self.assertLess(np.max(np.abs(d)), self.rig.sensor.accuracy + 0.002)
+
+    def test_bad_pitch_is_input_error(self):
+        from BladeInspect.inspect.closed_loop import run_inspect
+        with self.assertRaises(InputError):
+            run_inspect(None, os.path.join(self.tmp, "bad"), rig=self.rig, nominal=self.nominal,
+                        complete=True, pitch=0.0, document=False)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "bad")))
+
+
+if __name__ == "__main__":
+    unittest.main()
