@@ -120,6 +120,32 @@ class TestCompleteRaster(unittest.TestCase):
                               pitch=bad)
 
 
+class TestPasses(unittest.TestCase):
+    def test_whole_lines_up_to_the_limit(self):
+        from BladeInspect.rig.complete import _passes
+        rng = np.random.default_rng(3)
+        for _ in range(20):
+            sizes = rng.integers(1, 9, rng.integers(1, 30))
+            lines = np.repeat(np.arange(len(sizes)), sizes)
+            limit = int(rng.integers(1, 20))
+            passes = _passes(30.0, lines, 100, max_points=limit)
+            rows = np.concatenate([p.rows for p in passes])
+            np.testing.assert_array_equal(rows, 100 + np.arange(len(lines)))
+            for p in passes:
+                own = lines[p.rows - 100]
+                # Whole lines only: a pass starts where a line starts and ends where it ends.
+                self.assertEqual(np.count_nonzero(lines == own[0]),
+                                 np.count_nonzero(own == own[0]))
+                self.assertEqual(np.count_nonzero(lines == own[-1]),
+                                 np.count_nonzero(own == own[-1]))
+                self.assertTrue(len(p.rows) <= limit or len(np.unique(own)) == 1)
+                # No pass could have taken the next line too.
+                nxt = p.rows[-1] + 1 - 100
+                if nxt < len(lines):
+                    self.assertGreater(len(p.rows) + np.count_nonzero(lines == lines[nxt]),
+                                       limit)
+
+
 class TestInspectComplete(unittest.TestCase):
     """`inspect --complete` end to end at a coarse pitch: files, phases, times, pose."""
 

@@ -9,6 +9,10 @@
 5. Table 2 at the nominal sections (inspect.sections, with a CMM's columns when given), the
    verdict, and the report of the `report` command.
 
+With --complete (paper 4.3) steps 3-4 are the whole blade rastered every --pitch mm instead
+(rig.complete) and one ICP on all points; Table 2 takes the raster points within 0.25 mm of
+each nominal plane, and the `phase` column reads blind or complete.
+
 Files in DIR: points.csv (table frame, with a `phase` column: blind or planned), plan.json,
 scan.json (the blind scan's record, the planned passes, the simulator's truth), result.json
 (with `sections` and `uncertainty_after_blind_mm`), deviations.csv, report.html/.pdf.

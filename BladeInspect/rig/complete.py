@@ -227,13 +227,13 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         passes=passes, table_to_cad=table_to_cad, standoff_mm=standoff, info=info)
 
 
-def _passes(angle, lines, start):
-    """Cut one angle's ordered rows into passes of whole lines of at most MAX_PASS_POINTS."""
+def _passes(angle, lines, start, max_points=MAX_PASS_POINTS):
+    """Cut one angle's ordered rows into passes of whole lines of at most ``max_points``."""
     bounds = np.flatnonzero(np.diff(lines) != 0) + 1
     line_starts = np.concatenate([[0], bounds])
     out, first = [], 0
     for b in np.concatenate([line_starts[1:], [len(lines)]]):
-        if b - first > MAX_PASS_POINTS and b > first:
+        if b - first > max_points:
             # Close the pass at the last line start before it overflows (one long line alone
             # still makes a pass).
             cut = line_starts[(line_starts > first) & (line_starts < b)]
