@@ -283,6 +283,33 @@ def run():
         view_shot("loop_inspection_map")
         Gui.Control.closeDialog()
 
+    @step("inspect cancelled once its paths are drawn leaves the document as it was")
+    def _():
+        before = [o.Name for o in doc.Objects]
+        plan_obj = doc.getObject("PlannedPaths")
+
+        def vertices(shape):
+            return np.array([(v.X, v.Y, v.Z) for v in shape.Vertexes])
+        plan_vertices = vertices(plan_obj.Shape) if plan_obj is not None else None
+        drawn = []
+
+        def cancel_at_plan(plan, obj):
+            drawn.append(obj.Name)
+            buttons = Gui.getMainWindow().statusBar().findChildren(QtGui.QPushButton)
+            [b for b in buttons if b.text() == "Cancel"][-1].click()
+        loop_commands.PLAN_LISTENERS.append(cancel_at_plan)
+        try:
+            value = cmd["BladeInspect_Inspect"].inspect(state["blade"], (40.0,), 0.04, 3)
+        finally:
+            loop_commands.PLAN_LISTENERS.remove(cancel_at_plan)
+        check("second inspect drew its own paths, then was cancelled",
+              value is None and drawn and drawn[0] != "PlannedPaths" and
+              progress.MESSAGES[-1] == ("Inspect", "cancelled"), (drawn, progress.MESSAGES[-1:]))
+        check("cancelled inspect removes its drawn paths",
+              [o.Name for o in doc.Objects] == before, [o.Name for o in doc.Objects])
+        check("the first inspection's paths are untouched", plan_vertices is not None and
+              np.array_equal(vertices(plan_obj.Shape), plan_vertices))
+
     @step("add a CMM file to the inspection")
     def _():
         reg = state.get("reg")

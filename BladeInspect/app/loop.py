@@ -33,11 +33,11 @@ def _path_shape(plan):
     return Part.Compound(pieces)
 
 
-def show_plan(doc, plan, name="PlannedPaths"):
-    """The plan's paths as one Part compound of polylines (CAD frame). A re-plan replaces the
-    shape of the object made for the first plan, so the view shows the paths about to run."""
+def show_plan(doc, plan, obj=None, name="PlannedPaths"):
+    """The plan's paths as one Part compound of polylines (CAD frame), in a new object, or in
+    ``obj`` (the object drawn for the first plan of the same inspection): a re-plan replaces
+    its shape, so the view shows the paths about to run."""
     shape = _path_shape(plan)
-    obj = doc.getObject(name)
     if obj is None:
         with objects.building(doc, "Planned paths"):
             obj = doc.addObject("Part::Feature", name)
@@ -46,9 +46,10 @@ def show_plan(doc, plan, name="PlannedPaths"):
             obj.addProperty("App::PropertyInteger", "NPaths", PLAN_GROUP, "Rig passes")
             obj.addProperty("App::PropertyInteger", "NPoints", PLAN_GROUP, "Planned readings")
             if obj.ViewObject is not None:
-                obj.ViewObject.LineColor = (0.0, 0.45, 1.0)
+                # Magenta is on no deviation colour (blue-green-red): paths stay apart from maps.
+                obj.ViewObject.LineColor = (0.85, 0.0, 0.85)
                 obj.ViewObject.LineWidth = 3
-                obj.ViewObject.PointColor = (0.0, 0.45, 1.0)
+                obj.ViewObject.PointColor = (0.85, 0.0, 0.85)
                 obj.ViewObject.PointSize = 4
     obj.Shape = shape
     obj.HeightsPct = [float(s.height_pct) for s in plan.sections]

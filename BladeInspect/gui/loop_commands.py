@@ -216,8 +216,10 @@ class Inspect(commands._Command):
         doc = nominal_obj.Document
         out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
 
+        drawn = {}
+
         def draw(plan):
-            obj = loop.show_plan(doc, plan)
+            obj = drawn["plan"] = loop.show_plan(doc, plan, drawn.get("plan"))
             doc.recompute()
             commands.fit_view()
             QtGui.QApplication.processEvents()
@@ -252,7 +254,7 @@ class Inspect(commands._Command):
             _hide_measured_frame(doc, measurement)
             summary["objects"] = {"measurement": measurement, "registration": registration,
                                   "deviation_map": deviation_map, "profiles": profiles,
-                                  "plan": doc.getObject("PlannedPaths")}
+                                  "plan": drawn["plan"]}
             return summary
         summary = progress.run("Inspect", job)
         if summary is not None:
