@@ -278,7 +278,7 @@ def run():
               panel and panel.table.rowCount())
         for o in doc.Objects:
             if o.ViewObject is not None:
-                o.ViewObject.Visibility = o in (dmap[0], doc.getObject("PlannedPaths"))
+                o.ViewObject.Visibility = o == dmap[0]
         window_shot("loop_inspection_table")
         view_shot("loop_inspection_map")
         Gui.Control.closeDialog()

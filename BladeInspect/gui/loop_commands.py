@@ -72,7 +72,7 @@ def output_folder(doc, kind):
     return tempfile.mkdtemp(prefix="bladeinspect-%s-" % kind)
 
 
-def _hide_measured_frame(doc, measurement):
+def _hide_measured_frame(measurement):
     """The measurement lies in the table or a random frame, away from the CAD and its map."""
     if measurement.ViewObject is not None:
         measurement.ViewObject.Visibility = False
@@ -251,7 +251,10 @@ class Inspect(commands._Command):
                 deviation_map = objects.make_deviation_map(doc, registration,
                                                            settings.colour_limit())
                 profiles = objects.make_section_profiles(doc, summary["sections"], registration)
-            _hide_measured_frame(doc, measurement)
+            _hide_measured_frame(measurement)
+            if drawn["plan"].ViewObject is not None:
+                # The paths ran; drawn over the deviation map they would hide its colours.
+                drawn["plan"].ViewObject.Visibility = False
             summary["objects"] = {"measurement": measurement, "registration": registration,
                                   "deviation_map": deviation_map, "profiles": profiles,
                                   "plan": drawn["plan"]}
@@ -389,7 +392,7 @@ class Simulate(commands._Command):
                     setattr(registration, prop, value)
                 deviation_map = objects.make_deviation_map(doc, registration,
                                                            settings.colour_limit())
-            _hide_measured_frame(doc, measurement)
+            _hide_measured_frame(measurement)
             return report, registration, deviation_map
         outcome = progress.run("Simulation test bed", job)
         if outcome is None:
