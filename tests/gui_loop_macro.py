@@ -101,6 +101,10 @@ def run():
     sys.path.insert(0, REPO)
     window = Gui.getMainWindow()
     window.resize(1280, 1000)
+    combo = [d for d in window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"]
+    if combo:
+        # Wide enough for Table 2's columns in the screenshots.
+        window.resizeDocks(combo, [640], QtCore.Qt.Horizontal)
     Gui.activateWorkbench("BladeInspectWorkbench")
     from BladeInspect.app import objects
     from BladeInspect.gui import commands, loop_commands, progress, taskpanels
