@@ -21,6 +21,13 @@ SEED = 11
 COVER_RADIUS_MM = 0.5 * PITCH / np.cos(np.radians(5.0)) + 0.5 * 0.25 / np.cos(np.radians(40.0)) \
     + 0.1
 EDGE_ZONE_MM = 1.0
+# End to end: lines no farther apart than Table 2's band (+-0.25 mm), so every nominal plane
+# has raster points in its band wherever the lines lean.
+INSPECT_PITCH = 0.5
+HEIGHTS = (30.0, 70.0)
+# A bump of 30 um on the suction side near the 30 % plane (span 70 mm along CAD z).
+BUMP_HEIGHT = 0.03
+BUMP_RADIUS = 6.0
 
 
 def demo_nominal():
@@ -152,15 +159,24 @@ class TestInspectComplete(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         from BladeInspect.inspect.closed_loop import run_inspect
-        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        from BladeInspect.rig.sensor import SensorModel
+        from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
         cls.nominal = demo_nominal()
+        s = cls.nominal.samples
+        near = np.isin(s.face, cls.nominal.roles["suction"]) & (np.abs(s.xyz[:, 2] - 21.0) < 0.5)
+        centre = s.xyz[near][np.argsort(s.xyz[near][:, 0])[np.count_nonzero(near) // 2]]
+        cls.bump = staticmethod(make_bump(centre, BUMP_RADIUS, BUMP_HEIGHT))
         cls.truth = random_fixture_pose(np.random.default_rng(SEED + 1))
-        cls.rig = SimulatedRig(cls.nominal, cls.truth, seed=SEED)
+        # A quiet sensor (0.5 um), so that Table 2 can be held to the error field within 2 um.
+        cls.rig = SimulatedRig(cls.nominal, cls.truth, sensor=SensorModel(accuracy=0.0005),
+                               error_field=cls.bump, seed=SEED)
         cls.tmp = tempfile.mkdtemp(prefix="bi-complete-")
         cls.out = os.path.join(cls.tmp, "out")
         cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=cls.nominal,
-                                  complete=True, pitch=PITCH, seed=SEED, document=False,
-                                  scan_options={"n_sections": 5})
+                                  complete=True, pitch=INSPECT_PITCH, seed=SEED, document=False,
+                                  section_heights=HEIGHTS,
+                                  scan_options={"n_sections": 5, "point_spacing": 0.25,
+                                                "probe_spacing": 1.0})
         with open(os.path.join(cls.out, "scan.json")) as fh:
             cls.scan_json = json.load(fh)
         with open(os.path.join(cls.out, "result.json")) as fh:
@@ -180,7 +196,7 @@ class TestInspectComplete(unittest.TestCase):
         self.assertEqual(set(points.columns["phase"].tolist()), {"blind", "complete"})
         n_complete = int(np.count_nonzero(points.columns["phase"] == "complete"))
         self.assertEqual(n_complete, self.scan_json["phases"]["complete"]["points"])
-        self.assertEqual(len(self.result_json["sections"]), 5)
+        self.assertEqual(len(self.result_json["sections"]), len(HEIGHTS))
 
     def test_times_reported(self):
         phase = self.scan_json["phases"]["complete"]
@@ -199,7 +215,25 @@ class TestInspectComplete(unittest.TestCase):
                                - tf.apply_transform(self.truth, complete), axis=1)
         self.assertLess(moved.max(), 0.002)
         d = self.nominal.signed_distance(tf.apply_transform(self.truth, complete)).distance
-        self.assertLess(np.max(np.abs(d)), self.rig.sensor.accuracy + 0.002)
+        self.assertLess(np.max(np.abs(d) - self.bump(self.nominal.signed_distance(
+            tf.apply_transform(self.truth, complete)).closest)), 0.002)
+
+    def test_table2_reads_the_error_field(self):
+        from BladeInspect.core.pointio import read_points
+        points = read_points(os.path.join(self.out, "points.csv"))
+        cad = tf.apply_transform(self.truth, points.xyz[points.columns["phase"] == "complete"])
+        field = self.bump(self.nominal.signed_distance(cad).closest)
+        for sec in self.result_json["sections"]:
+            p, n = np.asarray(sec["plane"]["point"]), np.asarray(sec["plane"]["normal"])
+            mine = np.abs((cad - p) @ n) < 0.25
+            self.assertGreater(np.count_nonzero(mine), 100)
+            self.assertAlmostEqual(sec["optical"]["max_abs_mm"], np.max(np.abs(field[mine])),
+                                   delta=0.002)
+            self.assertAlmostEqual(sec["optical"]["rms_mm"],
+                                   np.sqrt(np.mean(field[mine] ** 2)), delta=0.002)
+        # The bump is seen at 30 % and not at 70 %.
+        self.assertGreater(self.result_json["sections"][0]["optical"]["max_abs_mm"], 0.02)
+        self.assertLess(self.result_json["sections"][1]["optical"]["max_abs_mm"], 0.005)
 
     def test_bad_pitch_is_input_error(self):
         from BladeInspect.inspect.closed_loop import run_inspect
