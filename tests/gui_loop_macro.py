@@ -314,6 +314,35 @@ def run():
         check("the first inspection's paths are untouched", plan_vertices is not None and
               np.array_equal(vertices(plan_obj.Shape), plan_vertices))
 
+    @step("inspect with the connected rig")
+    def _():
+        from BladeInspect.gui.session import RIG
+        from BladeInspect.rig.scan import open_rig
+        blade = state["blade"]
+        RIG.connect(open_rig("sim", objects.nominal_of(blade), seed=4), "sim")
+        try:
+            summary = cmd["BladeInspect_Inspect"].inspect(blade, (35.0, 65.0), 0.04, 4)
+            check("inspect ran on the connected rig", summary is not None,
+                  progress.MESSAGES[-1:])
+            check("the connected rig was used, and left open for the next command",
+                  summary is not None and RIG.connected and RIG.rig.elapsed_s > 0)
+            if summary is None:
+                return
+            reg = summary["objects"]["registration"]
+            record = json.load(open(os.path.join(reg.InspectionFolder, "scan.json")))
+            bb = blade.Shape.BoundBox
+            corners = np.array([[x, y, z] for x in (bb.XMin, bb.XMax)
+                                for y in (bb.YMin, bb.YMax) for z in (bb.ZMin, bb.ZMax)])
+            err = corner_error(objects.matrix_array(reg.MeasuredToCad),
+                               np.asarray(record["table_to_cad"], dtype=float), corners)
+            check("connected-rig pose within 3x its bound of the simulator's truth",
+                  err < 3 * reg.PoseUncertaintyMm,
+                  "error %.2f um, bound %.2f um" % (1e3 * err, 1e3 * reg.PoseUncertaintyMm))
+            check("two planned sections in Table 2", len(summary["sections"].sections) == 2)
+        finally:
+            RIG.disconnect()
+            Gui.Control.closeDialog()
+
     @step("add a CMM file to the inspection")
     def _():
         reg = state.get("reg")
