@@ -4,6 +4,7 @@ function as the command line (run_inspect, run_calibration, section_table, run_s
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
 or a cancel leaves the document as it was."""
 import os
+import shutil
 import tempfile
 
 import numpy as np
@@ -240,7 +241,8 @@ class Inspect(commands._Command):
                 points_csv = os.path.join(out_dir, "points.csv")
                 pointset = read_points(points_csv)
                 if len(pointset.xyz) != len(result.points_cad):
-                    raise InputError("%s: %d rows, the registration has %d points"
+                    # The loop wrote its own points: a mismatch is a bug, not bad input.
+                    raise RuntimeError("%s: %d rows, the registration has %d points"
                                      % (points_csv, len(pointset.xyz), len(result.points_cad)))
                 measurement = objects.make_measurement(doc, pointset, name="InspectionPoints",
                                                        source_file=points_csv)
@@ -260,7 +262,10 @@ class Inspect(commands._Command):
                                   "plan": drawn["plan"]}
             return summary
         summary = progress.run("Inspect", job)
-        if summary is not None:
+        if summary is None:
+            # run_inspect writes all files or none: the folder made for them is empty.
+            shutil.rmtree(os.path.dirname(out_dir), ignore_errors=True)
+        else:
             doc.recompute()
             commands.fit_view()
         return summary
