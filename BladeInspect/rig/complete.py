@@ -20,13 +20,17 @@ from scipy.ndimage import binary_dilation
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
 from .kinematics import RigKinematics
-from .planning import (ANGLES, COVERAGE_MARGIN_DEG, MAX_INCIDENCE_DEG, _blade_faces,
-                       _body_clear, _choose_angles, _incidence_table, _expected_snr)
+from .planning import (ANGLES, COVERAGE_MARGIN_DEG, _blade_faces, _body_clear,
+                       _expected_snr, _incidence_table)
 
 DEFAULT_PITCH_MM = 0.1
 # Along a line: 0.25 mm steps give the paper's ~269,000 points on a 70 x 50 x 20 mm blade at
 # 0.1 mm pitch (about 380 points per section around a ~100 mm contour).
 DEFAULT_SPACING_MM = 0.25
+# Evenly spaced angles: six put every normal across the span within 30 deg of one of them,
+# whatever the twist (a greedy cover at 40 deg picks 20 angles on the twisted Rotor 67 blade,
+# each a whole raster pass and a rotation).
+DEFAULT_N_ANGLES = 6
 # The lens starts this far above the blade's highest point at each angle.
 CAST_CLEARANCE_MM = 1.0
 # Where a ray may be worth casting: grid cells within this distance (mm) of a CAD sample whose
@@ -121,14 +125,26 @@ def _cast_mask(samples_m, best_here, line_y, x0, nx, spacing, pitch):
     return binary_dilation(mask, structure=np.ones((1, 2 * rx + 1), dtype=bool))
 
 
+def _even_angles(cos_all, n_angles):
+    """``n_angles`` angles evenly around the axis from the candidate grid, turned so that the
+    worst-served blade sample is served best. ``cos_all``: (candidates, samples)."""
+    if n_angles < 1 or len(ANGLES) % n_angles:
+        raise InputError("complete scan: %r angles do not divide the %g deg grid evenly"
+                         % (n_angles, 360.0 / len(ANGLES)))
+    per_turn = len(ANGLES) // n_angles
+    best = cos_all.reshape(n_angles, per_turn, -1).max(axis=0)
+    phase = int(np.argmax(best.min(axis=1)))
+    return ANGLES[phase::per_turn]
+
+
 def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
                   spacing=DEFAULT_SPACING_MM, kinematics=None, angles_deg=None,
-                  max_incidence_deg=MAX_INCIDENCE_DEG):
+                  n_angles=DEFAULT_N_ANGLES):
     """Plan the complete raster of the blade faces at pose ``table_to_cad`` (table -> CAD).
 
     ``pitch``: mm between raster lines along the rotary axis; ``spacing``: mm between readings
-    along a line; ``angles_deg``: the rotary angles (default: a greedy cover of the blade
-    faces' normals within ``max_incidence_deg``, as plan_sections chooses them).
+    along a line; ``angles_deg``: the rotary angles (default: ``n_angles`` evenly spaced, turned
+    to serve the blade faces' worst normal best).
     Returns a CompletePlan. InputError for bad steps, DeviceError when a setpoint is outside
     the soft limits."""
     pitch = _check_step(pitch, "--pitch")
@@ -145,9 +161,7 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
     samples_t = tf.apply_transform(cad_to_table, s.xyz)
     normals_t = s.normal[on_blade] @ cad_to_table[:3, :3].T
     if angles_deg is None:
-        cos_all = _incidence_table(normals_t, ANGLES, kinematics)
-        _, rows = _choose_angles(cos_all, max_incidence_deg)
-        angles = ANGLES[rows]
+        angles = _even_angles(_incidence_table(normals_t, ANGLES, kinematics), int(n_angles))
     else:
         angles = np.unique(np.mod(np.asarray(angles_deg, dtype=float), 360.0))
         if len(angles) == 0 or not np.all(np.isfinite(angles)):
@@ -218,7 +232,7 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         raise InputError("complete scan: no point of the CAD's blade faces is in view")
     cat = {k: np.concatenate(v) for k, v in cols.items()}
     incidence = np.degrees(np.arccos(np.clip(cat["cos"], -1.0, 1.0)))
-    info.update({"max_incidence_deg": max_incidence_deg, "cast_reach_mm": CAST_REACH_MM})
+    info["cast_reach_mm"] = CAST_REACH_MM
     return CompletePlan(
         pitch_mm=pitch, spacing_mm=spacing, angles_deg=np.asarray(angles, dtype=float),
         line_y=line_y, line=cat["line"], angle_deg=cat["angle"], stage_xyz=cat["stage"],
