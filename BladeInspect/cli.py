@@ -276,15 +276,10 @@ def cmd_calibrate(args):
               % (result["axis_tilt_about_z_deg"], result["axis_tilt_about_x_deg"],
                  result["measured_diameter_mm"], result["sphere_diameter_mm"],
                  result["circle_residual_rms_mm"]))
-    truth = result.get("truth")
-    if truth:
-        p, d = np.array(result["axis_point"]), np.array(result["axis_direction"])
-        tp, td = np.array(truth["axis_point"]), np.array(truth["axis_direction"])
-        # Axis position error: the offset of the true axis from the found one, across the axis.
-        off = (p - tp) - np.dot(p - tp, td) * td
-        angle = np.degrees(np.arccos(np.clip(abs(np.dot(d, td)), -1.0, 1.0)))
+    error = result.get("truth_error")
+    if error:
         out.write("  against the simulator's truth: position %.2f um, direction %.5f deg\n"
-                  % (1e3 * np.linalg.norm(off), angle))
+                  % (1e3 * error["position_mm"], error["direction_deg"]))
     out.write("rig calibration written to %s\n" % os.path.abspath(args.out))
 
 

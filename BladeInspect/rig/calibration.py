@@ -335,4 +335,16 @@ def run_calibration(out_path, rig_spec="sim", sphere_diameter=DEFAULT_DIAMETER, 
     if truth is not None:
         result["truth"] = {"axis_point": truth.axis_point.tolist(),
                            "axis_direction": truth.axis_direction.tolist()}
+        result["truth_error"] = axis_error(result["axis_point"], result["axis_direction"],
+                                           truth.axis_point, truth.axis_direction)
     return result
+
+
+def axis_error(point, direction, true_point, true_direction):
+    """How far a found axis is from the true one: the true axis' offset across itself (mm) and
+    the angle between the directions (degrees)."""
+    p, d = np.asarray(point, float), np.asarray(direction, float)
+    tp, td = np.asarray(true_point, float), np.asarray(true_direction, float)
+    off = (p - tp) - np.dot(p - tp, td) * td
+    angle = np.degrees(np.arccos(np.clip(abs(np.dot(d, td)), -1.0, 1.0)))
+    return {"position_mm": float(np.linalg.norm(off)), "direction_deg": float(angle)}
