@@ -231,27 +231,37 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     return summary
 
 
-def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out, work,
-          timing, progress, plan_sections, scan_mod, pipeline, sections_mod, verdict_mod,
-          write_report, document, scan_options, cad_label):
-    # 1. blind section scan
+def _blind_stage(nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+                 scan_mod, pipeline, scan_share, register_share):
+    """The blind section scan into ``work`` and its registration: nothing is known of the pose
+    yet, so only what the sensor reads is used. Returns (scan summary, points, scan record,
+    rig time spent, registration)."""
     t0 = time.perf_counter()
     progress(0.0, "blind section scan")
     scan_options.setdefault("epsilon", epsilon)
     blind_summary = scan_mod.scan_to_dir(work, rig, seed=seed, kinematics=kinematics,
-                                         progress=lambda f, m: progress(0.25 * f, m),
+                                         progress=lambda f, m: progress(scan_share * f, m),
                                          **scan_options)
     blind = read_points(os.path.join(work, "points.csv"))
     with open(os.path.join(work, "scan.json")) as fh:
         scan_record = json.load(fh)
     timing["blind_scan"] = time.perf_counter() - t0
     blind_rig_s = float(rig.elapsed_s)
-
-    # 2. register the blind points
     t0 = time.perf_counter()
-    first = pipeline.register(nominal, blind, seed=seed,
-                              progress=lambda f, m: progress(0.25 + 0.2 * f, m))
+    first = pipeline.register(
+        nominal, blind, seed=seed,
+        progress=lambda f, m: progress(scan_share + register_share * f, m))
     timing["register_blind"] = time.perf_counter() - t0
+    return blind_summary, blind, scan_record, blind_rig_s, first
+
+
+def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out, work,
+          timing, progress, plan_sections, scan_mod, pipeline, sections_mod, verdict_mod,
+          write_report, document, scan_options, cad_label):
+    # 1-2. blind section scan and its registration
+    blind_summary, blind, scan_record, blind_rig_s, first = _blind_stage(
+        nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+        scan_mod, pipeline, scan_share=0.25, register_share=0.2)
     pose = first.measured_to_cad
 
     # 3-4. plan, scan, ICP on everything; one re-plan if the pose moved enough to matter
@@ -365,22 +375,9 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     from . import sections as sections_mod
     from . import verdict as verdict_mod
     from .report import write_report
-    t0 = time.perf_counter()
-    progress(0.0, "blind section scan")
-    scan_options.setdefault("epsilon", epsilon)
-    blind_summary = scan_mod.scan_to_dir(work, rig, seed=seed, kinematics=kinematics,
-                                         progress=lambda f, m: progress(0.15 * f, m),
-                                         **scan_options)
-    blind = read_points(os.path.join(work, "points.csv"))
-    with open(os.path.join(work, "scan.json")) as fh:
-        scan_record = json.load(fh)
-    timing["blind_scan"] = time.perf_counter() - t0
-    blind_rig_s = float(rig.elapsed_s)
-
-    t0 = time.perf_counter()
-    first = pipeline.register(nominal, blind, seed=seed,
-                              progress=lambda f, m: progress(0.15 + 0.1 * f, m))
-    timing["register_blind"] = time.perf_counter() - t0
+    blind_summary, blind, scan_record, blind_rig_s, first = _blind_stage(
+        nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+        scan_mod, pipeline, scan_share=0.15, register_share=0.1)
 
     t0 = time.perf_counter()
     progress(0.25, "planning the complete raster from the CAD")
