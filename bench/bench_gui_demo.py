@@ -1,0 +1,49 @@
+"""The demo in the GUI against `./bladeinspect demo` (issue 6: no more than 20 % longer).
+
+    /usr/bin/python3 bench/bench_gui_demo.py
+
+Both run the same closed loop on the demo blade with the simulated rig, 5 nominal sections,
+seed 0, report included; the GUI run is timed from a new document to the finished inspection,
+the command line from its start (interpreter, imports) to its exit."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="bi-gui-bench-")
+    try:
+        t0 = time.time()
+        subprocess.run([os.path.join(REPO, "bladeinspect"), "demo", "--out",
+                        os.path.join(tmp, "cli")], check=True, capture_output=True)
+        cli_s = time.time() - t0
+        home = os.path.join(tmp, "home")
+        env = dict(os.environ, HOME=home, QTWEBENGINE_DISABLE_SANDBOX="1", BI_BENCH_OUT=tmp,
+                   FREECAD_USER_MOD=os.path.join(home, ".local", "share", "FreeCAD", "Mod"))
+        for key in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
+            env.pop(key, None)
+        subprocess.run([os.path.join(REPO, "scripts", "install-workbench.sh")], env=env,
+                       check=True, capture_output=True)
+        subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
+                        os.path.join(REPO, "bench", "gui_demo_macro.py")], env=env, cwd=tmp,
+                       capture_output=True, timeout=600)
+        with open(os.path.join(tmp, "gui_demo.json")) as fh:
+            gui = json.load(fh)
+        if "error" in gui:
+            print(gui["error"])
+            return 1
+        print("./bladeinspect demo: %.1f s; GUI demo blade + Inspect: %.1f s; GUI/CLI = %.2f "
+              "(required <= 1.20)" % (cli_s, gui["gui_demo_s"], gui["gui_demo_s"] / cli_s))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
