@@ -314,12 +314,9 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
     result = _result_from_fit(nominal, everything, fit, first.coarse,
                               dict(timing), list(first.warnings))
     result.cad_source = cad_label
-    rows = np.arange(n_blind, n_blind + len(xyz_p))
-    table = sections_mod.section_table(_subset(result, rows), nominal, heights_pct=heights,
-                                       span_axis=span_axis, cmm=cmm_data)
-    for sec in table.sections:
-        sec.point_index = sec.point_index + n_blind
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    table, verdict = _judge_after_blind(result, nominal, n_blind, len(xyz_p), heights,
+                                        span_axis, cmm_data, tolerance, sections_mod,
+                                        verdict_mod)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
@@ -355,6 +352,18 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
             "verdict": verdict, "replans": replans, "files": files,
             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
             "pose_uncertainty_mm": result.pose_uncertainty_mm}
+
+
+def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm_data,
+                       tolerance, sections_mod, verdict_mod):
+    """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
+    indexed back into the whole result, and the verdict on every point."""
+    rows = np.arange(n_blind, n_blind + n_rows)
+    table = sections_mod.section_table(_subset(result, rows), nominal, heights_pct=heights,
+                                       span_axis=span_axis, cmm=cmm_data)
+    for sec in table.sections:
+        sec.point_index = sec.point_index + n_blind
+    return table, verdict_mod.judge(result, table, tolerance=tolerance)
 
 
 def _blind_column(pointset, name, n):
@@ -415,14 +424,11 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
                               list(first.warnings))
     result.cad_source = cad_label
     span_axis, _ = sections_mod.span_axis_of(nominal)
-    rows = np.arange(n_blind, n_blind + len(xyz_c))
     # _subset drops the section column (raster lines are not the nominal planes), so the table
     # takes the points within its band of each plane.
-    table = sections_mod.section_table(_subset(result, rows), nominal, heights_pct=heights,
-                                       span_axis=span_axis, cmm=cmm_data)
-    for sec in table.sections:
-        sec.point_index = sec.point_index + n_blind
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    table, verdict = _judge_after_blind(result, nominal, n_blind, len(xyz_c), heights,
+                                        span_axis, cmm_data, tolerance, sections_mod,
+                                        verdict_mod)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
