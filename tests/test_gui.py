@@ -5,11 +5,10 @@ this test asserts. Screenshots go to a temporary folder and are copied to
 import json
 import os
 import shutil
-import subprocess
 import tempfile
 import unittest
 
-from tests.helpers import REPO
+from tests.helpers import REPO, run_freecad_gui
 
 SCREENS = "/tmp/bladeinspect-screens"
 TIMEOUT_S = 300   # the scenario takes about 1.5 min on two busy cores
@@ -21,21 +20,7 @@ class TestWorkbenchGui(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="bi-gui-")
-        # A private home: FreeCAD's user settings stay untouched, and the workbench is installed
-        # there the way users install it (a link in the user Mod folder).
-        home = os.path.join(cls.tmp, "home")
-        env = dict(os.environ, HOME=home, QTWEBENGINE_DISABLE_SANDBOX="1",
-                   BI_GUI_OUT=cls.tmp, BI_REPO=REPO, FREECAD_USER_MOD=os.path.join(
-                       home, ".local", "share", "FreeCAD", "Mod"))
-        for key in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
-            env.pop(key, None)
-        subprocess.run([os.path.join(REPO, "scripts", "install-workbench.sh")], env=env,
-                       check=True, capture_output=True)
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
-               os.path.join(REPO, "tests", "gui_macro.py")]
-        with open(os.path.join(cls.tmp, "freecad.log"), "w") as log:
-            subprocess.run(cmd, env=env, stdout=log, stderr=subprocess.STDOUT,
-                           timeout=TIMEOUT_S, cwd=cls.tmp)
+        run_freecad_gui(os.path.join(REPO, "tests", "gui_macro.py"), cls.tmp, TIMEOUT_S)
         path = os.path.join(cls.tmp, "checks.json")
         cls.report = json.load(open(path)) if os.path.exists(path) else None
         os.makedirs(SCREENS, exist_ok=True)

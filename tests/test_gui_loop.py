@@ -5,11 +5,10 @@ Screenshots are copied to /tmp/bladeinspect-screens for people to look at."""
 import json
 import os
 import shutil
-import subprocess
 import tempfile
 import unittest
 
-from tests.helpers import REPO
+from tests.helpers import REPO, run_freecad_gui
 
 SCREENS = "/tmp/bladeinspect-screens"
 TIMEOUT_S = 240   # about a minute on two busy cores
@@ -21,19 +20,7 @@ class TestLoopCommandsGui(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="bi-gui-loop-")
-        home = os.path.join(cls.tmp, "home")
-        env = dict(os.environ, HOME=home, QTWEBENGINE_DISABLE_SANDBOX="1",
-                   BI_GUI_OUT=cls.tmp, BI_REPO=REPO, FREECAD_USER_MOD=os.path.join(
-                       home, ".local", "share", "FreeCAD", "Mod"))
-        for key in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
-            env.pop(key, None)
-        subprocess.run([os.path.join(REPO, "scripts", "install-workbench.sh")], env=env,
-                       check=True, capture_output=True)
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
-               os.path.join(REPO, "tests", "gui_loop_macro.py")]
-        with open(os.path.join(cls.tmp, "freecad.log"), "w") as log:
-            subprocess.run(cmd, env=env, stdout=log, stderr=subprocess.STDOUT,
-                           timeout=TIMEOUT_S, cwd=cls.tmp)
+        run_freecad_gui(os.path.join(REPO, "tests", "gui_loop_macro.py"), cls.tmp, TIMEOUT_S)
         path = os.path.join(cls.tmp, "checks.json")
         cls.report = json.load(open(path)) if os.path.exists(path) else None
         os.makedirs(SCREENS, exist_ok=True)
