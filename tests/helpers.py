@@ -30,3 +30,55 @@ def run_freecad_gui(macro, out_dir, timeout_s):
     with open(os.path.join(out_dir, "freecad.log"), "w") as log:
         subprocess.run(cmd, env=env, stdout=log, stderr=subprocess.STDOUT, timeout=timeout_s,
                        cwd=out_dir)
+
+
+SCREENS = "/tmp/bladeinspect-screens"
+
+
+class GuiMacroChecks:
+    """Mixed into a unittest.TestCase: runs MACRO in the real GUI once for the class, copies its
+    log, checks and screenshots to SCREENS for people to look at (log and checks under
+    LOG_NAME/CHECKS_NAME), and asserts the macro finished with every check (at least MIN_CHECKS)
+    passed. The macro writes BI_GUI_OUT/checks.json."""
+    MACRO = None
+    TIMEOUT_S = 300
+    MIN_CHECKS = 1
+    LOG_NAME = "freecad.log"
+    CHECKS_NAME = None
+
+    @classmethod
+    def setUpClass(cls):
+        import json
+        import shutil
+        import tempfile
+        cls.tmp = tempfile.mkdtemp(prefix="bi-gui-")
+        run_freecad_gui(os.path.join(REPO, "tests", cls.MACRO), cls.tmp, cls.TIMEOUT_S)
+        path = os.path.join(cls.tmp, "checks.json")
+        cls.report = None
+        if os.path.exists(path):
+            with open(path) as fh:
+                cls.report = json.load(fh)
+        os.makedirs(SCREENS, exist_ok=True)
+        shutil.copy(os.path.join(cls.tmp, "freecad.log"), os.path.join(SCREENS, cls.LOG_NAME))
+        if cls.report is not None and cls.CHECKS_NAME:
+            shutil.copy(path, os.path.join(SCREENS, cls.CHECKS_NAME))
+        for name in os.listdir(cls.tmp):
+            if name.endswith(".png"):
+                shutil.copy(os.path.join(cls.tmp, name), SCREENS)
+
+    @classmethod
+    def tearDownClass(cls):
+        import shutil
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_macro_ran_to_the_end(self):
+        with open(os.path.join(self.tmp, "freecad.log")) as fh:
+            log = fh.read()[-3000:]
+        self.assertIsNotNone(self.report, "the GUI macro wrote no checks; log tail:\n" + log)
+
+    def test_every_check_passed(self):
+        import json
+        self.assertIsNotNone(self.report)
+        failed = [c for c in self.report["checks"] if not c["ok"]]
+        self.assertEqual(failed, [], json.dumps(failed, indent=1))
+        self.assertGreater(len(self.report["checks"]), self.MIN_CHECKS)
