@@ -44,6 +44,24 @@ class TestRegistrationFromAnyPose(unittest.TestCase):
                 self.assertEqual(np.count_nonzero(result.inlier[~good][far]), 0)
                 self.assertGreater(np.mean(result.inlier[good]), 0.99)
 
+    def test_large_cloud_pose_is_the_converged_optimum(self):
+        """Above the fine subsample the whole cloud only gets Gauss-Newton steps until one is
+        small: the pose must be the full cloud's optimum all the same (ICP run on to its tight
+        tolerances from there moves it by far less than a micrometre's hundredth)."""
+        from BladeInspect.core import icp
+        nominal = demo_nominal()
+        n = pipeline.FINE_SUBSAMPLE + 10000
+        ps, truth, info, good = simulate_measurement(nominal, n_points=n, outlier_fraction=0.02,
+                                                     seed=21, section_heights=())
+        result = pipeline.register(nominal, ps, seed=21)
+        tight = icp.icp(ps.xyz, ps.snr, pipeline.exact_closest_fn(nominal),
+                        result.measured_to_cad, icp.ICPOptions(horn_iters=0))
+        self.assertTrue(tight.converged)
+        moved = pose_error(result.measured_to_cad, tight.transform, nominal.bbox_corners)
+        self.assertLess(moved, 1e-5)
+        err = pose_error(result.measured_to_cad, truth, nominal.bbox_corners)
+        self.assertLess(err, 3.0 * result.pose_uncertainty_mm)
+
     def test_translation_far_away_and_upside_down(self):
         nominal = demo_nominal()
         rng = np.random.default_rng(5)

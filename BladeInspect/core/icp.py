@@ -34,9 +34,6 @@ from .errors import InputError
 from .transforms import make_transform, rotation_from_vector, rotation_matrix_from_quaternion
 
 MAD_TO_SIGMA = 1.4826   # sigma of a normal distribution per unit of median absolute deviation
-# A last Gauss-Newton step smaller than this is applied to the residuals linearly.
-LINEAR_UPDATE_MM = 1e-4
-LINEAR_UPDATE_RAD = 1e-6
 
 
 @dataclass
@@ -50,6 +47,10 @@ class ICPOptions:
     min_scale: float = 1e-6     # mm: residuals below this are exact data, not noise to scale by
     max_noise_ratio: float = 1.0   # largest noise, in typical points' noise, granted a low SNR
     defect_neighbours: int = 16    # neighbourhood size of the defect test; 0 switches it off
+    # A last Gauss-Newton step below both is applied to the residuals linearly, without a new
+    # closest-point evaluation: their error is curvature * step^2.
+    linear_update_mm: float = 1e-4
+    linear_update_rad: float = 1e-6
 
 
 @dataclass
@@ -300,11 +301,10 @@ def icp(points, snr, closest_fn, init, options=None):
             converged = True
             break
 
-    if last_step is not None and np.linalg.norm(last_step[4]) < LINEAR_UPDATE_MM \
-            and np.linalg.norm(last_step[5]) < LINEAR_UPDATE_RAD:
-        # The residuals at the returned pose to first order in the last small step: their
-        # error is curvature * step^2 (< 1e-7 mm), which saves a closest-point evaluation of
-        # the whole cloud.
+    if last_step is not None and np.linalg.norm(last_step[4]) < options.linear_update_mm \
+            and np.linalg.norm(last_step[5]) < options.linear_update_rad:
+        # The residuals at the returned pose to first order in the last small step, which
+        # saves a closest-point evaluation of the whole cloud.
         moved_before, normals, distances, center, dt, dw = last_step
         distances = distances + _jacobian(moved_before, normals, center) @ np.r_[dt, dw]
         moved = points @ T[:3, :3].T + T[:3, 3]
