@@ -132,6 +132,9 @@ def build_parser():
     i.add_argument("--cmm", default=None)
     i.add_argument("--tolerance", type=float, default=0.04)
     i.add_argument("--seed", type=_seed, default=0)
+    i.add_argument("--resume", action="store_true",
+                   help="continue an inspection in DIR interrupted by a rig failure, from its "
+                        "last complete section (same CAD, seed and options)")
 
     c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
     c.add_argument("--out", required=True, help="RIG.json to write")
@@ -255,7 +258,8 @@ def cmd_inspect(args):
     summary = run_inspect(args.cad, args.out, rig_spec=args.rig,
                           section_heights=args.section_heights, complete=args.complete,
                           pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
-                          seed=args.seed, rig_file=args.rig_file, progress=Progress())
+                          seed=args.seed, rig_file=args.rig_file, progress=Progress(),
+                          resume=args.resume)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 

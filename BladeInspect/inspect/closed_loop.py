@@ -21,13 +21,12 @@ scan.json (the blind scan's record, the planned passes, the simulator's truth), 
 import json
 import os
 import shutil
-import tempfile
 import time
 
 import numpy as np
 
 from ..core import transforms as tf
-from ..core.errors import InputError
+from ..core.errors import DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
 
 DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
@@ -38,6 +37,17 @@ EPSILON_MM = 2.0
 REPLAN_FRACTION = 0.0025
 # Below this fraction of planned points read, the part is not where the plan expected it.
 MIN_READ_FRACTION = 0.9
+# A resumed inspection registers its blind points again; they must land where they did
+# (the same numbers give the same pose, up to rounding far below this).
+RESUME_POSE_TOLERANCE_MM = 1e-6
+# While an inspection is unfinished, scan.json holds the loop's state under this key.
+CHECKPOINT = "inspection"
+RECORD_FILE = "scan.json"
+# What a checkpoint is made of; scan.json last, since it marks the folder as one.
+CHECKPOINT_FILES = ("plan.json", "points.csv", RECORD_FILE)
+# What a finished inspection adds; none of them may stand beside a checkpoint.
+RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf",
+                "inspection.FCStd")
 
 
 def _no_progress(fraction, message):
@@ -59,13 +69,17 @@ def _check_heights(heights):
     return values
 
 
-def scan_plan(rig, plan, kinematics, progress=_no_progress):
-    """Scan every planned path on the rig. Returns table-frame points with their SNR, the
-    planned section index, rotary angle and the planned point they answer (rows with no
-    reading are left out) and a list of per-path records for scan.json."""
-    xyz, snr, section, angle, point = [], [], [], [], []
-    records = []
-    for i, path in enumerate(plan.paths):
+def scan_plan(rig, plan, kinematics, progress=_no_progress, first_path=0, on_section=None):
+    """Scan the planned paths on the rig from path ``first_path`` on (those before it were
+    measured before an interruption). Returns table-frame points with their SNR, the planned
+    section index, rotary angle and the planned point they answer (rows with no reading are
+    left out) and a list of per-path records for scan.json. ``on_section(n_paths_done,
+    rows, records)`` is called as the last path of each section has run, with that section's
+    rows (xyz, snr, section, angle, point) and path records: the loop's checkpoint."""
+    rows, records = [], []
+    section_start = 0
+    for i in range(first_path, len(plan.paths)):
+        path = plan.paths[i]
         progress(i / max(len(plan.paths), 1), "planned scan: path %d of %d (section %g %%, "
                  "A=%.0f deg)" % (i + 1, len(plan.paths),
                                   plan.sections[path.section].height_pct, path.angle_deg))
@@ -74,28 +88,35 @@ def scan_plan(rig, plan, kinematics, progress=_no_progress):
         d = np.asarray(readings.reading_mm, dtype=float)
         ok = np.isfinite(d)
         machine = kinematics.machine_point(np.asarray(readings.stage_xyz)[ok], d[ok])
-        xyz.append(kinematics.table_point(machine, path.angle_deg))
-        snr.append(np.asarray(readings.snr, dtype=float)[ok])
-        section.append(np.full(int(ok.sum()), path.section))
-        angle.append(np.full(int(ok.sum()), path.angle_deg))
-        point.append(path.points[ok])
+        n = int(ok.sum())
+        rows.append((kinematics.table_point(machine, path.angle_deg),
+                     np.asarray(readings.snr, dtype=float)[ok], np.full(n, path.section),
+                     np.full(n, path.angle_deg), path.points[ok]))
         expected = plan.sections[path.section].expected_standoff_mm[path.points]
         records.append({"section": path.section, "angle_deg": path.angle_deg,
-                        "points": int(len(d)), "readings": int(ok.sum()),
+                        "points": int(len(d)), "readings": n,
                         "max_standoff_error_mm": (float(np.max(np.abs(d[ok] - expected[ok])))
                                                   if ok.any() else None),
                         "pass_index": readings.meta.get("pass_index")})
-    cat = np.concatenate
-    return (np.vstack(xyz) if xyz else np.zeros((0, 3)), cat(snr), cat(section), cat(angle),
-            cat(point), records)
+        if i + 1 == len(plan.paths) or plan.paths[i + 1].section != path.section:
+            if on_section is not None:
+                on_section(i + 1, _stack_rows(rows[section_start:]), records[section_start:])
+            section_start = len(rows)
+    return _stack_rows(rows) + (records,)
 
 
-def _plan_agreement(plan, planned, epsilon):
+def _stack_rows(rows):
+    """(xyz, snr, section, angle, point) of several paths as one set of arrays."""
+    if not rows:
+        return (np.zeros((0, 3)), np.zeros(0), np.zeros(0, int), np.zeros(0), np.zeros(0, int))
+    return (np.vstack([r[0] for r in rows]),) + tuple(np.concatenate([r[k] for r in rows])
+                                                     for k in range(1, 5))
+
+
+def _plan_agreement(plan, n_read, records, epsilon):
     """None when the planned scan read what the plan expected; else a one-line message. The
     plan puts every nominal point at the standoff: readings missing or far off it mean the
     part is not where the blind registration put it (a wrong PCA candidate, a moved part)."""
-    n_read = len(planned[0])
-    records = planned[5]
     worst = max((r["max_standoff_error_mm"] or 0.0) for r in records) if records else 0.0
     if n_read < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
         return ("inspect: the planned scan does not find the blade where the blind scan's "
@@ -169,12 +190,15 @@ def _pointset(xyz, snr, columns, source):
 def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGHTS,
                 complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
-                scan_options=None, on_plan=None):
+                scan_options=None, on_plan=None, resume=False):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (rig.scan.scan_to_dir, e.g. n_sections).
     ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
-    Returns a summary dict. All files appear in out_dir together, or none on an error."""
+    ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
+    ``scan_options`` None takes the interrupted run's).
+    Returns a summary dict. The result files appear in out_dir together, or none: on a
+    DeviceError out_dir holds the checkpoint instead (points.csv, plan.json, scan.json)."""
     from ..rig import scan as scan_mod
     from ..rig.kinematics import RigKinematics
     from ..rig.planning import plan_sections
@@ -190,6 +214,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     from . import verdict as verdict_mod
     from .report import write_report
     progress = progress or _no_progress
+    if not out_dir:
+        raise InputError("--out: a folder is required")
     heights = _check_heights(section_heights)
     tolerance = float(tolerance)
     if not (np.isfinite(tolerance) and tolerance > 0):
@@ -198,32 +224,41 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
         from ..rig.complete import _check_step
         pitch = _check_step(pitch, "--pitch")
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
+    if scan_options is not None or not resume:
+        scan_options = dict(scan_options or {})
+        scan_options.setdefault("epsilon", epsilon)
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
         nominal = pipeline.load_nominal(cad_path)
     kinematics = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
+    identity = _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics,
+                         scan_options)
     opened = rig is None
     if opened:
         rig = scan_mod.open_rig(rig_spec, nominal=nominal, seed=seed, kinematics=kinematics)
     timing["load"] = time.perf_counter() - t0
     try:
         with pipeline.AtomicOutput(out_dir) as out:
-            work = tempfile.mkdtemp(prefix="blind-", dir=out.tmp)
+            checkpoint = _Checkpoint(os.path.join(out.tmp, "checkpoint"), out_dir, identity,
+                                     rig, resume)
+            scan_options = dict(checkpoint.identity["scan_options"])
             try:
                 if complete:
                     summary = _complete_loop(nominal, rig, kinematics, heights, seed, epsilon,
-                                             cmm_data, tolerance, pitch, out, work, timing,
-                                             progress, document, dict(scan_options or {}),
+                                             cmm_data, tolerance, pitch, out, checkpoint,
+                                             timing, progress, document, scan_options,
                                              cad_path or "built-in demo blade")
                 else:
                     summary = _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data,
-                                    tolerance, out, work, timing, progress, plan_sections,
+                                    tolerance, out, checkpoint, timing, progress, plan_sections,
                                     scan_mod, pipeline, sections_mod, verdict_mod, write_report,
-                                    document, dict(scan_options or {}),
-                                    cad_path or "built-in demo blade")
+                                    document, scan_options, cad_path or "built-in demo blade")
+            except DeviceError:
+                checkpoint.keep()
+                raise
             finally:
-                shutil.rmtree(work, ignore_errors=True)
+                shutil.rmtree(checkpoint.folder, ignore_errors=True)
     finally:
         if opened:
             rig.close()
@@ -231,102 +266,152 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     return summary
 
 
-def _blind_stage(nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
                  scan_mod, pipeline, scan_share, register_share):
-    """The blind section scan into ``work`` and its registration: nothing is known of the pose
-    yet, so only what the sensor reads is used. Returns (scan summary, points, scan record,
-    rig time spent, registration)."""
+    """The blind section scan into the checkpoint and its registration: nothing is known of
+    the pose yet, so only what the sensor reads is used. A resumed inspection continues an
+    interrupted blind scan (scan_to_dir's own resume) or reads the finished one back.
+    Returns (the blind scan's record, points, rig time spent, registration)."""
     t0 = time.perf_counter()
-    progress(0.0, "blind section scan")
-    scan_options.setdefault("epsilon", epsilon)
-    blind_summary = scan_mod.scan_to_dir(work, rig, seed=seed, kinematics=kinematics,
-                                         progress=lambda f, m: progress(scan_share * f, m),
-                                         **scan_options)
-    blind = read_points(os.path.join(work, "points.csv"))
-    with open(os.path.join(work, "scan.json")) as fh:
-        scan_record = json.load(fh)
+    state = checkpoint.state
+    if state is None or state["phase"] == "blind":
+        progress(0.0, "blind section scan" + (" (resumed)" if state else ""))
+        scan_mod.scan_to_dir(checkpoint.folder, rig, seed=seed, kinematics=kinematics,
+                             resume=state is not None, phase="blind",
+                             progress=lambda f, m: progress(scan_share * f, m), **scan_options)
+        blind_rig_s = checkpoint.rig_s()
+    else:
+        blind_rig_s = float(state["blind_rig_s"])
+    record = checkpoint.record()
+    record["complete"] = True
+    blind = checkpoint.rows("blind")
+    if blind is None:
+        raise InputError("inspect: the blind scan measured no point of the part")
     timing["blind_scan"] = time.perf_counter() - t0
-    blind_rig_s = float(rig.elapsed_s)
     t0 = time.perf_counter()
     first = pipeline.register(
         nominal, blind, seed=seed,
         progress=lambda f, m: progress(scan_share + register_share * f, m))
     timing["register_blind"] = time.perf_counter() - t0
-    return blind_summary, blind, scan_record, blind_rig_s, first
+    if state is not None and state["phase"] != "blind":
+        # The saved pose plans the rest; a registration that no longer lands there means the
+        # points or the CAD are not those of the interrupted run.
+        saved = np.asarray(state["blind_measured_to_cad"], dtype=float)
+        moved = pose_change_mm(saved, first.measured_to_cad, nominal.bbox_corners)
+        if moved > RESUME_POSE_TOLERANCE_MM:
+            raise InputError("--resume: the blind points register %.3g mm away from where "
+                             "they did before the interruption (points.csv or the CAD "
+                             "changed)" % moved)
+    return record, blind, blind_rig_s, first
 
 
-def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out, work,
-          timing, progress, plan_sections, scan_mod, pipeline, sections_mod, verdict_mod,
-          write_report, document, scan_options, cad_label):
+def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out,
+          checkpoint, timing, progress, plan_sections, scan_mod, pipeline, sections_mod,
+          verdict_mod, write_report, document, scan_options, cad_label):
     # 1-2. blind section scan and its registration
-    blind_summary, blind, scan_record, blind_rig_s, first = _blind_stage(
-        nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+    resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "planned" else None
+    scan_record, blind, blind_rig_s, first = _blind_stage(
+        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
         scan_mod, pipeline, scan_share=0.25, register_share=0.2)
-    pose = first.measured_to_cad
+    n_blind = len(blind.xyz)
+    blind_sections = _blind_column(blind, "section", n_blind)
+    # Planned sections are numbered after the blind ones, so a `report` of points.csv by its
+    # section column keeps them apart.
+    first_planned = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() \
+        else 0
+    if resumed is None:
+        state = {"phase": "planned", "attempt": 0, "plan_pose": first.measured_to_cad.tolist(),
+                 "paths_done": 0, "sections_done": [], "paths": [], "replans": [],
+                 "points_bytes": checkpoint.points_bytes()}
+    else:
+        state = dict(resumed)
+        checkpoint.truncate_points(state["points_bytes"])
+        if state.get("pass_index") is not None and hasattr(rig, "set_pass_index"):
+            rig.set_pass_index(state["pass_index"])
+    state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
+                 blind_points=n_blind, blind_rig_s=blind_rig_s,
+                 blind_points_bytes=state.get("blind_points_bytes", state["points_bytes"]))
+    checkpoint.save(state, scan_record)
 
     # 3-4. plan, scan, ICP on everything; one re-plan if the pose moved enough to matter
     span_axis, _ = sections_mod.span_axis_of(nominal)
-    replans = []
-    planned = None
-    for attempt in range(2):
+    for attempt in range(int(state["attempt"]), 2):
+        pose = np.asarray(state["plan_pose"], dtype=float)
         t0 = time.perf_counter()
         progress(0.45 + 0.05 * attempt, "planning the nominal sections from the CAD")
         plan = plan_sections(nominal, pose, heights, rig.sensor, rig.limits,
                              span_axis=span_axis, kinematics=kinematics)
         timing["plan" if attempt == 0 else "replan"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        planned = scan_plan(rig, plan, kinematics,
-                            lambda f, m: progress(0.5 + 0.1 * attempt + 0.1 * f, m))
-        timing["planned_scan" if attempt == 0 else "replanned_scan"] = time.perf_counter() - t0
+        _save_plan(plan, checkpoint, resumed is not None and attempt == resumed["attempt"])
+        checkpoint.save(state, scan_record)
 
-        agreement = _plan_agreement(plan, planned, epsilon)
+        def section_done(n_paths, rows, records):
+            xyz, snr, section, angle, _ = rows
+            checkpoint.append_rows(xyz, snr, first_planned + section, angle, "planned")
+            state["paths_done"] = n_paths
+            state["sections_done"] = state["sections_done"] + [int(records[-1]["section"])]
+            state["paths"] = state["paths"] + records
+            state["points_bytes"] = checkpoint.points_bytes()
+            state["pass_index"] = getattr(rig, "pass_index", None)
+            checkpoint.save(state, scan_record)
+
+        t0 = time.perf_counter()
+        scan_plan(rig, plan, kinematics,
+                  lambda f, m: progress(0.5 + 0.1 * attempt + 0.1 * f, m),
+                  first_path=int(state["paths_done"]), on_section=section_done)
+        timing["planned_scan" if attempt == 0 else "replanned_scan"] = time.perf_counter() - t0
+        planned = checkpoint.rows("planned")
+        n_planned = 0 if planned is None else len(planned.xyz)
+        agreement = _plan_agreement(plan, n_planned, state["paths"], epsilon)
         if agreement:
             raise InputError(agreement)
         t0 = time.perf_counter()
-        xyz = np.vstack([blind.xyz, planned[0]])
-        snr = np.concatenate([blind.snr, planned[1]])
+        xyz = np.vstack([blind.xyz, planned.xyz])
+        snr = np.concatenate([blind.snr, planned.snr])
         fit = pipeline.fine_register(xyz, snr, nominal, pose,
                                      progress=lambda f, m: progress(0.75, m))
         timing["register_all" if attempt == 0 else "register_all_again"] = \
             time.perf_counter() - t0
         targets = np.vstack([s.target_cad for s in plan.sections])
         moved = pose_change_mm(pose, fit.transform, targets)
-        replans.append({"pose_change_mm": moved, "threshold_mm": REPLAN_FRACTION * epsilon,
-                        "n_planned": plan.n_points, "n_measured": int(len(planned[0]))})
-        pose = fit.transform
-        if moved <= REPLAN_FRACTION * epsilon:
+        state["replans"] = state["replans"] + [
+            {"pose_change_mm": moved, "threshold_mm": REPLAN_FRACTION * epsilon,
+             "n_planned": plan.n_points, "n_measured": n_planned}]
+        if moved <= REPLAN_FRACTION * epsilon or attempt == 1:
             break
+        # The re-plan measures the nominal sections again from the better pose; the first
+        # pass's rows are replaced, as the uninterrupted loop replaces them.
+        checkpoint.truncate_points(state["blind_points_bytes"])
+        state.update(attempt=attempt + 1, plan_pose=np.asarray(fit.transform).tolist(),
+                     paths_done=0, sections_done=[], paths=[],
+                     points_bytes=state["blind_points_bytes"])
+    replans = state["replans"]
+    path_records = state["paths"]
 
     # 5. results at the nominal sections
     t0 = time.perf_counter()
-    xyz_p, snr_p, section_p, angle_p, _, path_records = planned
-    n_blind = len(blind.xyz)
-    phase = np.array(["blind"] * n_blind + ["planned"] * len(xyz_p))
-    blind_sections = _blind_column(blind, "section", n_blind)
-    # Planned sections are numbered after the blind ones, so a `report` of points.csv by its
-    # section column keeps them apart.
-    first_planned = (np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
-    columns = {"section": np.concatenate([blind_sections, first_planned + section_p]),
+    columns = {"section": np.concatenate([blind_sections, planned.columns["section"]]),
                "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            angle_p]),
-               "phase": phase}
+                                            planned.columns["angle_deg"]]),
+               "phase": np.array(["blind"] * n_blind + ["planned"] * n_planned)}
     everything = _pointset(xyz, snr, columns, "inspect: blind and planned scans")
     result = _result_from_fit(nominal, everything, fit, first.coarse,
                               dict(timing), list(first.warnings))
     result.cad_source = cad_label
-    table, verdict = _judge_after_blind(result, nominal, n_blind, len(xyz_p), heights,
+    table, verdict = _judge_after_blind(result, nominal, n_blind, n_planned, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
     t0 = time.perf_counter()
+    rig_s = checkpoint.rig_s()
     write_points_csv(out.path("points.csv"), xyz, {"snr": snr, **columns})
     plan.to_json(out.path("plan.json"))
     scan_record["phases"] = {
-        "blind": {"points": n_blind, "summary": blind_summary, "rig_s": blind_rig_s},
-        "planned": {"points": int(len(xyz_p)), "paths": path_records,
-                    "rig_s": float(rig.elapsed_s) - blind_rig_s}}
+        "blind": {"points": n_blind, "summary": dict(scan_record),
+                  "rig_s": blind_rig_s},
+        "planned": {"points": n_planned, "paths": path_records, "rig_s": rig_s - blind_rig_s}}
     scan_record["replans"] = replans
     with open(out.path("scan.json"), "w") as fh:
         json.dump(scan_record, fh, indent=1, default=pipeline._json_default)
@@ -344,14 +429,28 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
              "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
              "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
              "replans": replans,
-             "n_points_by_phase": {"blind": n_blind, "planned": int(len(xyz_p))},
-             "rig_time_s": float(rig.elapsed_s)}
+             "n_points_by_phase": {"blind": n_blind, "planned": n_planned},
+             "rig_time_s": rig_s}
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     return {"result": result, "blind_result": first, "plan": plan, "sections": table,
             "verdict": verdict, "replans": replans, "files": files,
             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
             "pose_uncertainty_mm": result.pose_uncertainty_mm}
+
+
+def _save_plan(plan, checkpoint, resumed):
+    """plan.json of the checkpoint. Resumed, the plan made again from the saved pose must be
+    the saved plan: the rest of its sections is scanned as the interrupted run would have."""
+    text = plan.to_json()
+    if resumed:
+        with open(checkpoint.path("plan.json")) as fh:
+            if fh.read() != text:
+                raise InputError("--resume: the plan made again from the saved pose differs "
+                                 "from the checkpoint's plan.json (another rig or software)")
+        return
+    with open(checkpoint.path("plan.json"), "w") as fh:
+        fh.write(text)
 
 
 def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm_data,
@@ -374,7 +473,7 @@ def _blind_column(pointset, name, n):
 
 
 def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
-                   out, work, timing, progress, document, scan_options, cad_label):
+                   out, checkpoint, timing, progress, document, scan_options, cad_label):
     """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
     the whole blade rastered every ``pitch`` mm (rig.complete) from that pose, ICP on every
     point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
@@ -384,8 +483,8 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     from . import sections as sections_mod
     from . import verdict as verdict_mod
     from .report import write_report
-    blind_summary, blind, scan_record, blind_rig_s, first = _blind_stage(
-        nominal, rig, kinematics, seed, epsilon, work, timing, progress, scan_options,
+    scan_record, blind, blind_rig_s, first = _blind_stage(
+        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
         scan_mod, pipeline, scan_share=0.15, register_share=0.1)
 
     t0 = time.perf_counter()
@@ -397,7 +496,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     xyz_c, snr_c, line_c, angle_c, _, reading_c, pass_records = scan_complete(
         rig, plan, kinematics, lambda f, m: progress(0.3 + 0.3 * f, m))
     timing["complete_scan"] = time.perf_counter() - t0
-    complete_rig_s = float(rig.elapsed_s) - blind_rig_s
+    complete_rig_s = checkpoint.rig_s() - blind_rig_s
     worst = float(np.max(np.abs(reading_c - plan.standoff_mm))) if len(reading_c) else np.inf
     if len(xyz_c) < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
         raise InputError("inspect --complete: the raster does not find the blade where the "
@@ -436,7 +535,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     write_points_csv(out.path("points.csv"), xyz, {"snr": snr, **columns})
     plan.to_json(out.path("plan.json"))
     scan_record["phases"] = {
-        "blind": {"points": n_blind, "summary": blind_summary, "rig_s": blind_rig_s},
+        "blind": {"points": n_blind, "summary": dict(scan_record), "rig_s": blind_rig_s},
         "complete": {"points": int(len(xyz_c)), "planned_points": plan.n_points,
                      "pitch_mm": plan.pitch_mm, "angles_deg": plan.angles_deg.tolist(),
                      "passes": pass_records, "rig_s": complete_rig_s,
@@ -462,7 +561,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
              "n_points_by_phase": {"blind": n_blind, "complete": int(len(xyz_c))},
              "complete": {"pitch_mm": plan.pitch_mm, "rig_s": complete_rig_s,
                           "simulated_s": timing["complete_scan"]},
-             "rig_time_s": float(rig.elapsed_s)}
+             "rig_time_s": checkpoint.rig_s()}
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     return {"result": result, "blind_result": first, "plan": plan, "sections": table,
@@ -470,3 +569,179 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
             "pose_uncertainty_mm": result.pose_uncertainty_mm,
             "complete_rig_s": complete_rig_s, "complete_simulated_s": timing["complete_scan"]}
+
+
+# ---------------------------------------------------------------- checkpoint and resume
+
+class _Checkpoint:
+    """What an inspection has measured so far, kept in a private folder while it runs:
+    points.csv and scan.json grow one completed blind section at a time (rig.scan.scan_to_dir's
+    own checkpoint), then one completed planned section at a time; plan.json is the plan being
+    scanned. scan.json's CHECKPOINT entry says where the loop stands. A DeviceError moves the
+    three files into DIR (keep); ``resume`` starts from a copy of those in DIR."""
+
+    def __init__(self, folder, out_dir, identity, rig, resume):
+        self.folder = folder
+        self.out_dir = os.path.abspath(out_dir)
+        self.rig = rig
+        self.state = None
+        self._session_start = float(rig.elapsed_s)
+        self._earlier_rig_s = 0.0
+        record_path = os.path.join(self.out_dir, RECORD_FILE)
+        saved = _saved_checkpoint(record_path)
+        if not resume:
+            if saved is not None:
+                raise InputError("--out %s: holds an interrupted inspection (use --resume to "
+                                 "continue it, or another folder)" % out_dir)
+            self.identity = identity
+            return
+        if saved is None:
+            raise InputError("--resume: %s holds no interrupted inspection to continue"
+                             % out_dir)
+        self.identity = _same_identity(saved.get("options"), identity, out_dir)
+        self.state = saved
+        self._earlier_rig_s = float(saved.get("rig_s", 0.0))
+        os.makedirs(folder)
+        for name in CHECKPOINT_FILES:
+            if os.path.exists(os.path.join(self.out_dir, name)):
+                shutil.copyfile(os.path.join(self.out_dir, name), self.path(name))
+
+    def path(self, name):
+        return os.path.join(self.folder, name)
+
+    def rig_s(self):
+        """Rig time of the whole inspection: earlier sessions and this one."""
+        return self._earlier_rig_s + float(self.rig.elapsed_s) - self._session_start
+
+    def record(self):
+        """scan.json as it stands, without the loop's own state."""
+        with open(self.path(RECORD_FILE)) as fh:
+            record = json.load(fh)
+        record.pop(CHECKPOINT, None)
+        return record
+
+    def save(self, state, record=None):
+        """Records where the loop stands (after a completed section: the rows on disk are
+        exactly those the state counts)."""
+        from ..rig.scan import write_record
+        record = self.record() if record is None else dict(record)
+        self.state = dict(state, options=self.identity, complete=False, rig_s=self.rig_s())
+        record[CHECKPOINT] = self.state
+        record["complete"] = False
+        write_record(self.path(RECORD_FILE), record)
+
+    def keep(self):
+        """After a DeviceError: the measured data goes to DIR as a checkpoint to resume, in
+        place of any earlier result there (a result beside a checkpoint would not be one)."""
+        if not os.path.exists(self.path(RECORD_FILE)):
+            return
+        state = self.state if self.state is not None else {"phase": "blind"}
+        self.save(state)
+        os.makedirs(self.out_dir, exist_ok=True)
+        for name in RESULT_FILES:
+            if os.path.exists(os.path.join(self.out_dir, name)):
+                os.remove(os.path.join(self.out_dir, name))
+        # scan.json last: it is what marks the folder as a checkpoint.
+        for name in CHECKPOINT_FILES:
+            if os.path.exists(self.path(name)):
+                os.replace(self.path(name), os.path.join(self.out_dir, name))
+            elif os.path.exists(os.path.join(self.out_dir, name)):
+                os.remove(os.path.join(self.out_dir, name))
+
+    def truncate_points(self, size):
+        from ..rig.scan import POINTS_FILE
+        path = self.path(POINTS_FILE)
+        if os.path.getsize(path) < size:
+            raise InputError("%s: shorter than its checkpoint in %s (the folder was changed)"
+                             % (os.path.join(self.out_dir, POINTS_FILE), RECORD_FILE))
+        with open(path, "r+b") as fh:
+            fh.truncate(size)
+
+    def points_bytes(self):
+        return os.path.getsize(self.path("points.csv"))
+
+    def rows(self, phase):
+        """The rows of one phase in points.csv (a PointSet; None when there are none)."""
+        pointset = read_points(self.path("points.csv"))
+        keep = pointset.columns["phase"] == phase
+        if not keep.any():
+            return None
+        return PointSet(xyz=pointset.xyz[keep], snr=pointset.snr[keep],
+                        columns={k: np.asarray(v)[keep] for k, v in pointset.columns.items()},
+                        n_rows_skipped=0, source=pointset.source)
+
+    def append_rows(self, xyz, snr, section, angle, phase):
+        """Rows measured after the blind scan, at full precision: a resumed run reads back the
+        very numbers an uninterrupted one keeps in memory."""
+        lines = ["%r,%r,%r,%r,%d,%r,%s\n" % (x, y, z, s, k, a, phase)
+                 for (x, y, z), s, k, a in zip(np.asarray(xyz, dtype=float).tolist(),
+                                               np.asarray(snr, dtype=float).tolist(),
+                                               np.asarray(section).tolist(),
+                                               np.asarray(angle, dtype=float).tolist())]
+        with open(self.path("points.csv"), "a") as fh:
+            fh.write("".join(lines))
+            fh.flush()
+            os.fsync(fh.fileno())
+
+
+def _saved_checkpoint(record_path):
+    """The loop's state in DIR/scan.json when DIR holds an interrupted inspection, else None."""
+    if not os.path.exists(record_path):
+        return None
+    try:
+        with open(record_path) as fh:
+            record = json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise InputError("%s: not a readable scan record (%s)" % (record_path, exc))
+    state = record.get(CHECKPOINT) if isinstance(record, dict) else None
+    if not isinstance(state, dict) or state.get("complete", True):
+        return None
+    if state.get("phase") not in ("blind", "planned", "complete") or \
+            not isinstance(state.get("options"), dict):
+        raise InputError("%s: malformed inspection checkpoint" % record_path)
+    return state
+
+
+def _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan_options):
+    """What a resumed inspection must share with the interrupted one to measure the same
+    points (JSON-ready). ``scan_options`` None: whatever the interrupted run used."""
+    options = None
+    if scan_options is not None:
+        options = json.loads(json.dumps(scan_options, default=_json_option))
+    return {"cad_bbox": np.asarray(nominal.bbox_corners, dtype=float).tolist(),
+            "seed": int(seed), "section_heights": [float(h) for h in heights],
+            "complete": bool(complete), "pitch_mm": float(pitch) if complete else None,
+            "epsilon_mm": float(epsilon), "kinematics": kinematics.to_dict(),
+            "scan_options": options}
+
+
+def _json_option(value):
+    if hasattr(value, "to_dict"):
+        return value.to_dict()
+    if isinstance(value, (np.ndarray, np.floating, np.integer)):
+        return value.tolist()
+    raise TypeError("not JSON serialisable: %r" % type(value))
+
+
+IDENTITY_FLAGS = (("cad_bbox", "the CAD (its bounding box)"), ("seed", "--seed"),
+                  ("section_heights", "--section-heights"), ("complete", "--complete"),
+                  ("pitch_mm", "--pitch"), ("epsilon_mm", "epsilon"),
+                  ("kinematics", "--rig-file"), ("scan_options", "the blind scan's options"))
+
+
+def _same_identity(saved, given, out_dir):
+    """The identity the resumed run continues with; InputError naming the first difference."""
+    if not isinstance(saved, dict):
+        raise InputError("--resume %s: the checkpoint does not say how it was begun" % out_dir)
+    if given["scan_options"] is None:
+        given = dict(given, scan_options=saved.get("scan_options"))
+    for key, flag in IDENTITY_FLAGS:
+        a, b = saved.get(key), given[key]
+        same = (np.allclose(a, b, rtol=0.0, atol=1e-9) if key == "cad_bbox" and a is not None
+                else a == b)
+        if not same:
+            shown = ("another part" if key == "cad_bbox" else
+                     "another rig file" if key == "kinematics" else "%s, not %s" % (a, b))
+            raise InputError("--resume %s: the interrupted inspection was begun with other %s "
+                             "(%s); resume with the same options" % (out_dir, flag, shown))
+    return given

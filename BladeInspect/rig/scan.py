@@ -51,11 +51,13 @@ def demo_nominal():
     return nominal_from_shape(model.shape, roles=model.roles)
 
 
-def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
+def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None, phase=None,
                 **strategy_options):
     """Run the blind scan (rig.strategy.ScanStrategy with ``strategy_options``) and write it
     to ``out_dir`` section by section. Returns the scan record (what scan.json holds, plus
     ``points``: the number of points). ``progress(fraction, message)`` is called per section.
+    ``phase``: a value for a last ``phase`` column of points.csv (``inspect`` appends its
+    planned rows to the same file).
 
     A folder holding a previous scan is an InputError unless ``resume``; on resume the saved
     options are used (the scan continues as it began) and the rig must be the same one."""
@@ -76,6 +78,7 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
                              % (out_dir, POINTS_FILE, RECORD_FILE))
         options = dict(strategy_options, n_sections=int(n_sections))
         record = _new_record(rig, seed, options)
+        record["phase_column"] = phase
         state = None
     else:
         record = _load_record(record_path)
@@ -87,16 +90,16 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
     if fresh:
         os.makedirs(out_dir, exist_ok=True)
         with open(points_path, "w") as f:
-            f.write(POINTS_HEADER)
+            f.write(POINTS_HEADER if phase is None else POINTS_HEADER[:-1] + ",phase\n")
         record["checkpoint"]["points_bytes"] = os.path.getsize(points_path)
-        _write_record(record_path, record)
+        write_record(record_path, record)
     else:
         _truncate_points(points_path, record["checkpoint"]["points_bytes"])
     start_elapsed = rig.elapsed_s
     base_simulated = record["simulated_s"]
     try:
         for section in strategy.sections(progress):
-            _append_points(points_path, section)
+            _append_points(points_path, section, record.get("phase_column"))
             record["sections"].append(_section_record(section))
             record["points"] += int(len(section.snr))
             record["passes"] += section.passes
@@ -106,7 +109,7 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
             record["complete"] = strategy.state.next_section >= len(strategy.section_y)
             record["checkpoint"] = {"strategy": strategy.state.to_dict(),
                                     "points_bytes": os.path.getsize(points_path)}
-            _write_record(record_path, record)
+            write_record(record_path, record)
     except InputError as exc:
         # A device failure leaves the scan to resume; a scan that found nothing to measure
         # leaves nothing that looks like a result.
@@ -204,7 +207,9 @@ def _load_record(path):
     return record
 
 
-def _write_record(path, record):
+def write_record(path, record):
+    """Replace the JSON file ``path`` by ``record`` atomically (temporary file, fsync,
+    os.replace): a reader, or a resume after a crash, sees the old record or the new one."""
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".scan-", suffix=".json", dir=folder)
     try:
@@ -227,9 +232,10 @@ def _truncate_points(path, size):
         f.truncate(size)
 
 
-def _append_points(path, section):
+def _append_points(path, section, phase=None):
     rows = np.column_stack([section.table_xyz, section.snr])
-    lines = ["%.6f,%.6f,%.6f,%.6f,%d,%.6f\n" % (x, y, z, s, section.index, a)
+    end = "\n" if phase is None else ",%s\n" % phase
+    lines = [("%.6f,%.6f,%.6f,%.6f,%d,%.6f" % (x, y, z, s, section.index, a)) + end
              for (x, y, z, s), a in zip(rows, section.angle_deg)]
     with open(path, "a") as f:
         f.write("".join(lines))
