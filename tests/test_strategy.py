@@ -10,7 +10,7 @@ from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
 from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
-from BladeInspect.rig.strategy import ScanStrategy, fit_section_curve
+from BladeInspect.rig.strategy import ScanStrategy, ViewResult, fit_section_curve
 from tests.rig_parts import Sphere, TwistedEllipse
 
 TWIST = 25.0
@@ -100,6 +100,37 @@ class TestScanOfTwistedBlade(unittest.TestCase):
                 self.assertLess(incline, 3.0)
             levels = np.array(strategy.state.level_angles)
             np.testing.assert_allclose(np.abs(np.diff(levels[:, 1])), step, atol=1.0)
+
+
+class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
+    def test_later_views_find_the_surface_with_their_first_linear_pass(self):
+        """Once a section's first view has read, the others are predicted from its points
+        (turned to their angles) or from the previous section: their first linear pass reads.
+        Searching from the top of the envelope, the other side's first pass found nothing."""
+        for seed in (11, 12):
+            part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
+            pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
+            rig = SimulatedRig(part, pose, seed=seed)
+            sections = ScanStrategy(rig, n_sections=3).run()
+            for sec in sections:
+                for view in sec.views[1:]:
+                    first = view.passes[0]
+                    self.assertEqual(first["kind"], "linear")
+                    self.assertGreaterEqual(first["readings"], 5, (sec.index, view.name))
+
+    def test_side_prediction_is_the_far_side_turned_over(self):
+        """A plate's top face read at z = 8 from above at 0 deg (axis at the origin, along Y):
+        turned by 180 deg about the axis that face lies at z = -8, under the other face, which
+        a plate of a few mm puts within the working range of that height."""
+        strategy = ScanStrategy(SimulatedRig(Sphere(10.0), np.eye(4)), span_range=(0, 1))
+        x = np.linspace(-20.0, 20.0, 81)
+        top = 8.0
+        reading = np.full(len(x), 44.0)
+        stage = np.column_stack([x, np.zeros(len(x)), top + reading])
+        view = ViewResult("side1", 0.0, stage, reading, np.full(len(x), 90.0), [])
+        self.assertAlmostEqual(strategy._side_prediction([view], 180.0), -top, places=9)
+        self.assertAlmostEqual(strategy._side_prediction([view], 0.0), top, places=9)
+        self.assertIsNone(strategy._side_prediction([], 180.0))
 
 
 class TestCalibratedKinematics(unittest.TestCase):

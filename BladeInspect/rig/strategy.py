@@ -38,10 +38,16 @@ MIN_EDGE_POINTS = 3
 EDGE_WINDOW_MM = 5.0
 EDGE_PROBE_SPACING_MM = 0.05
 SPAN_PROBE_OFFSETS = (-15.0, 15.0)
-MAX_EXTENSION_FACTOR = 4.0
+# An end that keeps reading doubles its extension up to this many times extension_mm: a long
+# blade's side seen from an edge view runs on for tens of mm past the first find, and a cap of
+# a few extensions crept along it 12 mm a pass (Rotor 67: up to 8 rescans for one view).
+MAX_EXTENSION_FACTOR = 16.0
 # Where the re-centred first window puts the highest surface point found, in half ranges
 # above the window's centre.
 RECENTRE_TOP = 0.6
+# A search window is skipped when it lies within this many half ranges of one that read
+# nothing: more than half of it was seen empty already.
+SKIP_OVERLAP = 0.8
 LEVEL_TOLERANCE_DEG = 10.0
 MAX_LEVELLING = 3
 KNOT_SPACING_MM = 1.5
@@ -372,8 +378,11 @@ class ScanStrategy:
         results = []
         for name, offset in self._view_order(k):
             angle = base + offset
-            near = self._edge_prediction(results, angle) if name.startswith("edge") else None
-            results.append(self._scan_view(name, y, angle, near=near))
+            if name.startswith("edge"):
+                near, predicted = self._edge_prediction(results, angle), None
+            else:
+                near, predicted = None, self._side_prediction(results, angle)
+            results.append(self._scan_view(name, y, angle, near=near, predicted=predicted))
         first = next(v for v in results if v.name == "side1")
         twist = self._chord_angle(first)
         level = base + (0.0 if twist is None else self._twist_sign * twist)
@@ -424,6 +433,33 @@ class ScanStrategy:
         top = max(ends, key=lambda p: p[2])
         return float(top[0]), float(top[2])
 
+    def _turned_surface(self, views, angle):
+        """The surface points of the views measured so far, in stage coordinates as they will
+        lie once the table is turned to ``angle``."""
+        k = self.kinematics
+        out = []
+        for v in views:
+            if len(v.reading_mm) < MIN_VIEW_POINTS:
+                continue
+            surface = v.stage_xyz - np.column_stack([np.zeros((len(v.reading_mm), 2)),
+                                                     v.reading_mm])
+            out.append(k.machine_point_of_table(k.table_point(surface, v.angle_deg), angle))
+        return np.vstack(out) if out else np.zeros((0, 3))
+
+    def _side_prediction(self, views, angle):
+        """Surface height (stage Z - standoff) a side view at this angle should find, from the
+        views of this section already measured: their points turned to this angle lie on or
+        under the surface seen from above (a thin blade's far side lies a thickness below
+        it), so the median over the section of the highest turned point per millimetre of X
+        lands within the working range. None before any view of the section read."""
+        pts = self._turned_surface(views, angle)
+        if len(pts) < MIN_VIEW_POINTS:
+            return None
+        cells = np.floor(pts[:, 0]).astype(int)
+        order = np.lexsort((-pts[:, 2], cells))
+        first = np.r_[True, cells[order][1:] != cells[order][:-1]]
+        return float(np.median(pts[order][first, 2]))
+
     def _level(self, y, base):
         """Step 1 for the first section: turn the part until the first side's chord is level
         (an edge-on blade shows only an edge, its points stand steeply)."""
@@ -458,9 +494,9 @@ class ScanStrategy:
 
     # -- one view: steps 1-5 -------------------------------------------------------------------
 
-    def _scan_view(self, name, y, angle, final=True, near=None):
+    def _scan_view(self, name, y, angle, final=True, near=None, predicted=None):
         passes = []
-        found = self._find_surface(name, y, angle, passes, near)
+        found = self._find_surface(name, y, angle, passes, near, predicted)
         if found is None:
             return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes)
         x_all, z_all = found
@@ -526,10 +562,12 @@ class ScanStrategy:
         reach = np.hypot(beyond[:, 0] - x_all[end], beyond[:, 1] - z_all[end])
         return bool(reach.max() >= self.probe_spacing)
 
-    def _find_surface(self, name, y, angle, passes, near=None):
-        """Steps 1-2: linear passes along X at fixed Z, first at the height this view found on
-        the previous section, then stepping down through the search envelope, until the sensor
-        reads. Returns the surface points (x, z) of that pass, or None.
+    def _find_surface(self, name, y, angle, passes, near=None, predicted=None):
+        """Steps 1-2: linear passes along X at fixed Z until the sensor reads: first at the
+        ``predicted`` surface height (from this section's other views), then at the height
+        this view found on the previous section, then through the search envelope nearest
+        those first (from the top down when nothing is known), skipping windows mostly covered
+        by one already found empty. Returns the surface points (x, z) of that pass, or None.
 
         ``near`` (x, z): where an edge is expected. A thin edge turned up shows only its nose
         to the sensor (the flanks lie beyond the coverage), a fraction of a millimetre that
@@ -552,14 +590,19 @@ class ScanStrategy:
         x0 = max(ax - self.search_radius, lim.x[0])
         x1 = min(ax + self.search_radius, lim.x[1])
         xs = self._samples(x0, x1, self.probe_spacing)
+        known = [v for v in (predicted, self.state.surface_z.get(name)) if v is not None]
         levels = self._levels()
-        hint = self.state.surface_z.get(name)
-        if hint is not None:
-            levels.insert(0, hint)
+        if known:
+            # The surface lies most likely near where it was expected: a wrong guess (the
+            # part turned far, off-centre) is usually one window away, not at the top.
+            levels.sort(key=lambda level: abs(level - known[0]))
         gross_snr = getattr(self.sensor, "gross_snr", 0.0)
-        for level in levels:
+        empty = []
+        for level in known + levels:
             z_stage = level + self.sensor.standoff
             if not lim.z[0] <= z_stage <= lim.z[1]:
+                continue
+            if any(abs(level - e) < SKIP_OVERLAP * self.sensor.half_range for e in empty):
                 continue
             stage = np.column_stack([xs, np.full(len(xs), y), np.full(len(xs), z_stage)])
             readings = self.rig.scan_path(stage, angle)
@@ -567,6 +610,7 @@ class ScanStrategy:
             passes.append(self._pass_info("linear", readings, d))
             valid = np.isfinite(d)
             if np.count_nonzero(valid) < MIN_VIEW_POINTS:
+                empty.append(level)
                 continue
             x, z, snr = stage[valid, 0], z_stage - d[valid], np.asarray(readings.snr)[valid]
             top = z.max()
