@@ -101,6 +101,8 @@ class Tessellation:
         self.hi = self.vertices.max(axis=0)
         self.triangle_uv = _unwrap_seams(nominal, self.face, np.concatenate(uv)[self.triangles])
         self.outward = _outward_signs(nominal, self)
+        # Newton evaluates each face's surface many times: its polynomial patches once.
+        self.patches = [bspline.PowerPatches(surf) for surf in nominal.surfaces]
         self._grids = OrderedDict()
         self._lock = threading.Lock()
 
@@ -415,7 +417,7 @@ def _sample_starts(nominal, f, x):
     return start
 
 
-def _refine(nominal, f, o, d, t, start, enters):
+def _refine(nominal, tess, f, o, d, t, start, enters):
     """Newton on S(u,v) = o + t d for rays hitting face f near o + t d, from (u, v) ``start``
     -> (t, outward normal, ok). ``enters``: whether the tessellated hit had the ray entering
     the material (the exact hit must agree).
@@ -435,7 +437,7 @@ def _refine(nominal, f, o, d, t, start, enters):
         if len(active) == 0:
             break
         ua, va, ta, oa, da = u[active], v[active], t[active], o[active], d[active]
-        S, Su, Sv, Suu, Suv, Svv = bspline.evaluate(surf, ua, va, order=2)
+        S, Su, Sv, Suu, Suv, Svv = tess.patches[f].evaluate(ua, va)
         F = oa + ta[:, None] * da - S
         # [Su Sv -d] (du dv dt) = R by Cramer's rule: the three cofactor rows.
         cu, cv, ct = _cross(Sv, -da), _cross(-da, Su), _cross(Su, Sv)
@@ -548,7 +550,7 @@ def _exact_hits(nominal, tess, origins, unit, t_hit, tri, bary):
             if closed:
                 uv[:, axis] = rng[0] + np.mod(uv[:, axis] - rng[0], rng[1] - rng[0])
         enters = _enters(tess, th[sel], unit[rows])
-        t, nrm, ok = _refine(nominal, f, origins[rows], unit[rows], t_hit[rows].copy(), uv,
+        t, nrm, ok = _refine(nominal, tess, f, origins[rows], unit[rows], t_hit[rows].copy(), uv,
                              enters)
         good = rows[ok]
         t_out[good], face_out[good], normal_out[good] = t[ok], f, nrm[ok]
@@ -632,7 +634,7 @@ def cast(nominal, origins, directions, deflection=None):
                 continue
             rows = doubtful[others]
             x = origins[rows] + t_all[rows, None] * unit[rows]
-            t, nrm, ok = _refine(nominal, f, origins[rows], unit[rows], t_all[rows].copy(),
+            t, nrm, ok = _refine(nominal, tess, f, origins[rows], unit[rows], t_all[rows].copy(),
                                  _sample_starts(nominal, f, x),
                                  _enters(tess, tri_all[rows], unit[rows]))
             ok &= (np.abs(t - t_all[rows]) < NEIGHBOUR_SLACK * deflection) & (t < best_t[others])

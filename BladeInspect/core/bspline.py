@@ -327,3 +327,99 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
     if len(active):
         out_S[active], out_Su[active], out_Sv[active] = evaluate(surf, u[active], v[active], order=1)
     return u, v, out_S, out_Su, out_Sv, converged
+
+
+class PowerPatches:
+    """A surface as one polynomial patch per pair of knot spans, in the span's own parameters
+    s = (u - u_i) / (u_{i+1} - u_i) and r likewise: a point and its derivatives are then
+    powers of (s, r) and two small products with the patch's coefficients, without the
+    Cox-de Boor recurrence -- about twice as fast as ``evaluate`` (order 2) for code that
+    evaluates one surface many times (ray casting's Newton). Agrees with it to ~1e-13
+    relative: the coefficients are the Taylor expansions of the basis functions at each
+    span's start (``basis_derivatives`` up to the degree), exact for polynomials.
+    Rational surfaces are expanded in homogeneous coordinates and divided out as
+    ``evaluate`` does."""
+
+    def __init__(self, surf):
+        self.surf = surf
+        p, q = surf.degree_u, surf.degree_v
+        self._u = _span_taylor(surf.knots_u, p)
+        self._v = _span_taylor(surf.knots_v, q)
+        (su, _, Au), (sv, _, Av) = self._u, self._v
+        hom = surf.homogeneous()                              # (nu, nv, c)
+        rows = su[:, None] - p + np.arange(p + 1)             # (Su, p+1)
+        cols = sv[:, None] - q + np.arange(q + 1)             # (Sv, q+1)
+        block = hom[rows[:, None, :, None], cols[None, :, None, :]]   # (Su, Sv, p+1, q+1, c)
+        # coefficient of s^k r^l: sum over the span's poles of both Taylor rows
+        coef = np.einsum("ikr,ijrqc,jlq->ijlkc", Au, block, Av)
+        self._c = hom.shape[2]
+        # per patch: rows are powers of r, columns (power of s, coordinate)
+        self._coef = coef.reshape(len(su) * len(sv), q + 1, (p + 1) * self._c)
+
+    def evaluate(self, u, v):
+        """(S, Su, Sv, Suu, Suv, Svv) at N parameter pairs, each (N, 3), as
+        ``evaluate(surf, u, v, order=2)``."""
+        surf = self.surf
+        p, q = surf.degree_u, surf.degree_v
+        u = np.atleast_1d(np.asarray(u, dtype=float))
+        v = np.atleast_1d(np.asarray(v, dtype=float))
+        u, v = np.broadcast_arrays(u, v)
+        n = len(u)
+        (su, hu, _), (sv, hv, _) = self._u, self._v
+        iu = find_span(surf.knots_u, p, u) - su[0]
+        iv = find_span(surf.knots_v, q, v) - sv[0]
+        Mu = _powers(u - surf.knots_u[su[iu]], hu[iu], p)     # (N, 3, p+1)
+        Mv = _powers(v - surf.knots_v[sv[iv]], hv[iv], q)
+        c = self._c
+        # sum over powers of r first (0th..2nd v-derivative), then over powers of s
+        G = np.matmul(Mv, self._coef[iu * len(sv) + iv]).reshape(n, 3, p + 1, c)
+        A = np.matmul(Mu, G[:, 0])                  # d^k/du^k, k = 0, 1, 2
+        B = np.matmul(Mu[:, :2], G[:, 1])           # d/dv, d2/dudv
+        Dvv = np.matmul(Mu[:, :1], G[:, 2])[:, 0]
+        D = {(0, 0): A[:, 0], (1, 0): A[:, 1], (2, 0): A[:, 2], (0, 1): B[:, 0],
+             (1, 1): B[:, 1], (0, 2): Dvv}
+        if not surf.rational:
+            return tuple(D[kl] for kl in _COMBOS)
+        # Quotient rule, as in _evaluate_chunk.
+        A = {kl: d[:, :3] for kl, d in D.items()}
+        w = {kl: d[:, 3:4] for kl, d in D.items()}
+        w0 = w[0, 0]
+        S = A[0, 0] / w0
+        Su = (A[1, 0] - w[1, 0] * S) / w0
+        Sv = (A[0, 1] - w[0, 1] * S) / w0
+        Suu = (A[2, 0] - 2 * w[1, 0] * Su - w[2, 0] * S) / w0
+        Suv = (A[1, 1] - w[1, 0] * Sv - w[0, 1] * Su - w[1, 1] * S) / w0
+        Svv = (A[0, 2] - 2 * w[0, 1] * Sv - w[0, 2] * S) / w0
+        return S, Su, Sv, Suu, Suv, Svv
+
+
+def _span_taylor(knots, degree):
+    """For every span find_span can return: its index, its length, and (span, k, r) the
+    coefficient of s^k in basis function N_{span-degree+r}, s in [0, 1] across the span."""
+    p = degree
+    spans = np.arange(p, len(knots) - p - 1)
+    h = knots[spans + 1] - knots[spans]
+    # a zero-length span is never returned by find_span; keep its (unused) entries finite
+    h = np.where(h > 0, h, 1.0)
+    D = basis_derivatives(knots, p, spans, knots[spans].astype(float), p)   # (S, k, r)
+    fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
+    return spans, h, D * (h[:, None] ** np.arange(p + 1) / fact)[:, :, None]
+
+
+def _powers(x, h, degree):
+    """(N, 3, degree+1): s^k and its first and second derivatives in the surface's own
+    parameter, for s = x / h."""
+    n = len(x)
+    s = x / h
+    inv = 1.0 / h
+    M = np.zeros((n, 3, degree + 1))
+    M[:, 0, 0] = 1.0
+    pw = [np.ones(n), s]
+    for k in range(2, degree + 1):
+        pw.append(pw[-1] * s)
+    for k in range(1, degree + 1):
+        M[:, 0, k] = pw[k]
+        M[:, 1, k] = k * pw[k - 1] * inv
+        if k >= 2:
+            M[:, 2, k] = k * (k - 1) * pw[k - 2] * inv * inv
+    return M
