@@ -94,8 +94,8 @@ class Rotor67Solid(unittest.TestCase):
 
     def test_normals_point_outward(self):
         for face in self.shape.Faces:
-            # The filled caps' surfaces run beyond their boundaries: start from the area
-            # centre projected onto the surface.
+            # Start from the area centre projected onto the surface (a cap's centre of mass
+            # is off its curved surface).
             uv = face.Surface.parameter(face.CenterOfMass)
             self.assertTrue(face.isPartOfDomain(*uv))
             p, n = face.valueAt(*uv), face.normalAt(*uv)

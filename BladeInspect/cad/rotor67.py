@@ -127,7 +127,7 @@ def _chord_params(rows):
 
 def make_rotor67_blade(dat_path, sections=None):
     """Rotor 67 as a ``BladeModel``: a solid of suction and pressure B-spline faces through
-    the 1-based ``sections`` (default all: hub to casing) closed by filled hub and tip faces;
+    the 1-based ``sections`` (default all: hub to casing) closed by ruled hub and tip faces;
     roles suction, pressure, hub, tip."""
     # Rebuilt only when the file changes: the pipeline and the document objects both load it.
     try:

@@ -61,16 +61,20 @@ def close_sides(side_a, side_b, cap_edges_start, cap_edges_end, planar_caps):
     """Sew two side faces and two caps into a solid (outward normals).
 
     ``side_a``/``side_b`` are faces meeting along their u=0 and u=1 edges;
-    ``cap_edges_*`` are the pairs of edges bounding each cap. Planar caps become plane
-    faces; otherwise a filled (Plate) face spans the loop. Returns (solid, [faces in the order
-    side_a, side_b, cap_start, cap_end]) as found in the solid's face list (indices).
+    ``cap_edges_*`` are the pairs of edges bounding each cap (the two sides' end curves, run
+    in the same direction). Planar caps become plane faces; otherwise a ruled face spans the
+    two curves. A ruled face passes through both exactly and needs no trimming, where a filled
+    (Plate) face only approximates its boundary (microns off on a blade tip) and is trimmed from
+    a larger degree-8 surface, which makes every distance query near the cap slow and sends it
+    to OpenCASCADE. Returns (solid, [faces in the order side_a, side_b, cap_start, cap_end]) as
+    found in the solid's face list (indices).
     """
     caps = []
-    for edges in (cap_edges_start, cap_edges_end):
+    for a, b in (cap_edges_start, cap_edges_end):
         if planar_caps:
-            caps.append(Part.Face(Part.Wire(list(edges))))
+            caps.append(Part.Face(Part.Wire([a, b])))
         else:
-            caps.append(Part.makeFilledFace(list(edges)))
+            caps.append(Part.makeRuledSurface(a, b))
     originals = [side_a, side_b] + caps
     sewn = Part.Compound(originals)
     sewn.sewShape()
