@@ -30,6 +30,13 @@ def main():
         tmp = tempfile.mkdtemp(prefix="bi-scan-reg-")
         try:
             rig = open_rig("sim", nominal, seed)
+            angles = set()
+            scan_path = rig.scan_path
+
+            def counting(path, angle_deg, scan_path=scan_path, angles=angles):
+                angles.add(round(float(angle_deg), 9))
+                return scan_path(path, angle_deg)
+            rig.scan_path = counting
             t0 = time.perf_counter()
             scan_to_dir(tmp + "/scan", rig, n_sections=args.sections, seed=seed)
             t_scan = time.perf_counter() - t0
@@ -43,10 +50,13 @@ def main():
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
         err = tf.corner_displacement(result.measured_to_cad, truth, nominal.bbox_corners)
-        print("seed %d: %d points, scan %.0f s (real rig ~%.0f s), register %.1f s; pose error "
-              "%.2f um = %.2fx its bound %.2f um; residual RMS %.4f mm"
-              % (seed, len(points.xyz), t_scan, record.get("real_time_s", float("nan")), t_reg,
-                 1e3 * err, err / result.pose_uncertainty_mm, 1e3 * result.pose_uncertainty_mm,
+        print("seed %d: %d points, %d passes (%d in the views, %d probing the span and "
+              "levelling), %d rotary angles; scan %.0f s (real rig ~%.0f s), register %.1f s; "
+              "pose error %.2f um = %.2fx its bound %.2f um; residual RMS %.4f mm"
+              % (seed, len(points.xyz), rig.pass_index, record["passes"],
+                 rig.pass_index - record["passes"], len(angles), t_scan,
+                 record.get("real_time_s", float("nan")), t_reg, 1e3 * err,
+                 err / result.pose_uncertainty_mm, 1e3 * result.pose_uncertainty_mm,
                  result.rms_mm), flush=True)
 
 
