@@ -254,8 +254,16 @@ class TestICP(unittest.TestCase):
         snr = rng.uniform(10.0, 100.0, 400)
         noise = rng.normal(size=400) * 0.004 * np.sqrt(50.0 / snr)
         pts, truth, _, _ = measured_cloud(rng, 400, noise)
-        res = icp.icp(pts, snr, ellipsoid_closest, start_near(rng, truth, 5.0, 3.0))
+        start = start_near(rng, truth, 5.0, 3.0)
+        # Run to the step tolerances, not stopped by the pose's uncertainty.
+        res = icp.icp(pts, snr, ellipsoid_closest, start, icp.ICPOptions(uncertainty_fraction=0))
         self.assertTrue(res.converged)
+        # By default it stops once what is left is under 1 % of the pose's own 1 sigma.
+        early = icp.icp(pts, snr, ellipsoid_closest, start)
+        self.assertTrue(early.converged)
+        self.assertLess(early.iterations, res.iterations)
+        sigma = icp.pose_uncertainty(res.covariance, res.center, CORNERS)
+        self.assertLess(pose_error(early.transform, res.transform), 0.02 * sigma)
         # The distances reported are the exact ones at the returned pose.
         moved = tf.apply_transform(res.transform, pts)
         np.testing.assert_allclose(res.distances, ellipsoid_closest(moved)[2], atol=1e-9)

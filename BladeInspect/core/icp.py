@@ -51,6 +51,12 @@ class ICPOptions:
     # closest-point evaluation: their error is curvature * step^2.
     linear_update_mm: float = 1e-4
     linear_update_rad: float = 1e-6
+    # Gauss-Newton also stops once the motion still to come, extrapolated from how the last
+    # steps shrink, is below this fraction of the pose's own 1 sigma uncertainty (both at the
+    # points' extremes). Real parts, whose form errors keep many points in the robust weight's
+    # taper band, converge linearly and slowly; iterating on moves the pose by nothing that
+    # matters against its uncertainty.
+    uncertainty_fraction: float = 0.01
 
 
 @dataclass
@@ -199,6 +205,19 @@ class Neighbourhoods:
         return result
 
 
+def _extremes(points):
+    """The corners of the points' bounding box."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                     for z in (lo[2], hi[2])])
+
+
+def _extreme_motion(points, center, dt, dw):
+    """Largest displacement of a corner of the points' bounding box under the small motion."""
+    v = _extremes(points) - center
+    return float(np.linalg.norm(dt + np.cross(dw, v), axis=1).max())
+
+
 def _jacobian(points_cad, normals, center):
     return np.hstack([normals, np.cross(points_cad - center, normals)])
 
@@ -275,6 +294,7 @@ def icp(points, snr, closest_fn, init, options=None):
     converged = False
     iterations = 0
     last_step = None   # (moved, normals, distances, center, dt, dw) of the last Gauss-Newton step
+    previous_motion = np.nan
     while iterations < options.max_iter:
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
@@ -297,6 +317,15 @@ def icp(points, snr, closest_fn, init, options=None):
             last_step = (moved, normals, distances, center, dt, dw)
             size = (np.linalg.norm(dt), np.linalg.norm(dw))
             T = make_transform(R, center + dt - R @ center) @ T
+            motion = _extreme_motion(moved, center, dt, dw)
+            rate = motion / previous_motion      # nan after the first step
+            previous_motion = motion
+            if rate < 0.95 and options.uncertainty_fraction > 0:
+                sigma = pose_uncertainty(pose_covariance(moved, normals, w, distances, center),
+                                         center, _extremes(moved))
+                if motion * rate / (1.0 - rate) < options.uncertainty_fraction * sigma:
+                    converged = True
+                    break
         if size[0] < options.trans_tol and size[1] < options.rot_tol:
             converged = True
             break
