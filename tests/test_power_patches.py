@@ -51,6 +51,18 @@ class PowerPatchesAgainstOCC(unittest.TestCase):
             bs = face.toNurbs().Faces[0].Surface
             self.check(bs, surface_data(bs, closed_u=bs.isUPeriodic()), rng, n=30)
 
+    def test_large_batch_in_chunks(self):
+        rng = np.random.default_rng(45)
+        bs, surf = random_surface(rng, rational=True)
+        u = rng.uniform(0, 1, bspline.CHUNK + 17)
+        v = rng.uniform(0, 1, len(u))
+        out = bspline.PowerPatches(surf).evaluate(u, v)
+        pick = np.concatenate([rng.integers(0, len(u), 20), [len(u) - 1]])
+        ref = occ_derivatives(bs, u[pick], v[pick])
+        for k in range(6):
+            self.assertEqual(out[k].shape, (len(u), 3))
+            np.testing.assert_allclose(out[k][pick], ref[k], atol=1e-9 * max(1, np.abs(ref[k]).max()))
+
     def test_single_point_and_broadcast(self):
         rng = np.random.default_rng(44)
         bs, surf = random_surface(rng, rational=True)

@@ -353,8 +353,11 @@ class PowerPatches:
         # coefficient of s^k r^l: sum over the span's poles of both Taylor rows
         coef = np.einsum("ikr,ijrqc,jlq->ijlkc", Au, block, Av)
         self._c = hom.shape[2]
-        # per patch: rows are powers of r, columns (power of s, coordinate)
-        self._coef = coef.reshape(len(su) * len(sv), q + 1, (p + 1) * self._c)
+        # (power of r, power of s, coordinate, patch): the patch index last, so a batch of
+        # points gathers its patches as rows of N contiguous values and the products below
+        # run over N at a time.
+        self._coef = np.ascontiguousarray(
+            coef.reshape(len(su) * len(sv), q + 1, p + 1, self._c).transpose(1, 2, 3, 0))
 
     def evaluate(self, u, v):
         """(S, Su, Sv, Suu, Suv, Svv) at N parameter pairs, each (N, 3), as
@@ -364,20 +367,26 @@ class PowerPatches:
         u = np.atleast_1d(np.asarray(u, dtype=float))
         v = np.atleast_1d(np.asarray(v, dtype=float))
         u, v = np.broadcast_arrays(u, v)
-        n = len(u)
+        if len(u) > CHUNK:
+            parts = [self.evaluate(u[s:s + CHUNK], v[s:s + CHUNK]) for s in range(0, len(u), CHUNK)]
+            return tuple(np.concatenate(d) for d in zip(*parts))
         (su, hu, _), (sv, hv, _) = self._u, self._v
         iu = find_span(surf.knots_u, p, u) - su[0]
         iv = find_span(surf.knots_v, q, v) - sv[0]
-        Mu = _powers(u - surf.knots_u[su[iu]], hu[iu], p)     # (N, 3, p+1)
+        Mu = _powers(u - surf.knots_u[su[iu]], hu[iu], p)     # (3, p+1, N)
         Mv = _powers(v - surf.knots_v[sv[iv]], hv[iv], q)
-        c = self._c
-        # sum over powers of r first (0th..2nd v-derivative), then over powers of s
-        G = np.matmul(Mv, self._coef[iu * len(sv) + iv]).reshape(n, 3, p + 1, c)
-        A = np.matmul(Mu, G[:, 0])                  # d^k/du^k, k = 0, 1, 2
-        B = np.matmul(Mu[:, :2], G[:, 1])           # d/dv, d2/dudv
-        Dvv = np.matmul(Mu[:, :1], G[:, 2])[:, 0]
-        D = {(0, 0): A[:, 0], (1, 0): A[:, 1], (2, 0): A[:, 2], (0, 1): B[:, 0],
-             (1, 1): B[:, 1], (0, 2): Dvv}
+        C = np.take(self._coef, iu * len(sv) + iv, axis=3)  # (q+1, p+1, c, N)
+        # sum over powers of r (0th..2nd v-derivative), then over powers of s
+        G = Mv[:, 0, None, None, :] * C[0]
+        for l in range(1, q + 1):
+            G += Mv[:, l, None, None, :] * C[l]                # (3, p+1, c, N)
+        D = {}
+        for kv, ku_max in ((0, 3), (1, 2), (2, 1)):
+            T = Mu[:ku_max, 0, None, :] * G[kv, 0]
+            for k in range(1, p + 1):
+                T += Mu[:ku_max, k, None, :] * G[kv, k]         # (ku_max, c, N)
+            for ku in range(ku_max):
+                D[ku, kv] = T[ku].T
         if not surf.rational:
             return tuple(D[kl] for kl in _COMBOS)
         # Quotient rule, as in _evaluate_chunk.
@@ -407,19 +416,19 @@ def _span_taylor(knots, degree):
 
 
 def _powers(x, h, degree):
-    """(N, 3, degree+1): s^k and its first and second derivatives in the surface's own
+    """(3, degree+1, N): s^k and its first and second derivatives in the surface's own
     parameter, for s = x / h."""
     n = len(x)
     s = x / h
     inv = 1.0 / h
-    M = np.zeros((n, 3, degree + 1))
-    M[:, 0, 0] = 1.0
+    M = np.zeros((3, degree + 1, n))
+    M[0, 0] = 1.0
     pw = [np.ones(n), s]
     for k in range(2, degree + 1):
         pw.append(pw[-1] * s)
     for k in range(1, degree + 1):
-        M[:, 0, k] = pw[k]
-        M[:, 1, k] = k * pw[k - 1] * inv
+        M[0, k] = pw[k]
+        M[1, k] = k * pw[k - 1] * inv
         if k >= 2:
-            M[:, 2, k] = k * (k - 1) * pw[k - 2] * inv * inv
+            M[2, k] = k * (k - 1) * pw[k - 2] * inv * inv
     return M
