@@ -118,6 +118,24 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
                     self.assertEqual(first["kind"], "linear")
                     self.assertGreaterEqual(first["readings"], 5, (sec.index, view.name))
 
+    def test_first_section_starts_where_the_span_probe_read(self):
+        """The span probe's lines along the axis read the surface heights near the first
+        section: its levelling search starts there and its first linear pass reads (from the
+        top of the envelope it found nothing)."""
+        for seed in (11, 12, 13):
+            part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
+            pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
+            rig = SimulatedRig(part, pose, seed=seed)
+            strategy = ScanStrategy(rig, n_sections=1, sides=1, edges=False)
+            strategy.section_y
+            first = rig.pass_index
+            readings = []
+            scan_path = rig.scan_path
+            rig.scan_path = lambda p, a: readings.append(scan_path(p, a)) or readings[-1]
+            strategy.run()
+            self.assertEqual(readings[0].meta["pass_index"], first)
+            self.assertGreaterEqual(np.isfinite(readings[0].reading_mm).sum(), 5, seed)
+
     def test_side_prediction_is_the_far_side_turned_over(self):
         """A plate's top face read at z = 8 from above at 0 deg (axis at the origin, along Y):
         turned by 180 deg about the axis that face lies at z = -8, under the other face, which

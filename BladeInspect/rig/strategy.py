@@ -48,6 +48,9 @@ RECENTRE_TOP = 0.6
 # A search window is skipped when it lies within this many half ranges of one that read
 # nothing: more than half of it was seen empty already.
 SKIP_OVERLAP = 0.8
+# The span probe's readings this close to a section (along the axis) predict where its first
+# search finds the surface.
+PROBE_HINT_MM = 3.0
 LEVEL_TOLERANCE_DEG = 10.0
 MAX_LEVELLING = 3
 KNOT_SPACING_MM = 1.5
@@ -268,6 +271,9 @@ class ScanStrategy:
         # Turning the table by +phi lowers a chord inclined by phi when the axis runs along +Y.
         self._twist_sign = 1.0 if d[1] >= 0 else -1.0
         self.state = state if state is not None else StrategyState(span_range=span_range)
+        # (angle, y, surface height) of the span probe's readings; not part of the checkpoint,
+        # which is only taken once the first section (and its levelling) is done.
+        self._probed = []
         if state is not None and state.pass_index is not None and hasattr(rig, "set_pass_index"):
             rig.set_pass_index(state.pass_index)
 
@@ -348,10 +354,21 @@ class ScanStrategy:
                          "(check the part is mounted and the search radius)" % self.search_radius)
 
     def _read_along(self, xy, z_stage, angle):
-        """Y of the readings of one pass over the (x, y) points at height z_stage."""
+        """Y of the readings of one pass over the (x, y) points at height z_stage. The surface
+        heights read are kept: they tell the first section's search where to start."""
         stage = np.column_stack([xy, np.full(len(xy), z_stage)])
         d = np.asarray(self.rig.scan_path(stage, angle).reading_mm, dtype=float)
-        return xy[np.isfinite(d), 1]
+        ok = np.isfinite(d)
+        self._probed.append((float(angle), xy[ok, 1], z_stage - d[ok]))
+        return xy[ok, 1]
+
+    def _probed_height(self, y, angle):
+        """Median surface height the span probe read within PROBE_HINT_MM of Y = y at this
+        rotary angle, or None."""
+        near = [z[np.abs(ys - y) <= PROBE_HINT_MM] for a, ys, z in self._probed
+                if abs(a - angle) < 1e-9]
+        near = np.concatenate(near) if near else np.zeros(0)
+        return float(np.median(near)) if len(near) else None
 
     def _levels(self):
         """Surface heights (stage Z - standoff) to probe at, from the top of the search
@@ -464,7 +481,8 @@ class ScanStrategy:
         """Step 1 for the first section: turn the part until the first side's chord is level
         (an edge-on blade shows only an edge, its points stand steeply)."""
         for _ in range(MAX_LEVELLING):
-            view = self._scan_view("side1", y, base, final=False)
+            view = self._scan_view("side1", y, base, final=False,
+                                   predicted=self._probed_height(y, base))
             twist = self._chord_angle(view)
             if twist is None:
                 base += 90.0
