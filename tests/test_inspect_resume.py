@@ -1,9 +1,9 @@
 """`inspect` over the serial driver, interrupted and resumed: the demo blade on the simulated rig
 served on a pty (SimRigDevice), the port vanishing inside the 2nd blind section, then inside
-the 2nd planned section, then inside the re-planned scan; each time the folder keeps a
-checkpoint (no result), and each resume runs on a fresh device. The last resume must end with
-exactly the files of one uninterrupted run of the same rig in process: the same points.csv
-rows (nothing measured twice or lost) and the same pose.
+the 1st and the 2nd planned sections, then inside the re-planned scan; each time the folder
+keeps a checkpoint (no result), and each resume runs on a fresh device. The last resume must
+end with exactly the files of one uninterrupted run of the same rig in process: the same
+points.csv rows (nothing measured twice or lost) and the same pose.
 
 A small epsilon (0.2 mm) puts the re-plan threshold at 0.5 um, so the loop re-plans here and
 the re-planned scan can be interrupted too; the blind scan keeps the usual 2 mm criterion."""
@@ -113,10 +113,11 @@ class TestInspectResume(unittest.TestCase):
         # Where each device fails (absolute pass index of the rig), and what the resumed run
         # starts from.
         faults = {"blind": ref.blind_section_pass[1] + 2,
+                  "first planned": ref.inside_section(0, 0),
                   "planned": ref.inside_section(0, 1),
                   "replanned": ref.inside_section(1, 1)}
         start = 0
-        for name in ("blind", "planned", "replanned"):
+        for name in ("blind", "first planned", "planned", "replanned"):
             try:
                 cls.run_serial(fault_at=faults[name] - start, resume=start > 0)
             except DeviceError as exc:
@@ -217,6 +218,16 @@ class TestInspectResume(unittest.TestCase):
         first_section = np.flatnonzero(blind & (self.ref.points.columns["section"] == 0))
         self.assert_rows_match_reference(snap["points"], first_section)
         self.assertEqual(snap["points_lines"][0], "x,y,z,snr,section,angle_deg,phase")
+
+    def test_fault_in_the_first_planned_section(self):
+        self.assertRegex(self.errors["first planned"], "motion port lost")
+        snap = self.snapshots["first planned"]
+        self.assert_is_checkpoint(snap, "planned")
+        state = snap["scan.json"]["inspection"]
+        self.assertEqual((state["attempt"], state["sections_done"]), (0, []))
+        # Nothing planned kept; the next pass is the first planned one.
+        self.assertEqual(state["pass_index"], self.ref.path_pass[0][0])
+        self.assert_rows_match_reference(snap["points"], self.planned_rows_of([]))
 
     def test_planned_fault_keeps_the_finished_planned_section(self):
         self.assertRegex(self.errors["planned"], "motion port lost")

@@ -322,12 +322,12 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
     if resumed is None:
         state = {"phase": "planned", "attempt": 0, "plan_pose": first.measured_to_cad.tolist(),
                  "paths_done": 0, "sections_done": [], "paths": [], "replans": [],
-                 "points_bytes": checkpoint.points_bytes()}
+                 "points_bytes": checkpoint.points_bytes(),
+                 "pass_index": getattr(rig, "pass_index", None)}
     else:
         state = dict(resumed)
         checkpoint.truncate_points(state["points_bytes"])
-        if state.get("pass_index") is not None and hasattr(rig, "set_pass_index"):
-            rig.set_pass_index(state["pass_index"])
+        _continue_pass_numbering(rig, state)
     state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
                  blind_points=n_blind, blind_rig_s=blind_rig_s,
                  blind_points_bytes=state.get("blind_points_bytes", state["points_bytes"]))
@@ -439,6 +439,13 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
             "pose_uncertainty_mm": result.pose_uncertainty_mm}
 
 
+def _continue_pass_numbering(rig, state):
+    """The next pass is numbered as in the interrupted run: a simulated rig's noise stream per
+    pass, so a resumed run measures what the uninterrupted one would have."""
+    if state.get("pass_index") is not None and hasattr(rig, "set_pass_index"):
+        rig.set_pass_index(state["pass_index"])
+
+
 def _save_plan(plan, checkpoint, resumed):
     """plan.json of the checkpoint. Resumed, the plan made again from the saved pose must be
     the saved plan: the rest of its sections is scanned as the interrupted run would have."""
@@ -483,41 +490,68 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     from . import sections as sections_mod
     from . import verdict as verdict_mod
     from .report import write_report
+    resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "complete" else None
     scan_record, blind, blind_rig_s, first = _blind_stage(
         nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
         scan_mod, pipeline, scan_share=0.15, register_share=0.1)
+    n_blind = len(blind.xyz)
+    blind_sections = _blind_column(blind, "section", n_blind)
+    first_line = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
+    if resumed is None:
+        state = {"phase": "complete", "plan_pose": first.measured_to_cad.tolist(),
+                 "passes_done": 0, "passes": [], "points_bytes": checkpoint.points_bytes(),
+                 "pass_index": getattr(rig, "pass_index", None)}
+    else:
+        state = dict(resumed)
+        checkpoint.truncate_points(state["points_bytes"])
+        _continue_pass_numbering(rig, state)
+    state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
+                 blind_points=n_blind, blind_rig_s=blind_rig_s)
 
     t0 = time.perf_counter()
     progress(0.25, "planning the complete raster from the CAD")
-    plan = plan_complete(nominal, first.measured_to_cad, rig.sensor, rig.limits, pitch=pitch,
+    pose = np.asarray(state["plan_pose"], dtype=float)
+    plan = plan_complete(nominal, pose, rig.sensor, rig.limits, pitch=pitch,
                          kinematics=kinematics)
     timing["plan"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    xyz_c, snr_c, line_c, angle_c, _, reading_c, pass_records = scan_complete(
-        rig, plan, kinematics, lambda f, m: progress(0.3 + 0.3 * f, m))
-    timing["complete_scan"] = time.perf_counter() - t0
-    complete_rig_s = checkpoint.rig_s() - blind_rig_s
-    worst = float(np.max(np.abs(reading_c - plan.standoff_mm))) if len(reading_c) else np.inf
-    if len(xyz_c) < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
-        raise InputError("inspect --complete: the raster does not find the blade where the "
-                         "blind scan's registration put it (%d of %d planned points read, "
-                         "standoff off by up to %.2f mm)" % (len(xyz_c), plan.n_points, worst))
+    _save_plan(plan, checkpoint, resumed is not None)
+    checkpoint.save(state, scan_record)
+
+    def pass_done(n_passes, rows, record):
+        xyz, snr, line, angle = rows
+        checkpoint.append_rows(xyz, snr, first_line + line, angle, "complete")
+        state["passes_done"] = n_passes
+        state["passes"] = state["passes"] + [record]
+        state["points_bytes"] = checkpoint.points_bytes()
+        state["pass_index"] = getattr(rig, "pass_index", None)
+        checkpoint.save(state, scan_record)
 
     t0 = time.perf_counter()
-    xyz = np.vstack([blind.xyz, xyz_c])
-    snr = np.concatenate([blind.snr, snr_c])
-    fit = pipeline.fine_register(xyz, snr, nominal, first.measured_to_cad,
+    scan_complete(rig, plan, kinematics, lambda f, m: progress(0.3 + 0.3 * f, m),
+                  first_pass=int(state["passes_done"]), on_pass=pass_done)
+    timing["complete_scan"] = time.perf_counter() - t0
+    complete_rig_s = checkpoint.rig_s() - blind_rig_s
+    pass_records = state["passes"]
+    raster = checkpoint.rows("complete")
+    n_read = 0 if raster is None else len(raster.xyz)
+    worst = max((r["max_standoff_error_mm"] or 0.0) for r in pass_records) if n_read else np.inf
+    if n_read < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
+        raise InputError("inspect --complete: the raster does not find the blade where the "
+                         "blind scan's registration put it (%d of %d planned points read, "
+                         "standoff off by up to %.2f mm)" % (n_read, plan.n_points, worst))
+
+    t0 = time.perf_counter()
+    xyz = np.vstack([blind.xyz, raster.xyz])
+    snr = np.concatenate([blind.snr, raster.snr])
+    fit = pipeline.fine_register(xyz, snr, nominal, pose,
                                  progress=lambda f, m: progress(0.65, m))
     timing["register_all"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    n_blind = len(blind.xyz)
-    blind_sections = _blind_column(blind, "section", n_blind)
-    first_line = (np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
-    columns = {"section": np.concatenate([blind_sections, first_line + line_c]),
+    columns = {"section": np.concatenate([blind_sections, raster.columns["section"]]),
                "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            angle_c]),
-               "phase": np.array(["blind"] * n_blind + ["complete"] * len(xyz_c))}
+                                            raster.columns["angle_deg"]]),
+               "phase": np.array(["blind"] * n_blind + ["complete"] * n_read)}
     everything = _pointset(xyz, snr, columns, "inspect --complete: blind and complete scans")
     result = _result_from_fit(nominal, everything, fit, first.coarse, dict(timing),
                               list(first.warnings))
@@ -525,7 +559,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     span_axis, _ = sections_mod.span_axis_of(nominal)
     # _subset drops the section column (raster lines are not the nominal planes), so the table
     # takes the points within its band of each plane.
-    table, verdict = _judge_after_blind(result, nominal, n_blind, len(xyz_c), heights,
+    table, verdict = _judge_after_blind(result, nominal, n_blind, n_read, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)
     timing["sections"] = time.perf_counter() - t0
@@ -536,11 +570,11 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     plan.to_json(out.path("plan.json"))
     scan_record["phases"] = {
         "blind": {"points": n_blind, "summary": dict(scan_record), "rig_s": blind_rig_s},
-        "complete": {"points": int(len(xyz_c)), "planned_points": plan.n_points,
+        "complete": {"points": n_read, "planned_points": plan.n_points,
                      "pitch_mm": plan.pitch_mm, "angles_deg": plan.angles_deg.tolist(),
                      "passes": pass_records, "rig_s": complete_rig_s,
                      "simulated_s": timing["complete_scan"],
-                     "sensor_rate_s": len(xyz_c) / float(rig.sensor.rate_hz)}}
+                     "sensor_rate_s": n_read / float(rig.sensor.rate_hz)}}
     with open(out.path("scan.json"), "w") as fh:
         json.dump(scan_record, fh, indent=1, default=pipeline._json_default)
     files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
@@ -558,7 +592,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
              "tolerance_mm": tolerance,
              "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
              "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
-             "n_points_by_phase": {"blind": n_blind, "complete": int(len(xyz_c))},
+             "n_points_by_phase": {"blind": n_blind, "complete": n_read},
              "complete": {"pitch_mm": plan.pitch_mm, "rig_s": complete_rig_s,
                           "simulated_s": timing["complete_scan"]},
              "rig_time_s": checkpoint.rig_s()}

@@ -263,13 +263,17 @@ def _no_progress(fraction, message):
     pass
 
 
-def scan_complete(rig, plan, kinematics=None, progress=_no_progress):
-    """Run every pass of ``plan`` on the rig. Returns (table-frame points (M, 3), snr (M,),
-    line (M,), angle_deg (M,), plan row (M,), reading_mm (M,), per-pass records); rows with
-    no reading are left out."""
+def scan_complete(rig, plan, kinematics=None, progress=_no_progress, first_pass=0,
+                  on_pass=None):
+    """Run the passes of ``plan`` on the rig from pass ``first_pass`` on (those before it were
+    measured before an interruption). Returns (table-frame points (M, 3), snr (M,), line (M,),
+    angle_deg (M,), plan row (M,), reading_mm (M,), per-pass records); rows with no reading
+    are left out. ``on_pass(n_passes_done, (xyz, snr, line, angle_deg), record)`` is called as
+    each pass ends: the inspection's checkpoint."""
     kinematics = kinematics if kinematics is not None else RigKinematics()
     xyz, snr, rows, readings_mm, records = [], [], [], [], []
-    for i, p in enumerate(plan.passes):
+    for i in range(first_pass, len(plan.passes)):
+        p = plan.passes[i]
         progress(i / len(plan.passes), "complete scan: pass %d of %d (A=%g deg, %d points)"
                  % (i + 1, len(plan.passes), p.angle_deg, len(p.rows)))
         readings = rig.scan_path(plan.stage_xyz[p.rows], p.angle_deg)
@@ -286,6 +290,12 @@ def scan_complete(rig, plan, kinematics=None, progress=_no_progress):
                         "max_standoff_error_mm": (float(np.max(np.abs(d[ok] - plan.standoff_mm)))
                                                   if ok.any() else None),
                         "pass_index": readings.meta.get("pass_index")})
+        if on_pass is not None:
+            on_pass(i + 1, (xyz[-1], snr[-1], plan.line[rows[-1]], plan.angle_deg[rows[-1]]),
+                    records[-1])
+    if not rows:
+        return (np.zeros((0, 3)), np.zeros(0), np.zeros(0, int), np.zeros(0),
+                np.zeros(0, int), np.zeros(0), records)
     rows = np.concatenate(rows)
     return (np.vstack(xyz), np.concatenate(snr), plan.line[rows], plan.angle_deg[rows], rows,
             np.concatenate(readings_mm), records)
