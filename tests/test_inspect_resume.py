@@ -1,7 +1,8 @@
 """`inspect` over the serial driver, interrupted and resumed: the demo blade on the simulated rig
-served on a pty (SimRigDevice), the port vanishing inside the 2nd blind section, then inside
-the 1st and the 2nd planned sections, then inside the re-planned scan; each time the folder
-keeps a checkpoint (no result), and each resume runs on a fresh device. The last resume must
+served on a pty (SimRigDevice), failing inside the 2nd blind section (the port vanishes), then
+inside the 1st planned section (an alarm) and the 2nd (garbage), then inside the re-planned
+scan (silence); each time the folder keeps a checkpoint (no result), and each resume runs on a
+fresh device. The last resume must
 end with exactly the files of one uninterrupted run of the same rig in process: the same
 points.csv rows (nothing measured twice or lost) and the same pose.
 
@@ -27,6 +28,11 @@ SEED = 23
 EPSILON = 0.2
 SCAN_OPTIONS = {"n_sections": 3, "point_spacing": 0.5, "edges": False, "epsilon": 2.0}
 RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf")
+# Where the chain of runs fails: the device's fault and what the driver's error says.
+FAULTS = {"blind": ("close", "motion port lost"),
+          "first planned": ("alarm", r"hard limit: controller raised ALARM:1"),
+          "planned": ("garbage", "garbage from the controller"),
+          "replanned": ("silent", r"timeout, no answer within 1 s")}
 
 
 def demo_nominal():
@@ -119,7 +125,7 @@ class TestInspectResume(unittest.TestCase):
         start = 0
         for name in ("blind", "first planned", "planned", "replanned"):
             try:
-                cls.run_serial(fault_at=faults[name] - start, resume=start > 0)
+                cls.run_serial(FAULTS[name][0], faults[name] - start, resume=start > 0)
             except DeviceError as exc:
                 cls.errors[name] = str(exc)
             cls.snapshots[name] = cls.snapshot()
@@ -132,13 +138,15 @@ class TestInspectResume(unittest.TestCase):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
     @classmethod
-    def run_serial(cls, fault_at=None, resume=False):
+    def run_serial(cls, kind=None, fault_at=None, resume=False):
         from BladeInspect.inspect.closed_loop import run_inspect
         from BladeInspect.rig.serial_rig import SerialRig
         from BladeInspect.rig.simrig_device import Fault, SimRigDevice
-        fault = None if fault_at is None else Fault("close", after_passes=fault_at)
+        fault = None if kind is None else Fault(kind, after_passes=fault_at)
         with SimRigDevice(simulated_rig(cls.nominal), fault=fault) as device:
-            rig = SerialRig(device.port_url, timeout_s=5)
+            # A silent device is noticed after the timeout; ray casting a long pass is not
+            # silence (the device reports Run meanwhile).
+            rig = SerialRig(device.port_url, timeout_s=1.0 if kind == "silent" else 5.0)
             try:
                 # The serial rig's sensor model comes from the device's ID: the defaults of
                 # the simulated rig's, so both plan the same paths.
@@ -179,6 +187,11 @@ class TestInspectResume(unittest.TestCase):
         np.testing.assert_array_equal(points.columns["phase"],
                                       ref.columns["phase"][reference_rows])
 
+    def assert_device_error(self, name):
+        message = self.errors[name]
+        self.assertRegex(message, r"^serial:\S+: .*" + FAULTS[name][1])
+        self.assertNotIn("\n", message)
+
     def assert_is_checkpoint(self, snap, phase):
         for name in RESULT_FILES:
             self.assertNotIn(name, snap)
@@ -208,7 +221,7 @@ class TestInspectResume(unittest.TestCase):
     # -- each interruption -----------------------------------------------------------------
 
     def test_blind_fault_keeps_the_finished_blind_section(self):
-        self.assertRegex(self.errors["blind"], "motion port lost")
+        self.assert_device_error("blind")
         self.assertNotIn("\n", self.errors["blind"])
         snap = self.snapshots["blind"]
         self.assert_is_checkpoint(snap, "blind")
@@ -220,7 +233,7 @@ class TestInspectResume(unittest.TestCase):
         self.assertEqual(snap["points_lines"][0], "x,y,z,snr,section,angle_deg,phase")
 
     def test_fault_in_the_first_planned_section(self):
-        self.assertRegex(self.errors["first planned"], "motion port lost")
+        self.assert_device_error("first planned")
         snap = self.snapshots["first planned"]
         self.assert_is_checkpoint(snap, "planned")
         state = snap["scan.json"]["inspection"]
@@ -230,7 +243,7 @@ class TestInspectResume(unittest.TestCase):
         self.assert_rows_match_reference(snap["points"], self.planned_rows_of([]))
 
     def test_planned_fault_keeps_the_finished_planned_section(self):
-        self.assertRegex(self.errors["planned"], "motion port lost")
+        self.assert_device_error("planned")
         snap = self.snapshots["planned"]
         self.assert_is_checkpoint(snap, "planned")
         state = snap["scan.json"]["inspection"]
@@ -257,7 +270,7 @@ class TestInspectResume(unittest.TestCase):
                         0.01)
 
     def test_replanned_fault_keeps_the_finished_replanned_section(self):
-        self.assertRegex(self.errors["replanned"], "motion port lost")
+        self.assert_device_error("replanned")
         snap = self.snapshots["replanned"]
         self.assert_is_checkpoint(snap, "planned")
         state = snap["scan.json"]["inspection"]
