@@ -81,10 +81,16 @@ def main():
         origins.append(o)
         dirs.append(np.tile(d, (m, 1)))
     origins, dirs = np.concatenate(origins), np.concatenate(dirs)
-    nominal.raycast(origins[:100], dirs[:100])   # builds the tessellation once
+    # First cast: the tessellation and one bucket grid per direction are built; the same
+    # directions again reuse the grids (a scan's rotary angles recur for every line).
     t = time.perf_counter()
-    t_hit, face, nrm = nominal.raycast(origins, dirs)
-    t_ray = time.perf_counter() - t
+    nominal.raycast(origins, dirs)
+    t_cold = time.perf_counter() - t
+    t_ray = np.inf
+    for _ in range(2):          # the better of two: other jobs share the machine
+        t = time.perf_counter()
+        t_hit, face, nrm = nominal.raycast(origins, dirs)
+        t_ray = min(t_ray, time.perf_counter() - t)
     hit = np.flatnonzero(~np.isnan(t_hit))
     chk = rng.choice(hit, min(100, len(hit)), replace=False)
     x = origins[chk] + t_hit[chk, None] * dirs[chk]
@@ -101,8 +107,10 @@ def main():
              bool(np.all(np.sign(res.distance[pick]) == np.sign(ref.distance))), 1e3 * t_ref / N_CHECK))
     print("FreeCAD distToShape on the solid: %.2f ms/point -> %.0f s for the full cloud "
           "(%.0f x slower)" % (1e3 * per_point, per_point * N_POINTS, per_point * N_POINTS / t_fast))
-    print("raycast: %d rays (%d directions) in %.2f s, %d hits; hit points' OCC distance max "
-          "%.2e mm" % (len(origins), n_pass, t_ray, len(hit), np.abs(ray_err).max()))
+    print("raycast: %d rays (%d directions) in %.2f s (%.1f us/ray; first cast with the "
+          "tessellation and grids %.2f s), %d hits; hit points' OCC distance max %.2e mm"
+          % (len(origins), n_pass, t_ray, 1e6 * t_ray / len(origins), t_cold, len(hit),
+             np.abs(ray_err).max()))
 
 
 if __name__ == "__main__":
