@@ -16,6 +16,14 @@ each nominal plane, and the `phase` column reads blind or complete.
 Files in DIR: points.csv (table frame, with a `phase` column: blind or planned), plan.json,
 scan.json (the blind scan's record, the planned passes, the simulator's truth), result.json
 (with `sections` and `uncertainty_after_blind_mm`), deviations.csv, report.html/.pdf.
+
+A rig failure (DeviceError) mid-loop leaves DIR a checkpoint instead: points.csv up to the
+last completed blind section, planned section or raster pass, plan.json, and scan.json marked
+incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
+CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
+measured data is kept section by section in a private folder while the loop runs
+(_Checkpoint), and a simulated rig's noise depends only on the pass number, which the
+checkpoint carries. See docs/internals.md for the checkpoint's fields.
 """
 
 import json
@@ -242,7 +250,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
         with pipeline.AtomicOutput(out_dir) as out:
             checkpoint = _Checkpoint(os.path.join(out.tmp, "checkpoint"), out_dir, identity,
                                      rig, resume)
-            scan_options = dict(checkpoint.identity["scan_options"])
+            scan_options = dict(checkpoint.identity["scan_options"] or {})
             try:
                 if complete:
                     summary = _complete_loop(nominal, rig, kinematics, heights, seed, epsilon,
@@ -342,8 +350,7 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
         plan = plan_sections(nominal, pose, heights, rig.sensor, rig.limits,
                              span_axis=span_axis, kinematics=kinematics)
         timing["plan" if attempt == 0 else "replan"] = time.perf_counter() - t0
-        _save_plan(plan, checkpoint, resumed is not None and attempt == resumed["attempt"])
-        checkpoint.save(state, scan_record)
+        _save_plan(plan, checkpoint)
 
         def section_done(n_paths, rows, records):
             xyz, snr, section, angle, _ = rows
@@ -382,9 +389,11 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
         # The re-plan measures the nominal sections again from the better pose; the first
         # pass's rows are replaced, as the uninterrupted loop replaces them.
         checkpoint.truncate_points(state["blind_points_bytes"])
+        os.remove(checkpoint.path("plan.json"))
         state.update(attempt=attempt + 1, plan_pose=np.asarray(fit.transform).tolist(),
                      paths_done=0, sections_done=[], paths=[],
                      points_bytes=state["blind_points_bytes"])
+        checkpoint.save(state, scan_record)
     replans = state["replans"]
     path_records = state["paths"]
 
@@ -446,17 +455,19 @@ def _continue_pass_numbering(rig, state):
         rig.set_pass_index(state["pass_index"])
 
 
-def _save_plan(plan, checkpoint, resumed):
-    """plan.json of the checkpoint. Resumed, the plan made again from the saved pose must be
-    the saved plan: the rest of its sections is scanned as the interrupted run would have."""
+def _save_plan(plan, checkpoint):
+    """plan.json of the checkpoint. One already there is the plan being scanned when the run
+    was interrupted (a re-plan removes the first): the plan made again from the saved pose
+    must be that one, so the rest of its sections is scanned as the interrupted run would."""
     text = plan.to_json()
-    if resumed:
-        with open(checkpoint.path("plan.json")) as fh:
+    path = checkpoint.path("plan.json")
+    if os.path.exists(path):
+        with open(path) as fh:
             if fh.read() != text:
                 raise InputError("--resume: the plan made again from the saved pose differs "
                                  "from the checkpoint's plan.json (another rig or software)")
         return
-    with open(checkpoint.path("plan.json"), "w") as fh:
+    with open(path, "w") as fh:
         fh.write(text)
 
 
@@ -507,6 +518,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
         _continue_pass_numbering(rig, state)
     state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
                  blind_points=n_blind, blind_rig_s=blind_rig_s)
+    checkpoint.save(state, scan_record)
 
     t0 = time.perf_counter()
     progress(0.25, "planning the complete raster from the CAD")
@@ -514,8 +526,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     plan = plan_complete(nominal, pose, rig.sensor, rig.limits, pitch=pitch,
                          kinematics=kinematics)
     timing["plan"] = time.perf_counter() - t0
-    _save_plan(plan, checkpoint, resumed is not None)
-    checkpoint.save(state, scan_record)
+    _save_plan(plan, checkpoint)
 
     def pass_done(n_passes, rows, record):
         xyz, snr, line, angle = rows
