@@ -105,8 +105,9 @@ class TestScanOfTwistedBlade(unittest.TestCase):
 class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
     def test_later_views_find_the_surface_with_their_first_linear_pass(self):
         """Once a section's first view has read, the others are predicted from its points
-        (turned to their angles) or from the previous section: their first linear pass reads.
-        Searching from the top of the envelope, the other side's first pass found nothing."""
+        (turned to their angles) or from the previous section: their first linear pass reads,
+        and the rescans follow it. Searching from the top of the envelope, the other side's
+        first pass found nothing."""
         for seed in (11, 12):
             part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
             pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
@@ -117,6 +118,9 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
                     first = view.passes[0]
                     self.assertEqual(first["kind"], "linear")
                     self.assertGreaterEqual(first["readings"], 5, (sec.index, view.name))
+                    # A window centred where the surface was expected is not re-centred: the
+                    # rescans follow straight on.
+                    self.assertEqual(view.passes[1]["kind"], "rescan", (sec.index, view.name))
 
     def test_first_section_starts_where_the_span_probe_read(self):
         """The span probe's lines along the axis read the surface heights near the first

@@ -616,7 +616,8 @@ class ScanStrategy:
             levels.sort(key=lambda level: abs(level - known[0]))
         gross_snr = getattr(self.sensor, "gross_snr", 0.0)
         empty = []
-        for level in known + levels:
+        for i, level in enumerate(known + levels):
+            expected = i < len(known)
             z_stage = level + self.sensor.standoff
             if not lim.z[0] <= z_stage <= lim.z[1]:
                 continue
@@ -632,9 +633,11 @@ class ScanStrategy:
                 continue
             x, z, snr = stage[valid, 0], z_stage - d[valid], np.asarray(readings.snr)[valid]
             top = z.max()
-            if top - level > -RECENTRE_TOP * self.sensor.half_range:
-                # Step 1's adjustment: lower the window so that the highest point found sits
-                # near its top; the steeper parts below the first find come into range.
+            if not expected and top - level > -RECENTRE_TOP * self.sensor.half_range:
+                # Step 1's adjustment of a surface found blind: lower the window so that the
+                # highest point found sits near its top; the steeper parts below the first find
+                # come into range. A window centred on the expected height needs none: the
+                # rescans' extensions reach the rest (Rotor 67: 6 passes of ~100 saved).
                 z_stage = top - RECENTRE_TOP * self.sensor.half_range + self.sensor.standoff
                 if lim.z[0] <= z_stage <= lim.z[1]:
                     stage[:, 2] = z_stage
