@@ -70,6 +70,11 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
+def _along(points, axis):
+    """points @ axis without BLAS: its threads would compete with the ray chunks' own."""
+    return points[:, 0] * axis[0] + points[:, 1] * axis[1] + points[:, 2] * axis[2]
+
+
 class Tessellation:
     """The faces' triangles with each vertex's (u, v) on its face's SurfaceData, and the
     per-direction bucket grids built from them."""
@@ -344,8 +349,8 @@ def _first_hits_group(tess, grid, origins, dirs, t0, t1, planar):
     best_b = np.zeros((n, 2))
     e1, e2 = grid.e1, grid.e2
     if planar:
-        xy = np.column_stack([origins @ e1, origins @ e2])
-        axial = origins @ grid.direction
+        xy = np.column_stack([_along(origins, e1), _along(origins, e2)])
+        axial = _along(origins, grid.direction)
         inside = np.all((xy >= grid.glo) & (xy <= grid.ghi), axis=1)
         ij = np.clip(np.floor((xy - grid.glo) / grid.cell).astype(int), 0, grid.g - 1)
         ray_owner = np.flatnonzero(inside)
@@ -354,8 +359,8 @@ def _first_hits_group(tess, grid, origins, dirs, t0, t1, planar):
         # The ray's trace on the plane runs from its entry to its exit point of the box.
         a = origins + t0[:, None] * dirs
         b = origins + t1[:, None] * dirs
-        ra = np.column_stack([a @ e1, a @ e2])
-        rb = np.column_stack([b @ e1, b @ e2])
+        ra = np.column_stack([_along(a, e1), _along(a, e2)])
+        rb = np.column_stack([_along(b, e1), _along(b, e2)])
         rlo, rhi = np.minimum(ra, rb), np.maximum(ra, rb)
         meets = np.flatnonzero(np.all((rhi >= grid.glo) & (rlo <= grid.ghi), axis=1))
         ray_owner, ray_cell = grid.segment_cells(ra[meets], rb[meets])
