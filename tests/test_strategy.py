@@ -140,6 +140,25 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
             self.assertEqual(readings[0].meta["pass_index"], first)
             self.assertGreaterEqual(np.isfinite(readings[0].reading_mm).sum(), 5, seed)
 
+    def test_first_side_view_starts_from_the_levelling(self):
+        """The levelling already followed the first section's side1 to within a few degrees of
+        its final angle: that view starts from those points turned on (no search pass) and
+        still covers the section's side."""
+        for seed in (11, 12):
+            part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
+            pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
+            rig = SimulatedRig(part, pose, seed=seed)
+            sections = ScanStrategy(rig, n_sections=2).run()
+            side1 = sections[0].views[0]
+            self.assertEqual(side1.name, "side1")
+            self.assertEqual([p["kind"] for p in side1.passes if p["kind"] == "linear"], [])
+            self.assertEqual(side1.passes[-1]["kind"], "final")
+            # The side's points reach from one edge region to the other (chord 50 mm).
+            x = side1.stage_xyz[:, 0]
+            self.assertGreater(x.max() - x.min(), 40.0)
+            # The next section searches again (only the first one is levelled).
+            self.assertEqual(sections[1].views[0].passes[0]["kind"], "linear")
+
     def test_side_prediction_is_the_far_side_turned_over(self):
         """A plate's top face read at z = 8 from above at 0 deg (axis at the origin, along Y):
         turned by 180 deg about the axis that face lies at z = -8, under the other face, which

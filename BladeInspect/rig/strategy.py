@@ -51,6 +51,9 @@ SKIP_OVERLAP = 0.8
 # The span probe's readings this close to a section (along the axis) predict where its first
 # search finds the surface.
 PROBE_HINT_MM = 3.0
+# The levelling view's points that start the first section's side1 view stay below this
+# slope once turned to the section's angle.
+START_MAX_SLOPE_DEG = 60.0
 LEVEL_TOLERANCE_DEG = 10.0
 MAX_LEVELLING = 3
 KNOT_SPACING_MM = 1.5
@@ -274,6 +277,9 @@ class ScanStrategy:
         # (angle, y, surface height) of the span probe's readings; not part of the checkpoint,
         # which is only taken once the first section (and its levelling) is done.
         self._probed = []
+        # The first section's last levelling view, when it met the tolerance (not part of the
+        # checkpoint either: it is used within that section).
+        self._levelled_view = None
         if state is not None and state.pass_index is not None and hasattr(rig, "set_pass_index"):
             rig.set_pass_index(state.pass_index)
 
@@ -392,14 +398,19 @@ class ScanStrategy:
         base = self.state.base_angle_deg
         if not self.state.levelled:
             base = self._level(y, base)
+        levelled, self._levelled_view = self._levelled_view, None
         results = []
         for name, offset in self._view_order(k):
             angle = base + offset
+            known = None
             if name.startswith("edge"):
                 near, predicted = self._edge_prediction(results, angle), None
             else:
                 near, predicted = None, self._side_prediction(results, angle)
-            results.append(self._scan_view(name, y, angle, near=near, predicted=predicted))
+                if name == "side1" and levelled is not None:
+                    known = self._levelled_start(levelled, angle)
+            results.append(self._scan_view(name, y, angle, near=near, predicted=predicted,
+                                           start=known))
         first = next(v for v in results if v.name == "side1")
         twist = self._chord_angle(first)
         level = base + (0.0 if twist is None else self._twist_sign * twist)
@@ -477,6 +488,24 @@ class ScanStrategy:
         first = np.r_[True, cells[order][1:] != cells[order][:-1]]
         return float(np.median(pts[order][first, 2]))
 
+    def _levelled_start(self, view, angle):
+        """Where the first section's side1 view starts instead of searching: the last levelling
+        view's points (the same section, turned by less than LEVEL_TOLERANCE_DEG since) turned
+        to ``angle``, as (x, z). Points whose neighbours turn steeper than START_MAX_SLOPE_DEG
+        are left to the rescans: near the silhouette the turn may tuck them under the surface.
+        None with too few points."""
+        order = np.argsort(view.stage_xyz[:, 0], kind="stable")
+        pts = self._turned_surface([view], angle)
+        if len(pts) < MIN_VIEW_POINTS:
+            return None
+        pts = pts[order]
+        dx, dz = np.diff(pts[:, 0]), np.diff(pts[:, 2])
+        gentle = (dx > 0) & (np.abs(dz) < np.tan(np.radians(START_MAX_SLOPE_DEG)) * dx)
+        keep = np.r_[False, gentle] & np.r_[gentle, False]
+        if np.count_nonzero(keep) < MIN_VIEW_POINTS:
+            return None
+        return pts[keep, 0], pts[keep, 2]
+
     def _level(self, y, base):
         """Step 1 for the first section: turn the part until the first side's chord is level
         (an edge-on blade shows only an edge, its points stand steeply)."""
@@ -491,6 +520,7 @@ class ScanStrategy:
                 self.state.surface_z["side1"] = view.surface_z
             base += self._twist_sign * twist
             if abs(twist) < LEVEL_TOLERANCE_DEG:
+                self._levelled_view = view
                 break
         self.state.levelled = True
         self.state.base_angle_deg = base
@@ -512,9 +542,12 @@ class ScanStrategy:
 
     # -- one view: steps 1-5 -------------------------------------------------------------------
 
-    def _scan_view(self, name, y, angle, final=True, near=None, predicted=None):
+    def _scan_view(self, name, y, angle, final=True, near=None, predicted=None, start=None):
+        """Steps 1-5 for one view; ``start`` (x, z): surface points of this section already
+        known at this angle, followed at once instead of searching."""
         passes = []
-        found = self._find_surface(name, y, angle, passes, near, predicted)
+        found = start if start is not None else self._find_surface(name, y, angle, passes,
+                                                                     near, predicted)
         if found is None:
             return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes)
         x_all, z_all = found
