@@ -150,6 +150,26 @@ class BoxWithHole(DistanceCase, unittest.TestCase):
         rng = np.random.default_rng(12)
         self.check(self.nominal, corner_points(self.nominal.shape, rng, 4, 1.0), 0, 1.0)
 
+    def test_fallback_signs_without_the_inside_test(self):
+        """The fallback signs a point from its foot point's normal or an edge's pseudo-normal
+        instead of the solid's inside test: the same signs, around convex and concave edges
+        (the hole's), where the inside test of this simple solid is reliable."""
+        from BladeInspect.cad.nominal import DistanceResult
+        rng = np.random.default_rng(31)
+        points = corner_points(self.nominal.shape, rng, 3, 0.5)
+        n = len(points)
+        out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
+                             np.empty((n, 3)), np.empty(n), np.zeros(n, bool))
+        self.nominal._occ_into(points, out, np.arange(n), solid_test=False)
+        d, c, sign = occ_reference(self.nominal.shape, points)
+        np.testing.assert_allclose(np.abs(out.distance), d, atol=TOL)
+        known = d > 1e-7
+        np.testing.assert_array_equal(np.sign(out.distance[known]), sign[known])
+        # Most of these points' foot points are on an edge: the pseudo-normal decided them.
+        on_edge = [self.nominal._face_compound.distToShape(Part.Vertex(V(*p)))[2][0][0] == "Edge"
+                   for p in points]
+        self.assertGreater(np.mean(on_edge), 0.2)
+
     def test_face_types_and_trimming(self):
         kinds = sorted({type(f.Surface).__name__ for f in self.nominal.faces})
         self.assertEqual(kinds, ["Cylinder", "Plane"])
