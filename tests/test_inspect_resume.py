@@ -377,6 +377,11 @@ class TestResumeRefusals(unittest.TestCase):
         model = make_demo_blade(BladeParams(span=60.0))
         self.refused("another part", nominal=nominal_from_shape(model.shape, roles=model.roles))
 
+    def test_another_kind_of_rig(self):
+        # Begun over the serial driver; the in-process simulated rig is another rig.
+        self.refused("made on a SerialRig rig, not a SimulatedRig",
+                     scan_options=dict(SCAN_OPTIONS))
+
     def test_complete_instead_of_sections(self):
         self.refused("--complete", complete=True)
 

@@ -36,6 +36,7 @@ import numpy as np
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
+from ..rig.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
 
 DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 EPSILON_MM = 2.0
@@ -50,9 +51,8 @@ MIN_READ_FRACTION = 0.9
 RESUME_POSE_TOLERANCE_MM = 1e-6
 # While an inspection is unfinished, scan.json holds the loop's state under this key.
 CHECKPOINT = "inspection"
-RECORD_FILE = "scan.json"
 # What a checkpoint is made of; scan.json last, since it marks the folder as one.
-CHECKPOINT_FILES = ("plan.json", "points.csv", RECORD_FILE)
+CHECKPOINT_FILES = ("plan.json", POINTS_FILE, RECORD_FILE)
 # What a finished inspection adds; none of them may stand beside a checkpoint.
 RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf",
                 "inspection.FCStd")
@@ -644,6 +644,8 @@ class _Checkpoint:
             raise InputError("--resume: %s holds no interrupted inspection to continue"
                              % out_dir)
         self.identity = _same_identity(saved.get("options"), identity, out_dir)
+        with open(record_path) as fh:
+            check_same_rig(json.load(fh), rig, identity["seed"], record_path)
         self.state = saved
         self._earlier_rig_s = float(saved.get("rig_s", 0.0))
         os.makedirs(folder)
@@ -668,7 +670,6 @@ class _Checkpoint:
     def save(self, state, record=None):
         """Records where the loop stands (after a completed section: the rows on disk are
         exactly those the state counts)."""
-        from ..rig.scan import write_record
         record = self.record() if record is None else dict(record)
         self.state = dict(state, options=self.identity, complete=False, rig_s=self.rig_s())
         record[CHECKPOINT] = self.state
@@ -694,7 +695,6 @@ class _Checkpoint:
                 os.remove(os.path.join(self.out_dir, name))
 
     def truncate_points(self, size):
-        from ..rig.scan import POINTS_FILE
         path = self.path(POINTS_FILE)
         if os.path.getsize(path) < size:
             raise InputError("%s: shorter than its checkpoint in %s (the folder was changed)"
@@ -703,11 +703,11 @@ class _Checkpoint:
             fh.truncate(size)
 
     def points_bytes(self):
-        return os.path.getsize(self.path("points.csv"))
+        return os.path.getsize(self.path(POINTS_FILE))
 
     def rows(self, phase):
         """The rows of one phase in points.csv (a PointSet; None when there are none)."""
-        pointset = read_points(self.path("points.csv"))
+        pointset = read_points(self.path(POINTS_FILE))
         keep = pointset.columns["phase"] == phase
         if not keep.any():
             return None
@@ -723,7 +723,7 @@ class _Checkpoint:
                                                np.asarray(snr, dtype=float).tolist(),
                                                np.asarray(section).tolist(),
                                                np.asarray(angle, dtype=float).tolist())]
-        with open(self.path("points.csv"), "a") as fh:
+        with open(self.path(POINTS_FILE), "a") as fh:
             fh.write("".join(lines))
             fh.flush()
             os.fsync(fh.fileno())

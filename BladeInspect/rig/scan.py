@@ -82,7 +82,7 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
         state = None
     else:
         record = _load_record(record_path)
-        _check_same_rig(record, rig, seed, record_path)
+        check_same_rig(record, rig, seed, record_path)
         options = record["options"]
         state = StrategyState.from_dict(record["checkpoint"]["strategy"])
     # Options are checked before anything is written.
@@ -179,7 +179,9 @@ def _new_record(rig, seed, options):
     return record
 
 
-def _check_same_rig(record, rig, seed, path):
+def check_same_rig(record, rig, seed, path):
+    """InputError unless ``rig`` and ``seed`` are those the scan in ``record`` was begun with
+    (the rig's kind, and a simulated part's clamping)."""
     if int(record.get("seed", seed)) != int(seed):
         raise InputError("%s: the scan was made with seed %s, not %s"
                          % (path, record.get("seed"), seed))
