@@ -424,8 +424,10 @@ def _sample_starts(nominal, f, x):
 
 def _refine(nominal, tess, f, o, d, t, start, enters):
     """Newton on S(u,v) = o + t d for rays hitting face f near o + t d, from (u, v) ``start``
-    -> (t, outward normal, ok). ``enters``: whether the tessellated hit had the ray entering
-    the material (the exact hit must agree).
+    -> (t, outward normal, ok, jump). ``enters``: whether the tessellated hit had the ray
+    entering the material (the exact hit must agree). ``jump`` (N, 3): for rays whose Newton
+    found the root on the wrong side (a grazing ray's far root), a start (t, u, v) near the
+    root before it; NaN for the others.
 
     Each step is Chebyshev's: the Newton step, then solved again with the surface's quadratic
     term along it, so the residual falls cubically (two evaluations from a tessellated start
@@ -433,10 +435,12 @@ def _refine(nominal, tess, f, o, d, t, start, enters):
     surf = nominal.surfaces[f]
     sign = -1.0 if nominal._reversed[f] else 1.0
     n = len(o)
-    u, v = start[:, 0].copy(), start[:, 1].copy()
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    u = u0 + np.mod(start[:, 0] - u0, u1 - u0) if surf.closed_u else np.clip(start[:, 0], u0, u1)
+    v = v0 + np.mod(start[:, 1] - v0, v1 - v0) if surf.closed_v else np.clip(start[:, 1], v0, v1)
     nrm = np.full((n, 3), np.nan)
     converged = np.zeros(n, bool)
+    jump = np.full((n, 3), np.nan)
     active = np.arange(n)
     for _ in range(NEWTON_ITERATIONS):
         if len(active) == 0:
@@ -485,11 +489,36 @@ def _refine(nominal, tess, f, o, d, t, start, enters):
         same_side = (_dot(da[g], outward) < 0) == enters[active[g]]
         converged[active[g[same_side]]] = True
         nrm[active[g]] = outward
+        w = g[~same_side]
+        if len(w):
+            jump[active[w]] = _other_root(t[active[w]], u[active[w]], v[active[w]], da[w],
+                                          outward[~same_side], Su[w], Sv[w], Suu[w], Suv[w],
+                                          Svv[w])
         active = active[~done]
     dom = nominal._domains[f]
     inside, bdist = point_in_domain(dom, np.column_stack([u, v]))
     ok = converged & inside & (bdist > dom.margin) & (t >= 0)
-    return t, nrm, ok
+    return t, nrm, ok, jump
+
+
+def _other_root(t, u, v, d, nrm, Su, Sv, Suu, Suv, Svv):
+    """Where the ray's other root lies, from the surface's second-order expansion at the root
+    found: along the ray the height above the surface is h(s) = c s - II(w) s^2 / 2 (c = d.n,
+    w = d's tangential part, II the second fundamental form), so the other root is
+    s = 2c / II(w) away. -> (N, 3) starts (t, u, v); NaN unless that root comes first."""
+    c = _dot(d, nrm)
+    w = d - c[:, None] * nrm
+    E, F, G = _dot(Su, Su), _dot(Su, Sv), _dot(Sv, Sv)
+    wu, wv = _dot(Su, w), _dot(Sv, w)
+    det = E * G - F * F
+    a = (G * wu - F * wv) / det
+    b = (E * wv - F * wu) / det
+    second = _dot(Suu * (a * a)[:, None] + 2.0 * Suv * (a * b)[:, None]
+                  + Svv * (b * b)[:, None], nrm)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = 2.0 * c / second
+    s = np.where(np.isfinite(s) & (s < 0), s, np.nan)
+    return np.column_stack([t + s, u + s * a, v + s * b])
 
 
 def _occ_ray(nominal, o, d, t_far):
@@ -555,8 +584,17 @@ def _exact_hits(nominal, tess, origins, unit, t_hit, tri, bary):
             if closed:
                 uv[:, axis] = rng[0] + np.mod(uv[:, axis] - rng[0], rng[1] - rng[0])
         enters = _enters(tess, th[sel], unit[rows])
-        t, nrm, ok = _refine(nominal, tess, f, origins[rows], unit[rows], t_hit[rows].copy(), uv,
-                             enters)
+        t, nrm, ok, jump = _refine(nominal, tess, f, origins[rows], unit[rows],
+                                   t_hit[rows].copy(), uv, enters)
+        # A grazing ray whose Newton found the far root: once more from the near one.
+        again = np.flatnonzero(~ok & np.isfinite(jump[:, 0]))
+        if len(again):
+            r = rows[again]
+            t2, n2, ok2, _ = _refine(nominal, tess, f, origins[r], unit[r], jump[again, 0].copy(),
+                                     jump[again, 1:], enters[again])
+            ok2 &= t2 < t[again]
+            k = again[ok2]
+            t[k], nrm[k], ok[k] = t2[ok2], n2[ok2], True
         good = rows[ok]
         t_out[good], face_out[good], normal_out[good] = t[ok], f, nrm[ok]
         doubtful.append(rows[~ok])
@@ -639,9 +677,9 @@ def cast(nominal, origins, directions, deflection=None):
                 continue
             rows = doubtful[others]
             x = origins[rows] + t_all[rows, None] * unit[rows]
-            t, nrm, ok = _refine(nominal, tess, f, origins[rows], unit[rows], t_all[rows].copy(),
-                                 _sample_starts(nominal, f, x),
-                                 _enters(tess, tri_all[rows], unit[rows]))
+            t, nrm, ok, _ = _refine(nominal, tess, f, origins[rows], unit[rows],
+                                    t_all[rows].copy(), _sample_starts(nominal, f, x),
+                                    _enters(tess, tri_all[rows], unit[rows]))
             ok &= (np.abs(t - t_all[rows]) < NEIGHBOUR_SLACK * deflection) & (t < best_t[others])
             k = others[ok]
             best_t[k], best_f[k], best_n[k] = t[ok], f, nrm[ok]

@@ -408,9 +408,13 @@ def _span_taylor(knots, degree):
     p = degree
     spans = np.arange(p, len(knots) - p - 1)
     h = knots[spans + 1] - knots[spans]
-    # a zero-length span is never returned by find_span; keep its (unused) entries finite
-    h = np.where(h > 0, h, 1.0)
-    D = basis_derivatives(knots, p, spans, knots[spans].astype(float), p)   # (S, k, r)
+    # A zero-length span (a repeated knot) is never returned by find_span: its recurrence
+    # divides by zero, and its (unused) coefficients are set to zero.
+    empty = ~(h > 0)
+    h = np.where(empty, 1.0, h)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        D = basis_derivatives(knots, p, spans, knots[spans].astype(float), p)   # (S, k, r)
+    D[empty] = 0.0
     fact = np.cumprod(np.concatenate([[1.0], np.arange(1.0, p + 1)]))
     return spans, h, D * (h[:, None] ** np.arange(p + 1) / fact)[:, :, None]
 
