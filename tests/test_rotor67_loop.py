@@ -14,8 +14,9 @@ simulated rig (issues 4 and 8, "What must hold"), judged by the simulator's trut
 Readings are turned into CAD points here independently of the rig code: machine point
 (X, Y, Z - d), turned back about the nominal rotary axis (origin, +Y) by Rodrigues' formula,
 then through the fixture pose. Test parameters keep the module short: three blind sections,
-two nominal sections. Rotor 67's blind scans take the longest of the suite; their time goes
-to ray casting on its 160 mm lofted faces (one grid per rotary angle), see bench/."""
+two nominal sections. Most of its time is the simulated rig's ray casting (a triangle grid per
+rotary angle: ~44 angles over the two blind scans and the planned one); more poses are in
+bench/bench_scan_register.py and bench/bench_rotor67_loop.py."""
 import json
 import os
 import shutil
