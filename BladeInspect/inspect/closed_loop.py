@@ -621,8 +621,8 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
 class _Checkpoint:
     """What an inspection has measured so far, kept in a private folder while it runs:
     points.csv and scan.json grow one completed blind section at a time (rig.scan.scan_to_dir's
-    own checkpoint), then one completed planned section at a time; plan.json is the plan being
-    scanned. scan.json's CHECKPOINT entry says where the loop stands. A DeviceError moves the
+    own checkpoint), then one completed planned section or raster pass at a time; plan.json is
+    the plan being scanned. scan.json's CHECKPOINT entry says where the loop stands. A DeviceError moves the
     three files into DIR (keep); ``resume`` starts from a copy of those in DIR."""
 
     def __init__(self, folder, out_dir, identity, rig, resume):
@@ -633,13 +633,17 @@ class _Checkpoint:
         self._session_start = float(rig.elapsed_s)
         self._earlier_rig_s = 0.0
         record_path = os.path.join(self.out_dir, RECORD_FILE)
-        saved = _saved_checkpoint(record_path)
         if not resume:
+            try:
+                saved = _saved_checkpoint(record_path)
+            except InputError:
+                saved = None    # not a checkpoint: a fresh run replaces it, as any old file
             if saved is not None:
                 raise InputError("--out %s: holds an interrupted inspection (use --resume to "
                                  "continue it, or another folder)" % out_dir)
             self.identity = identity
             return
+        saved = _saved_checkpoint(record_path)
         if saved is None:
             raise InputError("--resume: %s holds no interrupted inspection to continue"
                              % out_dir)
