@@ -137,6 +137,39 @@ class Rotor67Solid(unittest.TestCase):
 
 
 @unittest.skipUnless(have_rotor67(), "Rotor 67 data not present")
+class Rotor67RealCloudRegistration(unittest.TestCase):
+    def test_register_finds_the_provenance_frame(self):
+        """The independent CFD cloud, moved to a random pose (any rotation, 150 mm away),
+        through `register` against the loft of the section table: both are in one frame by
+        their provenance, and the geometries differ by up to 0.3 mm, so the pose must come
+        back to within a few hundredths of a millimetre of it."""
+        import json
+        from BladeInspect import cli
+        from BladeInspect.core import transforms as tf
+        cloud = np.loadtxt(ROTOR67_CLOUD)[:, 1:4] * 1000.0
+        move = tf.random_transform(np.random.default_rng(2067), 150.0)
+        folder = tempfile.mkdtemp(prefix="bladeinspect-r67cloud-")
+        self.addCleanup(shutil.rmtree, folder, True)
+        points = os.path.join(folder, "cloud.csv")
+        np.savetxt(points, tf.apply_transform(move, cloud), delimiter=",", header="x,y,z",
+                   comments="")
+        out = os.path.join(folder, "out")
+        self.assertEqual(cli.main(["register", "--cad", ROTOR67_SECTIONS, "--points", points,
+                                   "--out", out]), 0)
+        with open(os.path.join(out, "result.json")) as fh:
+            result = json.load(fh)
+        lo, hi = cloud.min(axis=0), cloud.max(axis=0)
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                            for z in (lo[2], hi[2])])
+        err = tf.corner_displacement(np.array(result["measured_to_cad"]),
+                                     tf.invert_transform(move), corners)
+        self.assertLess(err, 0.08, "pose %.4f mm from the provenance frame" % err)
+        # The points the robust fit keeps are the blade's own differences, microns not tenths.
+        self.assertLess(result["rms_mm"], 0.02)
+        self.assertGreater(result["n_inliers"], 0.8 * len(cloud))
+
+
+@unittest.skipUnless(have_rotor67(), "Rotor 67 data not present")
 class Rotor67BadFiles(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
