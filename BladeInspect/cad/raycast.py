@@ -8,10 +8,13 @@ The grid of a direction depends only on the tessellation and the direction, so i
 (a scan turns the part to the same few rotary angles again and again). Rays parallel to the
 grid's direction are decided in the plane (2D barycentrics, depth interpolated); others by
 Möller–Trumbore. Stage 2 moves each hit onto the exact surface of the hit triangle's face by
-Newton on S(u, v) - o - t d = 0 (unknowns u, v, t), started from the hit's barycentric
-interpolation of the triangle's vertex parameters. A ray whose refined hit leaves the face's
-trimmed domain, lands too close to its boundary to tell, or does not converge is tried on the
-neighbouring faces, then intersected by OCC (``Shape.section`` with the ray as an edge).
+Newton (Chebyshev) steps on S(u, v) - o - t d = 0 (unknowns u, v, t), started from the hit's
+barycentric interpolation of the triangle's vertex parameters, on the surface's polynomial
+patches (core.bspline.PowerPatches). A root on the other side from the triangle's (a grazing
+ray's far root) restarts at the near root its second-order expansion predicts. A ray whose
+refined hit leaves the face's trimmed domain, lands too close to its boundary to tell, or does
+not converge is tried on the other faces from the samples near it, then intersected by OCC
+(``Shape.section`` with the ray as an edge). Both stages run on chunks of rays in two threads.
 
 Rays that graze a face within the tessellation's deflection of its silhouette may be reported
 as misses (or hits) differently from the exact surface: a scanning sensor never measures there.
