@@ -70,13 +70,6 @@ def table_points(readings):
             + np.outer(machine @ k, k) * (1.0 - np.cos(a)))
 
 
-def read_csv(path):
-    with open(path) as fh:
-        header = fh.readline().strip().split(",")
-    data = np.genfromtxt(path, delimiter=",", skip_header=1, dtype=str)
-    return {name: data[:, i] for i, name in enumerate(header)}
-
-
 @unittest.skipUnless(have_rotor67(), "Rotor 67 data not present")
 class TestBlindScanRegisters(unittest.TestCase):
     """Issue 4 on the real blade: `scan` (open_rig + scan_to_dir) then `register`."""
