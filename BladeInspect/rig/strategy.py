@@ -1,8 +1,10 @@
 """The blind section-line scan (paper 3.1.1, steps 1-5), driven only by what the sensor reads.
 
 Per section plane Y = y_k and per view (rotary angle):
-  1. find the surface: linear passes at fixed Z stepping down through the search envelope
-     (or at the level the previous section found) until the sensor reads;
+  1. find the surface: linear passes at fixed Z until the sensor reads, first at the height
+     where it is expected (this section's views already measured, turned to this angle; else
+     the previous section's; for the first section, what the span probe read near it), then
+     through the search envelope outward from there (top down when nothing is known);
   2. that linear scan at fixed Z gives the first points, only those within the working range;
   3. fit a cubic uniform B-spline to the valid points (parametric by chord length, so the
      steep flanks near the edges are as easy as the flat middle);
@@ -16,7 +18,8 @@ as far as the angular coverage reaches; a thin edge shows only its nose, looked 
 where the side views' ends predict it) and the other side at +180 deg. The next section's
 base angle is the one that levelled this section's first side (its chord read from the points)
 carried on by the twist rate read between the last two sections, so every section is scanned
-nearly level. The first section levels itself the same way before it counts.
+nearly level. The first section levels itself the same way before it counts, and its first
+side's view then starts from the last levelling points turned on by the residual twist.
 
 Everything is in stage coordinates while planning (surface height = Z - d); the kinematics
 (RIG.json) turns the kept readings into machine and then table-frame points.
