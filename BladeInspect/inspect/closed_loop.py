@@ -351,10 +351,14 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
                              span_axis=span_axis, kinematics=kinematics)
         timing["plan" if attempt == 0 else "replan"] = time.perf_counter() - t0
         _save_plan(plan, checkpoint)
+        # Sections measured before an interruption are read back; this run's are kept too.
+        earlier = checkpoint.rows("planned") if state["paths_done"] else None
+        session = []
 
         def section_done(n_paths, rows, records):
             xyz, snr, section, angle, _ = rows
-            checkpoint.append_rows(xyz, snr, first_planned + section, angle, "planned")
+            session.append((xyz, snr, first_planned + section, angle))
+            checkpoint.append_rows(*session[-1], "planned")
             state["paths_done"] = n_paths
             state["sections_done"] = state["sections_done"] + [int(records[-1]["section"])]
             state["paths"] = state["paths"] + records
@@ -367,14 +371,14 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
                   lambda f, m: progress(0.5 + 0.1 * attempt + 0.1 * f, m),
                   first_path=int(state["paths_done"]), on_section=section_done)
         timing["planned_scan" if attempt == 0 else "replanned_scan"] = time.perf_counter() - t0
-        planned = checkpoint.rows("planned")
-        n_planned = 0 if planned is None else len(planned.xyz)
+        planned = _measured_rows(earlier, session)
+        n_planned = len(planned[0])
         agreement = _plan_agreement(plan, n_planned, state["paths"], epsilon)
         if agreement:
             raise InputError(agreement)
         t0 = time.perf_counter()
-        xyz = np.vstack([blind.xyz, planned.xyz])
-        snr = np.concatenate([blind.snr, planned.snr])
+        xyz = np.vstack([blind.xyz, planned[0]])
+        snr = np.concatenate([blind.snr, planned[1]])
         fit = pipeline.fine_register(xyz, snr, nominal, pose,
                                      progress=lambda f, m: progress(0.75, m))
         timing["register_all" if attempt == 0 else "register_all_again"] = \
@@ -399,9 +403,9 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
 
     # 5. results at the nominal sections
     t0 = time.perf_counter()
-    columns = {"section": np.concatenate([blind_sections, planned.columns["section"]]),
+    columns = {"section": np.concatenate([blind_sections, planned[2]]),
                "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            planned.columns["angle_deg"]]),
+                                            planned[3]]),
                "phase": np.array(["blind"] * n_blind + ["planned"] * n_planned)}
     everything = _pointset(xyz, snr, columns, "inspect: blind and planned scans")
     result = _result_from_fit(nominal, everything, fit, first.coarse,
@@ -446,6 +450,20 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
             "verdict": verdict, "replans": replans, "files": files,
             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
             "pose_uncertainty_mm": result.pose_uncertainty_mm}
+
+
+def _measured_rows(earlier, session):
+    """(xyz, snr, section, angle_deg) of the rows measured after the blind scan: those of
+    earlier runs (a PointSet read back from the checkpoint, or None) then this run's (tuples
+    of arrays). The checkpoint holds them at full precision, so both are the same numbers."""
+    parts = list(session)
+    if earlier is not None:
+        parts.insert(0, (earlier.xyz, earlier.snr, earlier.columns["section"],
+                         earlier.columns["angle_deg"]))
+    if not parts:
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0)
+    return (np.vstack([p[0] for p in parts]),) + tuple(
+        np.concatenate([np.asarray(p[k], dtype=float) for p in parts]) for k in (1, 2, 3))
 
 
 def _continue_pass_numbering(rig, state):
@@ -527,10 +545,14 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
                          kinematics=kinematics)
     timing["plan"] = time.perf_counter() - t0
     _save_plan(plan, checkpoint)
+    # Passes measured before an interruption are read back; this run's are kept too.
+    earlier = checkpoint.rows("complete") if state["passes_done"] else None
+    session = []
 
     def pass_done(n_passes, rows, record):
         xyz, snr, line, angle = rows
-        checkpoint.append_rows(xyz, snr, first_line + line, angle, "complete")
+        session.append((xyz, snr, first_line + line, angle))
+        checkpoint.append_rows(*session[-1], "complete")
         state["passes_done"] = n_passes
         state["passes"] = state["passes"] + [record]
         state["points_bytes"] = checkpoint.points_bytes()
@@ -543,8 +565,8 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     timing["complete_scan"] = time.perf_counter() - t0
     complete_rig_s = checkpoint.rig_s() - blind_rig_s
     pass_records = state["passes"]
-    raster = checkpoint.rows("complete")
-    n_read = 0 if raster is None else len(raster.xyz)
+    raster = _measured_rows(earlier, session)
+    n_read = len(raster[0])
     worst = max((r["max_standoff_error_mm"] or 0.0) for r in pass_records) if n_read else np.inf
     if n_read < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
         raise InputError("inspect --complete: the raster does not find the blade where the "
@@ -552,16 +574,16 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
                          "standoff off by up to %.2f mm)" % (n_read, plan.n_points, worst))
 
     t0 = time.perf_counter()
-    xyz = np.vstack([blind.xyz, raster.xyz])
-    snr = np.concatenate([blind.snr, raster.snr])
+    xyz = np.vstack([blind.xyz, raster[0]])
+    snr = np.concatenate([blind.snr, raster[1]])
     fit = pipeline.fine_register(xyz, snr, nominal, pose,
                                  progress=lambda f, m: progress(0.65, m))
     timing["register_all"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    columns = {"section": np.concatenate([blind_sections, raster.columns["section"]]),
+    columns = {"section": np.concatenate([blind_sections, raster[2]]),
                "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            raster.columns["angle_deg"]]),
+                                            raster[3]]),
                "phase": np.array(["blind"] * n_blind + ["complete"] * n_read)}
     everything = _pointset(xyz, snr, columns, "inspect --complete: blind and complete scans")
     result = _result_from_fit(nominal, everything, fit, first.coarse, dict(timing),
