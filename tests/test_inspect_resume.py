@@ -396,6 +396,35 @@ class TestResumeRefusals(unittest.TestCase):
                         seed=SEED, resume=True, document=False)
         self.assertFalse(os.path.exists(empty))
 
+    def test_failure_over_an_earlier_result_leaves_no_result(self):
+        """A run into a folder holding a finished inspection fails on the rig: the folder is
+        then a checkpoint, and none of the earlier result files stands beside it."""
+        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.rig.serial_rig import SerialRig
+        from BladeInspect.rig.simrig_device import Fault, SimRigDevice
+        out = os.path.join(self.tmp, "over-a-result")
+        os.makedirs(out)
+        for name in RESULT_FILES + ("plan.json", "points.csv"):
+            with open(os.path.join(out, name), "w") as fh:
+                fh.write("earlier\n")
+        with open(os.path.join(out, "scan.json"), "w") as fh:
+            json.dump({"complete": True}, fh)
+        with SimRigDevice(simulated_rig(self.nominal), fault=Fault("close", after_passes=2)) \
+                as device:
+            rig = SerialRig(device.port_url, timeout_s=5)
+            try:
+                with self.assertRaises(DeviceError):
+                    run_inspect(None, out, rig=rig, nominal=self.nominal, seed=SEED,
+                                section_heights=HEIGHTS, document=False,
+                                scan_options=dict(SCAN_OPTIONS))
+            finally:
+                rig.close()
+        self.assertEqual(sorted(os.listdir(out)), ["points.csv", "scan.json"])
+        self.assertEqual(read_json(os.path.join(out, "scan.json"))["inspection"]["phase"],
+                         "blind")
+        self.assertEqual(read_lines(os.path.join(out, "points.csv")),
+                         ["x,y,z,snr,section,angle_deg,phase"])
+
     def test_command_line_device_error(self):
         """`inspect --rig serial:PORT` on a device whose port vanishes: one line on stderr,
         the device-error exit status, a checkpoint on disk; then --resume with another seed is
