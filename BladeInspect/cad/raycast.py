@@ -139,7 +139,8 @@ def _vertex_parameters(nominal, f, xyz, deflection):
         return np.full((len(xyz), 2), np.nan)
     _, near = cKDTree(nominal.samples.xyz[mine]).query(xyz)
     start = nominal.samples.uv[mine[near]]
-    u, v, foot, converged = bspline.project_points(nominal.surfaces[f], xyz, start[:, 0], start[:, 1])
+    u, v, foot, converged = bspline.project_points(nominal.surfaces[f], xyz, start[:, 0],
+                                                   start[:, 1])
     # Tessellation nodes lie on the surface: a foot point far from its node is a wrong basin.
     good = converged & (np.linalg.norm(foot - xyz, axis=1) < 1e-3 * deflection)
     return np.where(good[:, None], np.column_stack([u, v]), np.nan)
@@ -151,7 +152,8 @@ def _unwrap_seams(nominal, tri_face, tri_uv):
     out = tri_uv.copy()
     for f, surf in enumerate(nominal.surfaces):
         rows = np.flatnonzero(tri_face == f)
-        for axis, closed, rng in ((0, surf.closed_u, surf.u_range), (1, surf.closed_v, surf.v_range)):
+        for axis, closed, rng in ((0, surf.closed_u, surf.u_range),
+                                  (1, surf.closed_v, surf.v_range)):
             if not closed or len(rows) == 0:
                 continue
             period = rng[1] - rng[0]
@@ -582,10 +584,6 @@ def _exact_hits(nominal, tess, origins, unit, t_hit, tri, bary):
         if len(lost):
             uv[lost] = _sample_starts(nominal, f, origins[rows[lost]]
                                       + t_hit[rows[lost], None] * unit[rows[lost]])
-        surf = nominal.surfaces[f]
-        for axis, closed, rng in ((0, surf.closed_u, surf.u_range), (1, surf.closed_v, surf.v_range)):
-            if closed:
-                uv[:, axis] = rng[0] + np.mod(uv[:, axis] - rng[0], rng[1] - rng[0])
         enters = _enters(tess, th[sel], unit[rows])
         t, nrm, ok, jump = _refine(nominal, tess, f, origins[rows], unit[rows],
                                    t_hit[rows].copy(), uv, enters)
