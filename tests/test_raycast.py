@@ -61,7 +61,7 @@ class TwistedBladeAgainstOCC(unittest.TestCase):
 
     def test_parallel_rays_decided_in_the_grid_plane(self):
         rng = np.random.default_rng(31)
-        o, d = self.rays_towards(rng, 70, [0.3, -1.0, 0.2])
+        o, d = self.rays_towards(rng, 50, [0.3, -1.0, 0.2])
         self.nominal._tessellation = None
         t, face, nrm = self.nominal.raycast(o, d)
         self.assertEqual(len(self.nominal._tessellation._grids), 1)
@@ -74,7 +74,7 @@ class TwistedBladeAgainstOCC(unittest.TestCase):
 
     def test_slanted_rays_in_one_group(self):
         rng = np.random.default_rng(32)
-        o, d = self.rays_towards(rng, 70, [-0.2, -1.0, 0.1], spread=0.008)
+        o, d = self.rays_towards(rng, 50, [-0.2, -1.0, 0.1], spread=0.008)
         t, face, nrm = self.nominal.raycast(o, d)
         self.assert_first_hits(o, d, t, face, nrm)
 
