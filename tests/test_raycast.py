@@ -3,7 +3,8 @@ grazing incidence across its seam, a translated box) and OpenCASCADE (distToShap
 of the ray's stretch before it and of missing rays) on the small twisted blade. Covers the
 paths the cache of direction grids opens: the same direction again, rays parallel to a grid
 (decided in its plane) and slanted ones (Moller-Trumbore on segment traces), several
-directions in one call, and two nominals of the same shape at different places."""
+directions in one call, few rays bucketed without a kept grid, and two nominals of the same
+shape at different places."""
 import unittest
 from unittest import mock
 
@@ -59,18 +60,25 @@ class TwistedBladeAgainstOCC(unittest.TestCase):
                 # grazing misses are allowed within the tessellation's deflection
                 self.assertGreater(self.shape.distToShape(ray)[0], 0.0, "ray %d: missed" % i)
 
-    def test_parallel_rays_decided_in_the_grid_plane(self):
+    def test_parallel_rays_few_then_many(self):
+        """Few rays of a new direction bucket only the triangles around them (no grid kept);
+        a direction with many rays keeps its whole grid, which later calls reuse, few rays or
+        not. Both give the same answers, bit for bit."""
         rng = np.random.default_rng(31)
         o, d = self.rays_towards(rng, 50, [0.3, -1.0, 0.2])
         self.nominal._tessellation = None
         t, face, nrm = self.nominal.raycast(o, d)
-        self.assertEqual(len(self.nominal._tessellation._grids), 1)
+        grids = self.nominal._tessellation._grids
+        self.assertEqual(len(grids), 0)
         self.assert_first_hits(o, d, t, face, nrm)
-        # The same direction again reuses the grid and gives the same answers bit for bit.
-        again = self.nominal.raycast(o[::-1], d[::-1])
-        self.assertEqual(len(self.nominal._tessellation._grids), 1)
-        np.testing.assert_array_equal(again[0][::-1], t)
-        np.testing.assert_array_equal(again[1][::-1], face)
+        with mock.patch.object(raycast, "FEW_RAYS_PER_TRIANGLE", 0):
+            kept = self.nominal.raycast(o[::-1], d[::-1])
+        self.assertEqual(len(grids), 1)
+        again = self.nominal.raycast(o, d)
+        self.assertEqual(len(grids), 1)
+        for tk, fk in ((kept[0][::-1], kept[1][::-1]), again[:2]):
+            np.testing.assert_array_equal(tk, t)
+            np.testing.assert_array_equal(fk, face)
 
     def test_slanted_rays_in_one_group(self):
         rng = np.random.default_rng(32)
@@ -158,6 +166,7 @@ class ClosedForms(unittest.TestCase):
         np.testing.assert_allclose(t1, 20.0, atol=1e-12)
         np.testing.assert_allclose(t2, 17.0, atol=1e-12)
 
+    @mock.patch.object(raycast, "FEW_RAYS_PER_TRIANGLE", 0)
     def test_grid_cache_is_bounded(self):
         nominal = nominal_from_shape(Part.makeSphere(5.0))
         rng = np.random.default_rng(37)

@@ -5,7 +5,8 @@ grouped by direction; for each group the triangles are projected on the plane no
 group's direction and bucketed in a 2D grid, so a ray (a point, or a short segment when the
 group's directions differ slightly, in that plane) meets only the triangles of its cells.
 The grid of a direction depends only on the tessellation and the direction, so it is kept
-(a scan turns the part to the same few rotary angles again and again). Rays parallel to the
+(a scan turns the part to the same few rotary angles again and again); a new direction with
+few rays buckets only the triangles around them instead. Rays parallel to the
 grid's direction are decided in the plane (2D barycentrics, depth interpolated); others by
 Möller–Trumbore. Stage 2 moves each hit onto the exact surface of the hit triangle's face by
 Newton (Chebyshev) steps on S(u, v) - o - t d = 0 (unknowns u, v, t), started from the hit's
@@ -55,6 +56,9 @@ GRID_DIRECTION_MATCH = 1e-9
 # Rays are decided in the grid's plane when their traces across the box drift less than this
 # fraction of the deflection from a point: the tessellated hit is only Newton's start.
 PLANAR_DRIFT = 1e-3
+# A direction cast with fewer rays than this many per triangle gets no kept grid (yet): only
+# the triangles around its rays are bucketed (a section pass, one of many planning angles).
+FEW_RAYS_PER_TRIANGLE = 0.5
 # Rays per chunk of work; chunks run on two threads (numpy releases the GIL in its loops).
 RAY_CHUNK = 16384
 THREADS = 2
@@ -114,14 +118,17 @@ class Tessellation:
         self._grids = OrderedDict()
         self._lock = threading.Lock()
 
-    def grid(self, direction):
-        """The bucket grid for rays along ``direction`` (unit), built once per direction."""
+    def grid(self, direction, build=True):
+        """The bucket grid for rays along ``direction`` (unit), built once per direction
+        (None when there is none yet and ``build`` is False)."""
         key = tuple(np.round(direction / GRID_DIRECTION_MATCH).astype(np.int64))
         with self._lock:
             grid = self._grids.get(key)
             if grid is not None:
                 self._grids.move_to_end(key)
                 return grid
+        if not build:
+            return None
         grid = _TriangleGrid(self, direction)
         with self._lock:
             self._grids[key] = grid
@@ -181,6 +188,70 @@ def _outward_signs(nominal, tess):
     return out
 
 
+def _plane_maps(tri2, depth):
+    """Per triangle (projected corners (K, 3, 2), depths along the direction (K, 3)): the map
+    from a projected point to its barycentrics and depth, (x0, y0, the inverse of [a b]
+    row-major, z0, z1 - z0, z2 - z0)."""
+    a = tri2[:, 1] - tri2[:, 0]
+    b = tri2[:, 2] - tri2[:, 0]
+    det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    # Edge-on triangles are met by parallel rays only along a line: their neighbours decide.
+    # NaN barycentrics never pass the inside test.
+    seen = np.abs(det) > 1e-12 * (np.einsum("ij,ij->i", a, a) + np.einsum("ij,ij->i", b, b))
+    det = np.where(seen, det, np.nan)
+    return np.column_stack([
+        tri2[:, 0], b[:, 1] / det, -b[:, 0] / det, -a[:, 1] / det, a[:, 0] / det,
+        depth[:, 0], depth[:, 1] - depth[:, 0], depth[:, 2] - depth[:, 0]])
+
+
+def _grid_size(n_triangles):
+    return int(np.clip(np.sqrt(n_triangles / 2.0), 16, 1024))
+
+
+class _RayGrid:
+    """For a few rays along one direction (a section pass, a planning cast at a new angle):
+    the triangles whose projected boxes cover a cell holding one of the rays, bucketed in
+    those cells only. Costs a projection of the vertices instead of the whole grid of
+    _TriangleGrid, and is not kept. Cells as the whole grid's; rays parallel to
+    ``direction`` only."""
+
+    def __init__(self, tess, direction, origins):
+        self.direction = direction
+        self.e1, self.e2 = _basis(direction)
+        V = tess.vertices
+        tri2 = np.column_stack([_along(V, self.e1), _along(V, self.e2)])[tess.triangles]
+        lo2, hi2 = tri2.min(axis=1), tri2.max(axis=1)
+        self.glo = lo2.min(axis=0)
+        self.ghi = hi2.max(axis=0)
+        g = self.g = _grid_size(len(tess.triangles))
+        self.cell = np.maximum((self.ghi - self.glo) / g, 1e-12)
+        xy = np.column_stack([_along(origins, self.e1), _along(origins, self.e2)])
+        inside = np.all((xy >= self.glo) & (xy <= self.ghi), axis=1)
+        ij = np.clip(np.floor((xy[inside] - self.glo) / self.cell).astype(int), 0, g - 1)
+        held = np.zeros((g, g), bool)
+        held[ij[:, 0], ij[:, 1]] = True
+        # Rays in a triangle's box: a summed-area table counts the held cells of each box.
+        area = np.zeros((g + 1, g + 1), dtype=np.int64)
+        area[1:, 1:] = np.cumsum(np.cumsum(held, axis=0), axis=1)
+        i0 = np.clip(((lo2 - self.glo) / self.cell).astype(int), 0, g - 1)
+        i1 = np.clip(((hi2 - self.glo) / self.cell).astype(int), 0, g - 1) + 1
+        count = (area[i1[:, 0], i1[:, 1]] - area[i0[:, 0], i1[:, 1]]
+                 - area[i1[:, 0], i0[:, 1]] + area[i0[:, 0], i0[:, 1]])
+        cand = np.flatnonzero(count > 0)
+        i0, i1 = i0[cand], i1[cand]
+        nx, ny = i1[:, 0] - i0[:, 0], i1[:, 1] - i0[:, 1]
+        cnt = nx * ny
+        owner = np.repeat(np.arange(len(cand)), cnt)
+        local = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        cx = i0[owner, 0] + local % nx[owner]
+        cy = i0[owner, 1] + local // nx[owner]
+        keep = held[cx, cy]
+        self.table = _csr(cx[keep] * g + cy[keep], owner[keep], g * g)
+        self.triangle_id = cand
+        depth = _along(V, direction)[tess.triangles[cand]]
+        self.plane_map = _plane_maps(tri2[cand], depth)
+
+
 class _TriangleGrid:
     """Triangles projected on the plane normal to ``direction``, bucketed in a uniform grid;
     per triangle the plane map from a projected point to its barycentrics and depth."""
@@ -188,26 +259,16 @@ class _TriangleGrid:
     def __init__(self, tess, direction):
         self.direction = direction
         self.e1, self.e2 = _basis(direction)
-        P = np.column_stack([tess.vertices @ self.e1, tess.vertices @ self.e2])
-        depth = tess.vertices @ direction
+        V = tess.vertices
+        P = np.column_stack([_along(V, self.e1), _along(V, self.e2)])
+        depth = _along(V, direction)
         tri2 = P[tess.triangles]                         # (T, 3, 2)
-        a = tri2[:, 1] - tri2[:, 0]
-        b = tri2[:, 2] - tri2[:, 0]
-        det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-        # Edge-on triangles are met by parallel rays only along a line: their neighbours decide.
-        seen = np.abs(det) > 1e-12 * (np.einsum("ij,ij->i", a, a) + np.einsum("ij,ij->i", b, b))
-        # NaN barycentrics never pass the inside test: an edge-on triangle (which slanted rays
-        # do meet) is left to its neighbours in the plane.
-        det = np.where(seen, det, np.nan)
-        dz = depth[tess.triangles]
-        # (x0, y0, the inverse of [a b] row-major, z0, z1 - z0, z2 - z0)
-        self.plane_map = np.column_stack([
-            tri2[:, 0], b[:, 1] / det, -b[:, 0] / det, -a[:, 1] / det, a[:, 0] / det,
-            dz[:, 0], dz[:, 1] - dz[:, 0], dz[:, 2] - dz[:, 0]])
+        self.plane_map = _plane_maps(tri2, depth[tess.triangles])
+        self.triangle_id = None
         lo2, hi2 = tri2.min(axis=1), tri2.max(axis=1)
         self.glo = lo2.min(axis=0)
         self.ghi = hi2.max(axis=0)
-        self.g = int(np.clip(np.sqrt(len(tess.triangles) / 2.0), 16, 1024))
+        self.g = _grid_size(len(tess.triangles))
         self.cell = np.maximum((self.ghi - self.glo) / self.g, 1e-12)
         owner, cells = self.cells_of(lo2, hi2, tri2)
         self.table = _csr(cells, owner, self.g * self.g)
@@ -388,7 +449,7 @@ def _first_hits_group(tess, grid, origins, dirs, t0, t1, planar):
             better = t[win] < best_t[wr]
             wr, win = wr[better], win[better]
             best_t[wr] = t[win]
-            best_tri[wr] = tt[win]
+            best_tri[wr] = tt[win] if grid.triangle_id is None else grid.triangle_id[tt[win]]
             best_b[wr] = np.column_stack([bu[win], bv[win]])
     return best_t, best_tri, best_b
 
@@ -647,10 +708,14 @@ def cast(nominal, origins, directions, deflection=None):
         sel = live[groups == g]
         d0 = unit[sel].mean(axis=0)
         d0 /= np.linalg.norm(d0)
-        grid = tess.grid(d0)
+        grid = tess.grid(d0, build=False)
         # How far a ray's trace strays from a point in the grid's plane across the box.
-        drift = np.max(np.linalg.norm(unit[sel] - grid.direction, axis=1) * (t1[sel] - t0[sel]))
+        drift = np.max(np.linalg.norm(unit[sel] - (d0 if grid is None else grid.direction),
+                                      axis=1) * (t1[sel] - t0[sel]))
         planar = drift <= PLANAR_DRIFT * deflection
+        if grid is None:
+            few = len(sel) < FEW_RAYS_PER_TRIANGLE * len(tess.triangles)
+            grid = _RayGrid(tess, d0, origins[sel]) if planar and few else tess.grid(d0)
         jobs += [(grid, sel[c], planar) for c in _chunks(len(sel))]
 
     def work(job):
