@@ -327,15 +327,9 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
     # section column keeps them apart.
     first_planned = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() \
         else 0
-    if resumed is None:
-        state = {"phase": "planned", "attempt": 0, "plan_pose": first.measured_to_cad.tolist(),
-                 "paths_done": 0, "sections_done": [], "paths": [], "replans": [],
-                 "points_bytes": checkpoint.points_bytes(),
-                 "pass_index": getattr(rig, "pass_index", None)}
-    else:
-        state = dict(resumed)
-        checkpoint.truncate_points(state["points_bytes"])
-        _continue_pass_numbering(rig, state)
+    state = _start_or_resume(checkpoint, rig, resumed, {
+        "phase": "planned", "attempt": 0, "plan_pose": first.measured_to_cad.tolist(),
+        "paths_done": 0, "sections_done": [], "paths": [], "replans": []})
     state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
                  blind_points=n_blind, blind_rig_s=blind_rig_s,
                  blind_points_bytes=state.get("blind_points_bytes", state["points_bytes"]))
@@ -466,6 +460,18 @@ def _measured_rows(earlier, session):
         np.concatenate([np.asarray(p[k], dtype=float) for p in parts]) for k in (1, 2, 3))
 
 
+def _start_or_resume(checkpoint, rig, resumed, fresh):
+    """The phase's state: ``fresh`` with where the points file and the rig's pass numbering
+    stand now, or the checkpoint's ``resumed`` state with both put back to where it stood."""
+    if resumed is None:
+        return dict(fresh, points_bytes=checkpoint.points_bytes(),
+                    pass_index=getattr(rig, "pass_index", None))
+    state = dict(resumed)
+    checkpoint.truncate_points(state["points_bytes"])
+    _continue_pass_numbering(rig, state)
+    return state
+
+
 def _continue_pass_numbering(rig, state):
     """The next pass is numbered as in the interrupted run: a simulated rig's noise stream per
     pass, so a resumed run measures what the uninterrupted one would have."""
@@ -526,14 +532,9 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     n_blind = len(blind.xyz)
     blind_sections = _blind_column(blind, "section", n_blind)
     first_line = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
-    if resumed is None:
-        state = {"phase": "complete", "plan_pose": first.measured_to_cad.tolist(),
-                 "passes_done": 0, "passes": [], "points_bytes": checkpoint.points_bytes(),
-                 "pass_index": getattr(rig, "pass_index", None)}
-    else:
-        state = dict(resumed)
-        checkpoint.truncate_points(state["points_bytes"])
-        _continue_pass_numbering(rig, state)
+    state = _start_or_resume(checkpoint, rig, resumed, {
+        "phase": "complete", "plan_pose": first.measured_to_cad.tolist(),
+        "passes_done": 0, "passes": []})
     state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
                  blind_points=n_blind, blind_rig_s=blind_rig_s)
     checkpoint.save(state, scan_record)
