@@ -262,8 +262,14 @@ class Inspect(commands._Command):
                                   "plan": drawn["plan"]}
             return summary
         summary = progress.run("Inspect", job)
-        if summary is None:
-            # run_inspect writes all files or none: the folder made for them is empty.
+        if summary is None and os.path.exists(os.path.join(out_dir, "scan.json")):
+            # A rig that failed mid-run leaves what it measured as a checkpoint.
+            FreeCAD.Console.PrintWarning(
+                "BladeInspect: the measured sections are kept in %s; "
+                "'./bladeinspect inspect --resume --out %s' with the same CAD, rig and options "
+                "continues the inspection\n" % (out_dir, out_dir))
+        elif summary is None:
+            # Bad input or a cancel: run_inspect wrote nothing, the folder made for it is empty.
             shutil.rmtree(os.path.dirname(out_dir), ignore_errors=True)
         else:
             doc.recompute()
