@@ -454,3 +454,46 @@ class TestResumeRefusals(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestCancelledInspectionResumes(unittest.TestCase):
+    """A cancel (the GUI's Cancel, raised from the progress callback) in the planned phase
+    keeps what was measured as a checkpoint, as a rig failure does; --resume then ends as the
+    uninterrupted run."""
+
+    def test_cancel_in_the_planned_phase_then_resume(self):
+        from BladeInspect.core.errors import Cancelled
+        from BladeInspect.inspect.closed_loop import run_inspect
+        nominal = demo_nominal()
+        tmp = tempfile.mkdtemp(prefix="bi-cancel-")
+        self.addCleanup(shutil.rmtree, tmp, True)
+        ref = Reference(nominal, os.path.join(tmp, "reference"))
+        out = os.path.join(tmp, "cancelled")
+        rig = simulated_rig(nominal)
+        inside_second_section = ref.inside_section(0, 1)
+
+        def cancel_inside_second_section(fraction, message):
+            if (message.startswith("planned scan: path")
+                    and rig.pass_index >= inside_second_section):
+                raise Cancelled("inspection cancelled")
+        options = dict(nominal=nominal, seed=SEED, section_heights=HEIGHTS, epsilon=EPSILON,
+                       document=False, scan_options=dict(SCAN_OPTIONS))
+        with self.assertRaises(Cancelled):
+            run_inspect(None, out, rig=rig, progress=cancel_inside_second_section, **options)
+        record = read_json(os.path.join(out, "scan.json"))
+        self.assertFalse(record["complete"])
+        self.assertEqual(record["inspection"]["phase"], "planned")
+        for name in RESULT_FILES:
+            self.assertFalse(os.path.exists(os.path.join(out, name)), name)
+        # The blind scan and the planned section finished before the cancel are kept (the
+        # reference's own planned rows are the re-plan's: the loop re-plans at this epsilon).
+        kept = read_points(os.path.join(out, "points.csv"))
+        self.assertGreater(np.count_nonzero(kept.columns["phase"] == "planned"), 0)
+        blind, ref_blind = (p.xyz[p.columns["phase"] == "blind"] for p in (kept, ref.points))
+        np.testing.assert_allclose(blind, ref_blind, atol=1e-6)
+
+        run_inspect(None, out, rig=simulated_rig(nominal), resume=True, **options)
+        self.assertIsNone(first_difference(read_lines(os.path.join(out, "points.csv")),
+                                           ref.points_lines))
+        pose = np.asarray(read_json(os.path.join(out, "result.json"))["measured_to_cad"])
+        np.testing.assert_allclose(pose, np.asarray(ref.result["measured_to_cad"]), atol=1e-9)

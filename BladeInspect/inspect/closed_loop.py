@@ -17,9 +17,9 @@ Files in DIR: points.csv (table frame, with a `phase` column: blind or planned),
 scan.json (the blind scan's record, the planned passes, the simulator's truth), result.json
 (with `sections` and `uncertainty_after_blind_mm`), deviations.csv, report.html/.pdf.
 
-A rig failure (DeviceError) mid-loop leaves DIR a checkpoint instead: points.csv up to the
-last completed blind section, planned section or raster pass, plan.json, and scan.json marked
-incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
+A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint instead:
+points.csv up to the last completed blind section, planned section or raster pass, plan.json,
+and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in a private folder while the loop runs
 (_Checkpoint), and a simulated rig's noise depends only on the pass number, which the
@@ -34,7 +34,7 @@ import time
 import numpy as np
 
 from ..core import transforms as tf
-from ..core.errors import DeviceError, InputError
+from ..core.errors import Cancelled, DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
 from ..rig.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
 
@@ -206,7 +206,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
     ``scan_options`` None takes the interrupted run's).
     Returns a summary dict. The result files appear in out_dir together, or none: on a
-    DeviceError out_dir holds the checkpoint instead (points.csv, plan.json, scan.json)."""
+    DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
+    (points.csv, plan.json, scan.json)."""
     from ..rig import scan as scan_mod
     from ..rig.kinematics import RigKinematics
     from ..rig.planning import plan_sections
@@ -262,7 +263,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
                                     tolerance, out, checkpoint, timing, progress, plan_sections,
                                     scan_mod, pipeline, sections_mod, verdict_mod, write_report,
                                     document, scan_options, cad_path or "built-in demo blade")
-            except DeviceError:
+            except (DeviceError, Cancelled, KeyboardInterrupt):
+                # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
                 raise
             finally:
@@ -704,7 +706,7 @@ class _Checkpoint:
         write_record(self.path(RECORD_FILE), record)
 
     def keep(self):
-        """After a DeviceError: the measured data goes to DIR as a checkpoint to resume, in
+        """After a DeviceError or a cancel: the measured data goes to DIR as a checkpoint to resume, in
         place of any earlier result there (a result beside a checkpoint would not be one)."""
         if not os.path.exists(self.path(RECORD_FILE)):
             return
