@@ -75,20 +75,6 @@ def mark_inspection(registration, heights_pct, first_planned_row, out_dir):
     registration.InspectionFolder = out_dir
 
 
-def _planned_rows(result, first):
-    import dataclasses
-    from ..core import stats
-    rows = np.arange(first, len(result.points_cad))
-    # The section column numbers blind and planned passes; the table is cut at the nominal
-    # planes instead, as the inspection itself did.
-    columns = {k: np.asarray(v)[rows] for k, v in result.columns.items() if k != "section"}
-    return dataclasses.replace(
-        result, points_cad=result.points_cad[rows], deviation=result.deviation[rows],
-        inlier=result.inlier[rows], closest=result.closest[rows], normal=result.normal[rows],
-        face=result.face[rows], snr=None if result.snr is None else result.snr[rows],
-        columns=columns, deviation_stats=stats.deviation_statistics(result.deviation[rows]))
-
-
 def cmm_section_table(registration, cmm_path):
     """Table 2 of a Registration with the CMM file's columns beside the optical ones. For an
     inspection, at its nominal sections from the planned points only; for any other
@@ -105,8 +91,8 @@ def cmm_section_table(registration, cmm_path):
         if not 0 <= first < len(result.points_cad):
             raise InputError("%s: FirstPlannedRow %d is outside its %d points"
                              % (registration.Label, first, len(result.points_cad)))
-        table = section_table(_planned_rows(result, first), nominal, heights_pct=heights,
-                              cmm=cmm)
+        planned = result.planned_rows(np.arange(first, len(result.points_cad)))
+        table = section_table(planned, nominal, heights_pct=heights, cmm=cmm)
     else:
         table = section_table(result, nominal, cmm=cmm)
     if "CmmFile" not in registration.PropertiesList:

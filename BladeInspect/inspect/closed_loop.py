@@ -142,6 +142,21 @@ def pose_change_mm(old_table_to_cad, new_table_to_cad, cad_points):
     return float(np.max(np.linalg.norm(old - new, axis=1)))
 
 
+def _result_of_all(nominal, blind, blind_sections, later, phase, xyz, snr, fit, first, timing,
+                   cad_label, source):
+    """points.csv's extra columns and the RegistrationResult of the blind rows followed by
+    those measured after them (``later``: xyz, snr, section, angle_deg; tagged ``phase``)."""
+    n_blind = len(blind.xyz)
+    columns = {"section": np.concatenate([blind_sections, later[2]]),
+               "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
+                                            later[3]]),
+               "phase": np.array(["blind"] * n_blind + [phase] * len(later[0]))}
+    result = _result_from_fit(nominal, _pointset(xyz, snr, columns, source), fit, first.coarse,
+                              dict(timing), list(first.warnings))
+    result.cad_source = cad_label
+    return columns, result
+
+
 def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     """A RegistrationResult for points registered by a fine ICP from a known start, built the
     way pipeline.register builds its own."""
@@ -161,19 +176,6 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         pose_uncertainty_mm=float(uncertainty),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
         timing_s=timing, warnings=warnings, source=pointset.source)
-
-
-def _subset(result, rows):
-    """The result restricted to some rows (the planned points), for the section table."""
-    import dataclasses
-    from ..core import stats as stats_mod
-    rows = np.asarray(rows)
-    cols = {k: np.asarray(v)[rows] for k, v in result.columns.items() if k != "section"}
-    return dataclasses.replace(
-        result, points_cad=result.points_cad[rows], deviation=result.deviation[rows],
-        inlier=result.inlier[rows], closest=result.closest[rows], normal=result.normal[rows],
-        face=result.face[rows], snr=None if result.snr is None else result.snr[rows],
-        columns=cols, deviation_stats=stats_mod.deviation_statistics(result.deviation[rows]))
 
 
 def _sections_json(table, plan):
@@ -399,14 +401,9 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
 
     # 5. results at the nominal sections
     t0 = time.perf_counter()
-    columns = {"section": np.concatenate([blind_sections, planned[2]]),
-               "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            planned[3]]),
-               "phase": np.array(["blind"] * n_blind + ["planned"] * n_planned)}
-    everything = _pointset(xyz, snr, columns, "inspect: blind and planned scans")
-    result = _result_from_fit(nominal, everything, fit, first.coarse,
-                              dict(timing), list(first.warnings))
-    result.cad_source = cad_label
+    columns, result = _result_of_all(nominal, blind, blind_sections, planned, "planned", xyz,
+                                     snr, fit, first, timing, cad_label,
+                                     "inspect: blind and planned scans")
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_planned, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)
@@ -502,7 +499,7 @@ def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm
     """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
     indexed back into the whole result, and the verdict on every point."""
     rows = np.arange(n_blind, n_blind + n_rows)
-    table = sections_mod.section_table(_subset(result, rows), nominal, heights_pct=heights,
+    table = sections_mod.section_table(result.planned_rows(rows), nominal, heights_pct=heights,
                                        span_axis=span_axis, cmm=cmm_data)
     for sec in table.sections:
         sec.point_index = sec.point_index + n_blind
@@ -584,17 +581,12 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     timing["register_all"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    columns = {"section": np.concatenate([blind_sections, raster[2]]),
-               "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
-                                            raster[3]]),
-               "phase": np.array(["blind"] * n_blind + ["complete"] * n_read)}
-    everything = _pointset(xyz, snr, columns, "inspect --complete: blind and complete scans")
-    result = _result_from_fit(nominal, everything, fit, first.coarse, dict(timing),
-                              list(first.warnings))
-    result.cad_source = cad_label
+    columns, result = _result_of_all(nominal, blind, blind_sections, raster, "complete", xyz,
+                                     snr, fit, first, timing, cad_label,
+                                     "inspect --complete: blind and complete scans")
     span_axis, _ = sections_mod.span_axis_of(nominal)
-    # _subset drops the section column (raster lines are not the nominal planes), so the table
-    # takes the points within its band of each plane.
+    # planned_rows drops the section column (raster lines are not the nominal planes), so the
+    # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_read, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)

@@ -30,6 +30,20 @@ class RegistrationResult:
     source: str = ""
     cad_source: str = ""
 
+    def planned_rows(self, rows):
+        """The result restricted to some rows (an inspection's points measured after its blind
+        scan), for Table 2 at the nominal sections: the section column, which numbers the scan's
+        passes rather than those planes, is left out."""
+        import dataclasses
+        from ..core import stats
+        rows = np.asarray(rows)
+        columns = {k: np.asarray(v)[rows] for k, v in self.columns.items() if k != "section"}
+        return dataclasses.replace(
+            self, points_cad=self.points_cad[rows], deviation=self.deviation[rows],
+            inlier=self.inlier[rows], closest=self.closest[rows], normal=self.normal[rows],
+            face=self.face[rows], snr=None if self.snr is None else self.snr[rows],
+            columns=columns, deviation_stats=stats.deviation_statistics(self.deviation[rows]))
+
     @property
     def n_points(self):
         return int(len(self.deviation))
