@@ -11,7 +11,6 @@ Rays are cast only where the CAD's samples say the angle can be the best one, wh
 cast near the number of points kept (no per-line OCC cuts: 700 lines would take minutes).
 """
 
-import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,7 +20,7 @@ from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
 from .kinematics import RigKinematics
 from .planning import (ANGLES, COVERAGE_MARGIN_DEG, _blade_faces, _body_clear,
-                       _expected_snr, _incidence_table)
+                       _expected_snr, _incidence_table, plan_json)
 
 DEFAULT_PITCH_MM = 0.1
 # Along a line: 0.25 mm steps give the paper's ~269,000 points on a 70 x 50 x 20 mm blade at
@@ -88,12 +87,7 @@ class CompletePlan:
                 "max_incidence_deg": float(np.max(self.incidence_deg)),
                 "info": self.info}
 
-    def to_json(self, path=None):
-        text = json.dumps(self.to_dict(), indent=1)
-        if path is not None:
-            with open(path, "w") as fh:
-                fh.write(text)
-        return text
+    to_json = plan_json
 
 
 def _check_step(value, name):

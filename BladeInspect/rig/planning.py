@@ -90,6 +90,16 @@ class PlannedPath:
                 "points": self.points.tolist()}
 
 
+def plan_json(plan, path=None):
+    """A plan (anything with ``to_dict``) as JSON text (DIR/plan.json); written to ``path``
+    when given."""
+    text = json.dumps(plan.to_dict(), indent=1)
+    if path is not None:
+        with open(path, "w") as fh:
+            fh.write(text)
+    return text
+
+
 @dataclass
 class Plan:
     sections: list                   # PlannedSection per requested height, in height order
@@ -121,13 +131,7 @@ class Plan:
                 "sections": [s.to_dict() for s in self.sections],
                 "paths": [p.to_dict() for p in self.paths]}
 
-    def to_json(self, path=None):
-        """The plan as JSON text (DIR/plan.json); written to ``path`` when given."""
-        text = json.dumps(self.to_dict(), indent=1)
-        if path is not None:
-            with open(path, "w") as fh:
-                fh.write(text)
-        return text
+    to_json = plan_json
 
 
 # ---------------------------------------------------------------- geometry helpers
