@@ -7,7 +7,6 @@ import json
 import os
 import sys
 import time
-import traceback
 
 import numpy as np
 
@@ -15,73 +14,11 @@ import FreeCAD
 import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
-OUT = os.environ["BI_GUI_OUT"]
-REPO = os.environ["BI_REPO"]
-CHECKS = []
-STEPS = {}
+sys.path.insert(0, os.environ["BI_REPO"])
+from tests.gui_harness import (OUT, active_panel, check, run_scenario, settle,  # noqa: E402
+                               start_workbench, step, view_shot, window_shot)
+
 HEIGHTS = (20.0, 50.0, 80.0)
-
-
-def check(name, ok, detail=""):
-    CHECKS.append({"name": name, "ok": bool(ok), "detail": str(detail)[:2000]})
-
-
-def step(name):
-    def wrap(fn):
-        t0 = time.time()
-        try:
-            fn()
-            STEPS[name] = {"status": "ran", "seconds": round(time.time() - t0, 2)}
-        except Exception:
-            STEPS[name] = {"status": "error", "seconds": round(time.time() - t0, 2)}
-            check(name + ": no exception", False, traceback.format_exc())
-        return fn
-    return wrap
-
-
-def settle(seconds=0.2):
-    end = time.time() + seconds
-    while time.time() < end:
-        QtGui.QApplication.processEvents()
-        time.sleep(0.02)
-
-
-def view_shot(name, fit=True):
-    view = Gui.activeDocument().activeView()
-    if fit:
-        view.viewIsometric()
-        view.fitAll()
-    settle()
-    path = os.path.join(OUT, name + ".png")
-    view.saveImage(path, 1000, 750, "Current")
-    return path
-
-
-def window_shot(name):
-    """The main window with its task panel, the OpenGL view painted into its place (grab()
-    leaves it blank)."""
-    settle(0.3)
-    window = Gui.getMainWindow()
-    shot = window.grab()
-    sub = window.centralWidget().activeSubWindow()
-    if sub is not None and Gui.activeDocument() is not None:
-        target = sub.widget()
-        origin = target.mapTo(window, QtCore.QPoint(0, 0))
-        tmp = os.path.join(OUT, name + "-view.tmp.png")
-        Gui.activeDocument().activeView().saveImage(tmp, target.width(), target.height(),
-                                                    "Current")
-        painter = QtGui.QPainter(shot)
-        painter.drawImage(origin, QtGui.QImage(tmp))
-        painter.end()
-        os.remove(tmp)
-    shot.save(os.path.join(OUT, name + ".png"))
-
-
-def active_panel(kind):
-    for obj in __import__("gc").get_objects():
-        if isinstance(obj, kind) and obj.form.isVisible():
-            return obj
-    return None
 
 
 def occ_distances(shape, points):
@@ -98,17 +35,10 @@ def corner_error(estimated, truth, corners):
 
 
 def run():
-    sys.path.insert(0, REPO)
+    start_workbench(640)   # wide enough for Table 2's columns in the screenshots
     window = Gui.getMainWindow()
-    window.resize(1280, 1000)
-    combo = [d for d in window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"]
-    if combo:
-        # Wide enough for Table 2's columns in the screenshots.
-        window.resizeDocks(combo, [640], QtCore.Qt.Horizontal)
-    Gui.activateWorkbench("BladeInspectWorkbench")
     from BladeInspect.app import objects
     from BladeInspect.gui import commands, loop_commands, progress, taskpanels
-    progress.SHOW_DIALOGS = False   # dialogs would wait for a click; messages are checked
     cmd = loop_commands.BY_NAME
     names = set(c for c in Gui.listCommands() if c.startswith("BladeInspect_"))
     check("loop commands registered", set(loop_commands.NAMES) <= names, sorted(names))
@@ -432,14 +362,4 @@ def run():
           state.get("inspect_s"))
 
 
-def main():
-    try:
-        run()
-    except Exception:
-        check("scenario ran", False, traceback.format_exc())
-    with open(os.path.join(OUT, "checks.json"), "w") as fh:
-        json.dump({"checks": CHECKS, "steps": STEPS}, fh, indent=1)
-    os._exit(0)
-
-
-QtCore.QTimer.singleShot(300, main)
+run_scenario(run)

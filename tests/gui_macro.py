@@ -5,8 +5,6 @@ be running), hence no test_ prefix."""
 import json
 import os
 import sys
-import time
-import traceback
 
 import numpy as np
 
@@ -14,81 +12,10 @@ import FreeCAD
 import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
-OUT = os.environ["BI_GUI_OUT"]
-REPO = os.environ["BI_REPO"]
-CHECKS = []
-STEPS = {}
-
-
-def check(name, ok, detail=""):
-    CHECKS.append({"name": name, "ok": bool(ok), "detail": str(detail)})
-
-
-def step(name):
-    """Run a scenario step, recording its time and any exception as a failed check."""
-    def wrap(fn):
-        t0 = time.time()
-        try:
-            fn()
-            STEPS[name] = {"status": "ran", "seconds": round(time.time() - t0, 2)}
-        except _Skip as exc:
-            STEPS[name] = {"status": "skipped", "reason": str(exc)}
-        except Exception:
-            STEPS[name] = {"status": "error", "seconds": round(time.time() - t0, 2)}
-            check(name + ": no exception", False, traceback.format_exc())
-        return fn
-    return wrap
-
-
-class _Skip(Exception):
-    pass
-
-
-def need(module):
-    try:
-        __import__(module)
-    except ImportError as exc:
-        raise _Skip("%s not available: %s" % (module, exc))
-
-
-def settle(seconds=0.2):
-    end = time.time() + seconds
-    while time.time() < end:
-        QtGui.QApplication.processEvents()
-        time.sleep(0.02)
-
-
-def view_shot(name):
-    view = Gui.activeDocument().activeView()
-    view.viewIsometric()
-    view.fitAll()
-    settle()
-    path = os.path.join(OUT, name + ".png")
-    view.saveImage(path, 1000, 750, "Current")
-    return path
-
-
-def window_shot(name):
-    """The main window with its task panel. QWidget.grab() leaves the OpenGL 3D view blank, so
-    the view is rendered with saveImage and painted into its place."""
-    settle(0.3)
-    window = Gui.getMainWindow()
-    shot = window.grab()
-    mdi = window.centralWidget()
-    sub = mdi.activeSubWindow() if hasattr(mdi, "activeSubWindow") else None
-    if sub is not None and Gui.activeDocument() is not None:
-        target = sub.widget()
-        origin = target.mapTo(window, QtCore.QPoint(0, 0))
-        view_png = os.path.join(OUT, name + "-view.tmp.png")
-        Gui.activeDocument().activeView().saveImage(view_png, target.width(), target.height(),
-                                                    "Current")
-        painter = QtGui.QPainter(shot)
-        painter.drawImage(origin, QtGui.QImage(view_png))
-        painter.end()
-        os.remove(view_png)
-    path = os.path.join(OUT, name + ".png")
-    shot.save(path)
-    return path
+sys.path.insert(0, os.environ["BI_REPO"])
+from tests.gui_harness import (OUT, Skip, active_panel, check, need,  # noqa: E402
+                               run_scenario, settle, start_workbench, step, view_shot,
+                               window_shot)
 
 
 def colours_of(obj):
@@ -96,16 +23,9 @@ def colours_of(obj):
 
 
 def run():
-    sys.path.insert(0, REPO)
-    window = Gui.getMainWindow()
-    window.resize(1280, 1000)
-    combo = [d for d in window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"]
-    if combo:
-        window.resizeDocks(combo, [430], QtCore.Qt.Horizontal)
-    Gui.activateWorkbench("BladeInspectWorkbench")
+    start_workbench(430)
     from BladeInspect.app import objects
     from BladeInspect.gui import commands, progress, viewproviders
-    progress.SHOW_DIALOGS = False   # dialogs would wait for a click; messages are checked
     names = [c for c in Gui.listCommands() if c.startswith("BladeInspect_")]
     check("all commands registered", set(commands.MENU) <= set(names), names)
     check("workbench active", Gui.activeWorkbench().name() == "BladeInspectWorkbench",
@@ -224,7 +144,7 @@ def run():
         need("BladeInspect.cad.sections")
         need("BladeInspect.inspect.report")
         if "reg" not in state:
-            raise _Skip("no registration made")
+            raise Skip("no registration made")
         reg = state["reg"]
         table = commands.BY_NAME["BladeInspect_SectionAnalysis"].analyse(reg)
         check("section analysis made", table is not None and len(table.sections) > 0,
@@ -239,7 +159,7 @@ def run():
         need("BladeInspect.inspect.report")
         need("BladeInspect.inspect.document")
         if "reg" not in state:
-            raise _Skip("no registration made")
+            raise Skip("no registration made")
         reg, nominal = state["reg"], state["nominal"]
         from BladeInspect.core import transforms as tf
         out = os.path.join(OUT, "report")
@@ -318,7 +238,7 @@ def run():
     def _():
         blade = state.get("blade")
         if blade is None:
-            raise _Skip("no demo blade")
+            raise Skip("no demo blade")
         from BladeInspect.core.colormap import deviation_colors
         result = _known_result(blade.Shape)
         reg = objects.make_registration(doc, result, name="KnownRegistration")
@@ -400,11 +320,7 @@ def run():
 
 def _active_panel():
     from BladeInspect.gui import taskpanels
-    for obj in __import__("gc").get_objects():
-        if isinstance(obj, (taskpanels._Panel, taskpanels.RegistrationPanel)) and \
-                obj.form.isVisible():
-            return obj
-    return None
+    return active_panel((taskpanels._Panel, taskpanels.RegistrationPanel))
 
 
 class _FakePoints:
@@ -442,14 +358,4 @@ def _known_result(shape):
         deviation_stats=deviation_statistics(dev), coarse={}, warnings=[])
 
 
-def main():
-    try:
-        run()
-    except Exception:
-        check("scenario ran", False, traceback.format_exc())
-    with open(os.path.join(OUT, "checks.json"), "w") as fh:
-        json.dump({"checks": CHECKS, "steps": STEPS}, fh, indent=1)
-    os._exit(0)
-
-
-QtCore.QTimer.singleShot(300, main)
+run_scenario(run)
