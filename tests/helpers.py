@@ -8,6 +8,18 @@ ROTOR67_SECTIONS = os.path.join(ROTOR67_DIR, "rotor67geometry.dat")
 ROTOR67_CLOUD = os.path.join(ROTOR67_DIR, "MoveSurface_NASA_R67_parablade.txt")
 
 
+_DEMO_NOMINAL = []
+
+
+def demo_nominal():
+    """The built-in demo blade's Nominal, built once per test run (about a second) and shared
+    by the modules that only read it."""
+    if not _DEMO_NOMINAL:
+        from BladeInspect.inspect.pipeline import load_nominal
+        _DEMO_NOMINAL.append(load_nominal(None))
+    return _DEMO_NOMINAL[0]
+
+
 def have_rotor67():
     return os.path.exists(ROTOR67_SECTIONS)
 

@@ -9,17 +9,7 @@ import numpy as np
 
 from BladeInspect.core.stats import deviation_statistics
 from BladeInspect.inspect.result import RegistrationResult
-
-_NOMINAL = []
-
-
-def demo_nominal():
-    """The demo blade's Nominal, built once per process (about a second)."""
-    if not _NOMINAL:
-        from BladeInspect.inspect.pipeline import load_nominal
-        _NOMINAL.append(load_nominal(None))
-    return _NOMINAL[0]
-
+from tests.helpers import demo_nominal  # noqa: F401 (the fixtures' users call fx.demo_nominal)
 
 def surface_points(nominal, levels_z, spacing=0.3, normal=(0.0, 0.0, 1.0)):
     """Points on the CAD's surface along plane cuts at the given heights (mm, along ``normal``

@@ -13,17 +13,13 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
+from tests.helpers import demo_nominal
 
 HEIGHTS = (30.0, 70.0)
 # A bump of 30 um on the suction side, centred near the 30 % section: the error field whose
 # values on that plane Table 2 must reproduce.
 BUMP_HEIGHT = 0.03
 BUMP_RADIUS = 6.0
-
-
-def demo_nominal():
-    from tests.test_planning import demo_nominal as cached
-    return cached()
 
 
 class TestInspectLoop(unittest.TestCase):

@@ -13,7 +13,8 @@ import numpy as np
 
 from BladeInspect.core.errors import DeviceError
 from BladeInspect.core.pointio import read_points
-from tests.test_inspect_resume import (HEIGHTS, RESULT_FILES, SCAN_OPTIONS, SEED, demo_nominal,
+from tests.helpers import demo_nominal
+from tests.test_inspect_resume import (HEIGHTS, RESULT_FILES, SCAN_OPTIONS, SEED,
                                        first_difference, read_json, read_lines, simulated_rig)
 
 PITCH = 2.0

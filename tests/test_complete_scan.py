@@ -12,6 +12,7 @@ from scipy.spatial import cKDTree
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
+from tests.helpers import demo_nominal
 
 PITCH = 2.0
 SEED = 11
@@ -28,11 +29,6 @@ HEIGHTS = (30.0, 70.0)
 # A bump of 30 um on the suction side near the 30 % plane (span 70 mm along CAD z).
 BUMP_HEIGHT = 0.03
 BUMP_RADIUS = 6.0
-
-
-def demo_nominal():
-    from tests.test_planning import demo_nominal as cached
-    return cached()
 
 
 class TestCompleteRaster(unittest.TestCase):

@@ -22,6 +22,7 @@ import numpy as np
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
 from BladeInspect.core.pointio import read_points
+from tests.helpers import demo_nominal
 
 HEIGHTS = (30.0, 70.0)
 SEED = 23
@@ -33,11 +34,6 @@ FAULTS = {"blind": ("close", "motion port lost"),
           "first planned": ("alarm", r"hard limit: controller raised ALARM:1"),
           "planned": ("garbage", "garbage from the controller"),
           "replanned": ("silent", r"timeout, no answer within 1 s")}
-
-
-def demo_nominal():
-    from tests.test_planning import demo_nominal as cached
-    return cached()
 
 
 def simulated_rig(nominal):

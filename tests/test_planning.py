@@ -10,17 +10,7 @@ from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
 from BladeInspect.rig import planning
 from BladeInspect.rig.base import AxisLimits
-
-_CACHE = {}
-
-
-def demo_nominal():
-    if "nominal" not in _CACHE:
-        from BladeInspect.cad.demo_blade import make_demo_blade
-        from BladeInspect.cad.nominal import nominal_from_shape
-        model = make_demo_blade()
-        _CACHE["nominal"] = nominal_from_shape(model.shape, roles=model.roles)
-    return _CACHE["nominal"]
+from tests.helpers import demo_nominal
 
 
 def machine_to_cad(points, angle_deg, table_to_cad):

@@ -7,16 +7,7 @@ import numpy as np
 from BladeInspect.core import transforms as tf
 from BladeInspect.inspect import pipeline
 from BladeInspect.inspect.simulate import pose_error, simulate_measurement
-
-_NOMINAL = None
-
-
-def demo_nominal():
-    global _NOMINAL
-    if _NOMINAL is None:
-        _NOMINAL = pipeline.load_nominal(None)
-    return _NOMINAL
-
+from tests.helpers import demo_nominal
 
 class TestRegistrationFromAnyPose(unittest.TestCase):
     def test_random_poses_reach_the_statistical_limit(self):
