@@ -1,7 +1,7 @@
 """CAD building figures: build times, Rotor 67 loft against its independent cloud (every
 point), section cut time and accuracy of the reconstruction from noisy section passes.
 
-Run: PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_cad.py [--quick]
+Run: scripts/fcpython bench/bench_cad.py [--quick]
 (--quick uses 400 cloud points instead of all 2057)."""
 import os
 import sys

@@ -2,7 +2,7 @@
 CAD-planned sections measured by the simulated rig, and (when the inspect workflow is
 available) the whole loop.
 
-Run: /usr/bin/python3 bench/bench_closed_loop.py [--trials N] [--skip-plan] [--inspect-seeds N]"""
+Run: scripts/fcpython bench/bench_closed_loop.py [--trials N] [--skip-plan] [--inspect-seeds N]"""
 
 import argparse
 import os
@@ -13,7 +13,6 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(1, "/usr/lib/freecad-python3/lib")
 
 
 def calibration_figures(trials):

@@ -3,7 +3,7 @@ fixture pose: points, the simulated scan's wall time against the real sensor's a
 time at its rate (must be >= 10x faster), the real rig's estimated time, and the whole
 `inspect --complete` wall time (must be < 60 s on two cores).
 
-Run: /usr/bin/python3 bench/bench_complete.py [--pitch 0.1] [--seed 0] [--skip-inspect]"""
+Run: scripts/fcpython bench/bench_complete.py [--pitch 0.1] [--seed 0] [--skip-inspect]"""
 
 import argparse
 import os
@@ -16,7 +16,6 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(1, "/usr/lib/freecad-python3/lib")
 
 
 def main():

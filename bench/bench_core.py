@@ -1,7 +1,7 @@
 """Figures for the numerical core (no FreeCAD): ICP at the statistical limit on an analytic
 surface, its convergence basin, its own cost, the point reader's speed, the statistics' speed.
 
-    /usr/bin/python3 bench/bench_core.py [--trials 200] [--points 2000]
+    scripts/fcpython bench/bench_core.py [--trials 200] [--points 2000]
 
 The surface is the triaxial ellipsoid patch of tests/test_icp.py with exact closest points, so
 every figure is about the numerics alone (the CAD distance is measured elsewhere).

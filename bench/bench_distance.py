@@ -2,7 +2,7 @@
 OCC fallback fraction, agreement with OCC on a random sample, FreeCAD's per-point route for
 comparison, and the ray cast on 100,000 sensor-like rays.
 
-Run: PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_distance.py [--rotor67]
+Run: scripts/fcpython bench/bench_distance.py [--rotor67]
 """
 import os
 import sys

@@ -1,6 +1,6 @@
 """The demo in the GUI against `./bladeinspect demo` (issue 6: no more than 20 % longer).
 
-    /usr/bin/python3 bench/bench_gui_demo.py
+    scripts/fcpython bench/bench_gui_demo.py
 
 Both run the same closed loop on the demo blade with the simulated rig, 5 nominal sections,
 seed 0, report included; the GUI run is timed from a new document to the finished inspection,

@@ -8,7 +8,7 @@
 Prints the times, what the interrupted folder holds, and whether points.csv and the pose of
 2 and 3 equal the reference's.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_inspect_resume.py \
+    scripts/fcpython bench/bench_inspect_resume.py \
         [--seed S] [--heights 30,70] [--keep]
 """
 import argparse

@@ -1,6 +1,6 @@
 """Registration at the statistical limit (issue 3, "What must hold").
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_register.py \
+    scripts/fcpython bench/bench_register.py \
         [--cad CAD] [--trials 200] [--points 20000] [--scatter 30] [--full]
 
 1. Trials of the paper's simulation protocol (both sides, uniform +-6 um, 2 % gross outliers at

@@ -5,7 +5,7 @@ two defects (a +0.08 mm bump on the suction side, a -0.06 mm dent near the leadi
 moved to a random pose; then times run_report (register, section table, verdict, report.html,
 report.pdf, inspection.FCStd, result.json, deviations.csv) and prints the stage times.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_report.py [N] [OUT]
+    scripts/fcpython bench/bench_report.py [N] [OUT]
 Target: the whole report under 30 s on two cores.
 """
 import json

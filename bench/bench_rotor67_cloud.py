@@ -3,7 +3,7 @@ registered from a random pose to the blade lofted from NASA's section table. Bot
 frame by their provenance (X = r cos th, Y = r sin th, Z = axial), so the recovered pose is
 judged against it; the two geometries differ by up to 0.3 mm (PROVENANCE.txt).
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_rotor67_cloud.py
+    scripts/fcpython bench/bench_rotor67_cloud.py
 """
 import os
 import sys

@@ -2,7 +2,7 @@
 the real blade), set up as tests/test_rotor67_loop.py does for one: quiet sensor (0.5 um), a
 30 um bump on the suction side at the 30 % section, judged by the simulator's truth.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_rotor67_loop.py \
+    scripts/fcpython bench/bench_rotor67_loop.py \
         [--seeds 31,32,33] [--sections 3]
 """
 import argparse

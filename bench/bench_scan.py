@@ -5,7 +5,7 @@ scan of the demo blade at a random fixture pose: points, passes, simulated and e
 time, and how well the points lie on the CAD. Pass times are the better of two runs (other
 jobs share the machine).
 
-Run: PYTHONPATH=. /usr/bin/python3 bench/bench_scan.py [--sections 5] [--seed 0]
+Run: scripts/fcpython bench/bench_scan.py [--sections 5] [--seed 0]
 """
 import argparse
 import os
@@ -16,7 +16,6 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.append("/usr/lib/freecad-python3/lib")
 
 from BladeInspect.core import transforms as tf  # noqa: E402
 from BladeInspect.rig.calibration import SpherePart  # noqa: E402

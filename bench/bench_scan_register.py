@@ -1,7 +1,7 @@
 """Blind section scans on the simulated rig, registered back through the pipeline and judged
 against the rig's own fixture pose (issue 4: within 3x the pose's Cramér-Rao bound).
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_scan_register.py \
+    scripts/fcpython bench/bench_scan_register.py \
         [--cad CAD] [--seeds 0,1] [--sections 5]
 """
 import argparse

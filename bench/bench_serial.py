@@ -1,7 +1,7 @@
 """Serial rig throughput: one pass of K points through SerialRig and the simulated rig on a
 pseudo-terminal, checked point for point against the same rig in process.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_serial.py \
+    scripts/fcpython bench/bench_serial.py \
         [--points 100000] [--two-ports] [--process] [--rx-buffer 1024]
 
 --process serves the device from a second process (as `./bladeinspect simrig` does) instead of
@@ -45,7 +45,7 @@ def main():
                         help="controller receive buffer: 128 GRBL 1.1, 1024 grblHAL")
     args = parser.parse_args()
     if args.process:
-        server = subprocess.Popen([sys.executable, "-c", SERVE % (REPO, args.two_ports, args.rx_buffer)],
+        server = subprocess.Popen([os.path.join(REPO, "scripts", "fcpython"), "-c", SERVE % (REPO, args.two_ports, args.rx_buffer)],
                                   stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         url = server.stdout.readline().strip()
     else:

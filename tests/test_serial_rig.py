@@ -192,11 +192,10 @@ class SimrigCommandTest(unittest.TestCase):
         # A cylinder's ray casts are cheap; the demo blade's first one takes seconds.
         cad = os.path.join(folder.name, "part.step")
         Part.makeCylinder(15.0, 60.0).exportStep(cad)
-        env = dict(os.environ, PYTHONPATH=REPO + ":/usr/lib/freecad-python3/lib")
         server = subprocess.Popen(
-            ["/usr/bin/python3", "-c", "import FreeCAD; from BladeInspect.rig.simrig_device "
-             "import simrig_main; simrig_main(%r, 3)" % cad],
-            cwd=REPO, env=env, stdout=subprocess.PIPE, text=True)
+            [os.path.join(REPO, "scripts", "fcpython"), "-c", "from BladeInspect.rig."
+             "simrig_device import simrig_main; simrig_main(%r, 3)" % cad],
+            cwd=REPO, stdout=subprocess.PIPE, text=True)
         self.addCleanup(server.wait, 10)
         self.addCleanup(server.send_signal, signal.SIGTERM)
         reference = simulated_rig_for(load_nominal(cad), 3)     # while the server loads
