@@ -9,6 +9,7 @@ Bad input ends with one line ``bladeinspect: error: <file>: <problem>`` and exit
 """
 
 import argparse
+import faulthandler
 import json
 import os
 import sys
@@ -309,5 +310,38 @@ def main(argv=None):
     return 0
 
 
+def run_program():
+    """The entry of ``./bladeinspect``: FreeCAD started as a library (freecad_library), then
+    main(). The wrapper passes BLADEINSPECT_STATUS_FILE, where this records the command and
+    the versions when it starts and its exit status when main() returns: a process that dies
+    without the second line crashed, and the wrapper says so instead of ending silently."""
+    status_file = os.environ.get("BLADEINSPECT_STATUS_FILE")
+    _record_status(status_file, "pid %d" % os.getpid())
+    try:
+        from . import freecad_library
+        versions = freecad_library.versions()
+    except ImportError as exc:
+        sys.stderr.write("bladeinspect: error: %s\n" % exc)
+        _record_status(status_file, "finished 1")
+        return 1
+    # Enabled after FreeCAD installed its own signal handlers, so a fatal signal writes the
+    # Python stack before FreeCAD's handler ends the process: into the wrapper's log, where the
+    # one line the wrapper prints points, rather than a screenful on the terminal.
+    crash_log = os.environ.get("BLADEINSPECT_CRASH_LOG")
+    faulthandler.enable(file=open(crash_log, "a") if crash_log else sys.stderr)
+    command = next((a for a in sys.argv[1:] if not a.startswith("-")), "")
+    _record_status(status_file, "started %s\tFreeCAD %s, Python %s"
+                   % (command, versions["freecad"], versions["python"]))
+    code = main()
+    _record_status(status_file, "finished %d" % code)
+    return code
+
+
+def _record_status(path, line):
+    if path:
+        with open(path, "a") as fh:
+            fh.write(line + "\n")
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_program())

@@ -361,7 +361,9 @@ class AtomicOutput:
         self.out_dir = os.path.abspath(out_dir)
         parent = os.path.dirname(self.out_dir)
         os.makedirs(parent, exist_ok=True)
-        self.tmp = tempfile.mkdtemp(prefix=".bladeinspect-", dir=parent)
+        # The process id in the name lets ./bladeinspect remove the folder of a process that
+        # crashed before it could discard it.
+        self.tmp = tempfile.mkdtemp(prefix=".bladeinspect-%d-" % os.getpid(), dir=parent)
 
     def path(self, name):
         return os.path.join(self.tmp, name)

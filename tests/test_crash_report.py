@@ -1,0 +1,95 @@
+"""A crash under ./bladeinspect is never silent: the Python process is killed by a signal in the
+middle of a run, and the wrapper prints one line naming the command, the FreeCAD and Python
+versions and the log, exits non-zero, and leaves no result in --out."""
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import unittest
+
+from tests.helpers import REPO
+
+BLADEINSPECT = os.path.join(REPO, "bladeinspect")
+RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf", "inspection.FCStd")
+
+
+def _children(pid):
+    try:
+        with open("/proc/%d/task/%d/children" % (pid, pid)) as fh:
+            return [int(p) for p in fh.read().split()]
+    except OSError:
+        return []
+
+
+def _python_child(wrapper_pid):
+    """The wrapper's Python process (its direct child running BladeInspect.cli)."""
+    for pid in _children(wrapper_pid):
+        try:
+            with open("/proc/%d/cmdline" % pid, "rb") as fh:
+                if b"BladeInspect.cli" in fh.read():
+                    return pid
+        except OSError:
+            pass
+    return None
+
+
+class CrashIsNeverSilent(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="bladeinspect-crash-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+
+    def _kill_mid_run(self, sig):
+        out = os.path.join(self.tmp, "out-%d" % sig)
+        wrapper = subprocess.Popen(
+            [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
+            cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+            env=dict(os.environ, TMPDIR=self.tmp))
+        lines = []
+        killed = None
+        try:
+            for line in wrapper.stderr:
+                lines.append(line)
+                # A progress line: FreeCAD is up and the run is inside a stage.
+                if killed is None and re.match(r"\[\s*\d+%\]", line):
+                    killed = _python_child(wrapper.pid)
+                    self.assertIsNotNone(killed, "no Python child under the wrapper")
+                    os.kill(killed, sig)
+            rc = wrapper.wait(timeout=120)
+        finally:
+            if wrapper.poll() is None:
+                wrapper.kill()
+        self.assertIsNotNone(killed, "the run printed no progress: %s" % "".join(lines))
+        return out, rc, lines
+
+    def _check(self, sig, how):
+        out, rc, lines = self._kill_mid_run(sig)
+        self.assertNotEqual(rc, 0)
+        last = lines[-1].rstrip("\n")
+        self.assertRegex(last, r"^bladeinspect: crashed: 'simulate' %s \(FreeCAD \d+\.\d+(\.\d+)?,"
+                         r" Python %d\.%d\.\d+\); no result in .*; log: (\S+)$"
+                         % (how, sys.version_info[0], sys.version_info[1]))
+        log = last.rsplit("log: ", 1)[1]
+        self.assertTrue(os.path.isfile(log), log)
+        for name in RESULT_FILES:
+            self.assertFalse(os.path.exists(os.path.join(out, name)), name)
+        beside = [n for n in os.listdir(os.path.dirname(out)) if n.startswith(".bladeinspect-")]
+        self.assertEqual(beside, [], "a private output folder was left beside --out")
+        return log
+
+    def test_sigkill(self):
+        self._check(signal.SIGKILL, "was killed by signal KILL")
+
+    def test_segfault_turned_into_an_exit_status(self):
+        # FreeCAD's own handler turns SIGSEGV into a bare exit status; either way the wrapper
+        # reports it, and the log holds the Python stack written by faulthandler.
+        log = self._check(signal.SIGSEGV, r"(was killed by signal SEGV|ended with exit status "
+                                          r"\d+ without finishing)")
+        with open(log) as fh:
+            self.assertIn("Fatal Python error", fh.read())
+
+
+if __name__ == "__main__":
+    unittest.main()
