@@ -7,6 +7,7 @@ import shutil
 import subprocess
 import tempfile
 import unittest
+import warnings
 
 import numpy as np
 
@@ -59,14 +60,20 @@ class WriteReportTest(unittest.TestCase):
         cls.table = S.section_table(cls.result, cls.nominal, cmm=cls.cmm_path)
         cls.verdict = V.judge(cls.result, cls.table, tolerance=0.04)
         cls.out = os.path.join(cls.tmp, "report")
-        cls.files = R.write_report(cls.out, cls.result, cls.nominal, cls.table, cls.verdict,
-                                   0.04)
+        with warnings.catch_warnings(record=True) as cls.warnings:
+            warnings.simplefilter("always")
+            cls.files = R.write_report(cls.out, cls.result, cls.nominal, cls.table,
+                                       cls.verdict, 0.04)
         with open(os.path.join(cls.out, "report.html"), encoding="utf-8") as fh:
             cls.html = fh.read()
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_figures_raise_no_warnings(self):
+        # matplotlib 3.10 warned five times a report about the section figures' fixed limits
+        self.assertEqual(["%s: %s" % (w.category.__name__, w.message) for w in self.warnings], [])
 
     def test_files_and_pdf_pages(self):
         self.assertEqual(sorted(os.listdir(self.out)), ["report.html", "report.pdf"])

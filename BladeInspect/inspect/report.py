@@ -262,9 +262,11 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
                     ha="right", va="center", fontweight="bold")
         ax.annotate("TE", (sec.profile.chord, 0.0), xytext=(12, 0), textcoords="offset points",
                     ha="left", va="center", fontweight="bold")
+    # The margin enters the data limits, not fixed axis limits: an equal aspect that adjusts the
+    # data limits cannot also keep both fixed (matplotlib 3.10 warns and drops the y limits).
+    ax.update_datalim([both.min(axis=0) - margin, both.max(axis=0) + margin])
+    ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlim(both[:, 0].min() - margin, both[:, 0].max() + margin)
-    ax.set_ylim(both[:, 1].min() - margin, both[:, 1].max() + margin)
     ax.set_xlabel("along the chord from the leading edge (mm)")
     ax.set_ylabel("across (mm)")
     o = sec.optical
