@@ -1,6 +1,7 @@
 """The report files (HTML, PDF), the inspection document and the whole `report` run."""
 import base64
 import json
+import logging
 import os
 import re
 import shutil
@@ -60,10 +61,19 @@ class WriteReportTest(unittest.TestCase):
         cls.table = S.section_table(cls.result, cls.nominal, cmm=cls.cmm_path)
         cls.verdict = V.judge(cls.result, cls.table, tolerance=0.04)
         cls.out = os.path.join(cls.tmp, "report")
-        with warnings.catch_warnings(record=True) as cls.warnings:
-            warnings.simplefilter("always")
-            cls.files = R.write_report(cls.out, cls.result, cls.nominal, cls.table,
-                                       cls.verdict, 0.04)
+        # matplotlib warns through the warnings module and through its loggers: catch both
+        logged = []
+        handler = logging.Handler(logging.WARNING)
+        handler.emit = lambda record: logged.append(record.getMessage())
+        logging.getLogger("matplotlib").addHandler(handler)
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                cls.files = R.write_report(cls.out, cls.result, cls.nominal, cls.table,
+                                           cls.verdict, 0.04)
+        finally:
+            logging.getLogger("matplotlib").removeHandler(handler)
+        cls.warnings = ["%s: %s" % (w.category.__name__, w.message) for w in caught] + logged
         with open(os.path.join(cls.out, "report.html"), encoding="utf-8") as fh:
             cls.html = fh.read()
 
@@ -73,7 +83,7 @@ class WriteReportTest(unittest.TestCase):
 
     def test_figures_raise_no_warnings(self):
         # matplotlib 3.10 warned five times a report about the section figures' fixed limits
-        self.assertEqual(["%s: %s" % (w.category.__name__, w.message) for w in self.warnings], [])
+        self.assertEqual(self.warnings, [])
 
     def test_files_and_pdf_pages(self):
         self.assertEqual(sorted(os.listdir(self.out)), ["report.html", "report.pdf"])
