@@ -21,9 +21,11 @@ A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint
 points.csv up to the last completed blind section, planned section or raster pass, plan.json,
 and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
-measured data is kept section by section in a private folder while the loop runs
-(_Checkpoint), and a simulated rig's noise depends only on the pass number, which the
-checkpoint carries. See docs/internals.md for the checkpoint's fields.
+measured data is kept section by section in DIR/.checkpoint while the loop runs
+(_Checkpoint), every pass in between journaled (rig.journal), so a kill -9 or a power cut
+loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
+depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
+checkpoint's fields.
 """
 
 import json
