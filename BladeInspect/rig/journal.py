@@ -50,6 +50,8 @@ class JournaledRig:
             _sync(fh)
 
     def __getattr__(self, name):
+        if name == "rig":       # not set yet (a copy being made): no recursion
+            raise AttributeError(name)
         return getattr(self.rig, name)
 
     # -- resume --------------------------------------------------------------------------
