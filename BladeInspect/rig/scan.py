@@ -93,7 +93,6 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
         check_same_rig(record, rig, seed, record_path)
         options = record["options"]
         state = StrategyState.from_dict(record["checkpoint"]["strategy"])
-    # Options are checked before anything is written.
     kwargs = _strategy_kwargs(options)
     if fresh:
         # A bad option fails here, before anything is written.
