@@ -5,11 +5,19 @@ folder holds result.json (written last and atomically), so a lot interrupted mid
 where it stopped; a bad file is reported in the summary and skipped. Files run in parallel in
 worker processes (concurrent.futures), or on a Dask distributed cluster when a scheduler
 address is given; either way every worker loads the nominal once and keeps it.
+
+A worker lost mid-file (killed, its machine gone) has the file run again elsewhere (Dask does
+that by itself). Each run of a file begins by appending a line (host, process) to
+out_dir/.attempts/<stem>, on disk before any work, so the summary's ``attempts`` column says
+how many times a file was begun: more than one means it was retried. The folder goes when the
+lot is complete.
 """
 
 import csv
 import json
 import os
+import shutil
+import socket
 import threading
 import time
 
@@ -18,7 +26,8 @@ from . import verdict as verdict_mod
 
 POINT_EXTENSIONS = (".csv", ".xyz", ".asc", ".txt", ".ply", ".pcd")
 SUMMARY_FIELDS = ["file", "status", "n_points", "rms_mm", "worst_deviation_mm", "verdict",
-                  "pose_uncertainty_mm"]
+                  "pose_uncertainty_mm", "attempts"]
+ATTEMPTS_FOLDER = ".attempts"
 SECTION_FIELDS = ("n", "max_abs_mm", "rms_mm", "pct_within")
 
 _NOMINALS = {}
@@ -79,10 +88,13 @@ def _read_done(folder):
         return None     # unreadable: the file is simply done again
 
 
-def report_one(cad_path, points_path, folder, tolerance, seed):
-    """One file of the lot, in whichever process runs it: a summary row, never an exception."""
+def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None):
+    """One file of the lot, in whichever process runs it: a summary row, never an exception.
+    ``attempt_log``: the file this run is recorded in before it begins."""
     from .report import run_report
     name = os.path.basename(points_path)
+    if attempt_log is not None:
+        _record_attempt(attempt_log)
     try:
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
                    nominal=_nominal_for(cad_path))
@@ -92,6 +104,23 @@ def report_one(cad_path, points_path, folder, tolerance, seed):
         return {"file": name, "status": "error",
                 "error": "internal error: %s: %s" % (type(exc).__name__, exc)}
     return _row_from_result_json(name, _read_done(folder))
+
+
+def _record_attempt(path):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "a") as fh:
+        fh.write("%s %d %.3f\n" % (socket.gethostname(), os.getpid(), time.time()))
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def attempts_of(out_dir, stem):
+    """How many times the file ``stem`` of the lot in ``out_dir`` was begun (0: not yet)."""
+    try:
+        with open(os.path.join(out_dir, ATTEMPTS_FOLDER, stem)) as fh:
+            return sum(1 for line in fh if line.strip())
+    except FileNotFoundError:
+        return 0
 
 
 def write_summary(path, rows):
@@ -155,7 +184,7 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
             todo.append((stem, path))
 
     def finished(stem, row):
-        rows[stem] = dict(row, reused=False)
+        rows[stem] = dict(row, reused=False, attempts=attempts_of(out_dir, stem))
         # the summary is rewritten as files finish, so an interrupted lot still has one
         write_summary(summary_path, [rows[s] for s, _ in files if s in rows])
         progress(len(rows) / len(files), "%s: %s" % (row["file"], row.get("verdict") or
@@ -168,14 +197,25 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
         _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
+    # Every file is reported: the attempt counts are in the summary.
+    shutil.rmtree(os.path.join(out_dir, ATTEMPTS_FOLDER), ignore_errors=True)
     count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)
              for k in ("pass", "fail")}
-    message = ("%d files: %d pass, %d fail, %d error (%d already done, %.1f s); %s"
+    retried = ["%s (%d attempts)" % (r["file"], r["attempts"]) for r in ordered
+               if (r.get("attempts") or 0) > 1]
+    message = ("%d files: %d pass, %d fail, %d error (%d already done, %.1f s)%s; %s"
                % (len(files), count["pass"], count["fail"],
                   sum(1 for r in ordered if r["status"] == "error"),
-                  len(files) - len(todo), time.perf_counter() - t0, summary_path))
+                  len(files) - len(todo), time.perf_counter() - t0,
+                  ("; retried after a lost worker: " + ", ".join(retried)) if retried else "",
+                  summary_path))
     progress(1.0, message)
     return {"rows": ordered, "summary_csv": summary_path, "message": message}
+
+
+def _attempt_log(out_dir, stem):
+    # Absolute: a worker elsewhere runs in another folder (the lot's folder must be shared).
+    return os.path.join(os.path.abspath(out_dir), ATTEMPTS_FOLDER, stem)
 
 
 def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished):
@@ -185,12 +225,13 @@ def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished):
     if workers == 1 or len(todo) == 1:
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
-                                      seed))
+                                      seed, _attempt_log(out_dir, stem)))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                               tolerance, seed): stem for stem, path in todo}
+                               tolerance, seed, _attempt_log(out_dir, stem)): stem
+                   for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
@@ -208,9 +249,12 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished):
                          % (scheduler, exc))
     try:
         stems, futures = {}, []
+        # Workers run in other folders, perhaps on other machines (sharing these paths).
+        cad = os.path.abspath(cad_path) if cad_path is not None else None
         for stem, path in todo:
-            fut = client.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                                tolerance, seed, pure=False)
+            fut = client.submit(report_one, cad, os.path.abspath(path),
+                                os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
+                                _attempt_log(out_dir, stem), pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):

@@ -21,9 +21,11 @@ A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint
 points.csv up to the last completed blind section, planned section or raster pass, plan.json,
 and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
-measured data is kept section by section in a private folder while the loop runs
-(_Checkpoint), and a simulated rig's noise depends only on the pass number, which the
-checkpoint carries. See docs/internals.md for the checkpoint's fields.
+measured data is kept section by section in DIR/.checkpoint while the loop runs
+(_Checkpoint), every pass in between journaled (rig.journal), so a kill -9 or a power cut
+loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
+depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
+checkpoint's fields.
 """
 
 import json
@@ -36,6 +38,7 @@ import numpy as np
 from ..core import transforms as tf
 from ..core.errors import Cancelled, DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
+from ..rig.journal import JOURNAL_FILE, JournaledRig
 from ..rig.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
 
 DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
@@ -53,6 +56,9 @@ RESUME_POSE_TOLERANCE_MM = 1e-6
 CHECKPOINT = "inspection"
 # What a checkpoint is made of; scan.json last, since it marks the folder as one.
 CHECKPOINT_FILES = ("plan.json", POINTS_FILE, RECORD_FILE)
+# While an inspection runs, its checkpoint grows in this folder inside DIR: what a kill -9 or a
+# power cut leaves, and what --resume continues in place.
+LIVE_FOLDER = ".checkpoint"
 # What a finished inspection adds; none of them may stand beside a checkpoint.
 RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf",
                 "inspection.FCStd")
@@ -251,26 +257,31 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     timing["load"] = time.perf_counter() - t0
     try:
         with pipeline.AtomicOutput(out_dir) as out:
-            checkpoint = _Checkpoint(os.path.join(out.tmp, "checkpoint"), out_dir, identity,
-                                     rig, resume)
+            checkpoint = _Checkpoint(os.path.join(os.path.abspath(out_dir), LIVE_FOLDER),
+                                     out_dir, identity, rig, resume)
             scan_options = dict(checkpoint.identity["scan_options"] or {})
             try:
                 if complete:
-                    summary = _complete_loop(nominal, rig, kinematics, heights, seed, epsilon,
-                                             cmm_data, tolerance, pitch, out, checkpoint,
-                                             timing, progress, document, scan_options,
-                                             cad_path or "built-in demo blade")
+                    summary = _complete_loop(nominal, checkpoint.rig, kinematics, heights,
+                                             seed, epsilon, cmm_data, tolerance, pitch, out,
+                                             checkpoint, timing, progress, document,
+                                             scan_options, cad_path or "built-in demo blade")
                 else:
-                    summary = _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data,
-                                    tolerance, out, checkpoint, timing, progress, plan_sections,
-                                    scan_mod, pipeline, sections_mod, verdict_mod, write_report,
-                                    document, scan_options, cad_path or "built-in demo blade")
+                    summary = _loop(nominal, checkpoint.rig, kinematics, heights, seed, epsilon,
+                                    cmm_data, tolerance, out, checkpoint, timing, progress,
+                                    plan_sections, scan_mod, pipeline, sections_mod,
+                                    verdict_mod, write_report, document, scan_options,
+                                    cad_path or "built-in demo blade")
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
+                checkpoint.discard()
                 raise
-            finally:
-                shutil.rmtree(checkpoint.folder, ignore_errors=True)
+            except BaseException:
+                checkpoint.abandon()
+                raise
+        # Only once the result is in DIR: a kill before leaves the checkpoint to resume.
+        checkpoint.discard()
     finally:
         if opened:
             rig.close()
@@ -290,7 +301,8 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
         progress(0.0, "blind section scan" + (" (resumed)" if state else ""))
         scan_mod.scan_to_dir(checkpoint.folder, rig, seed=seed, kinematics=kinematics,
                              resume=state is not None, phase="blind",
-                             progress=lambda f, m: progress(scan_share * f, m), **scan_options)
+                             progress=lambda f, m: progress(scan_share * f, m),
+                             on_record=checkpoint.mark_blind, **scan_options)
         blind_rig_s = checkpoint.rig_s()
     else:
         blind_rig_s = float(state["blind_rig_s"])
@@ -468,6 +480,7 @@ def _start_or_resume(checkpoint, rig, resumed, fresh):
     state = dict(resumed)
     checkpoint.truncate_points(state["points_bytes"])
     _continue_pass_numbering(rig, state)
+    checkpoint.rig.resume(state.get("journal_passes"))
     return state
 
 
@@ -636,43 +649,61 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
 # ---------------------------------------------------------------- checkpoint and resume
 
 class _Checkpoint:
-    """What an inspection has measured so far, kept in a private folder while it runs:
+    """What an inspection has measured so far, kept in DIR/LIVE_FOLDER while it runs:
     points.csv and scan.json grow one completed blind section at a time (rig.scan.scan_to_dir's
     own checkpoint), then one completed planned section or raster pass at a time; plan.json is
-    the plan being scanned. scan.json's CHECKPOINT entry says where the loop stands. A DeviceError moves the
-    three files into DIR (keep); ``resume`` starts from a copy of those in DIR."""
+    the plan being scanned; readings.journal holds every pass since (``rig``: the rig,
+    journaled). scan.json's CHECKPOINT entry says where the loop stands from the first write
+    on, so whatever a kill leaves can be resumed. A DeviceError or a cancel moves the three
+    files into DIR (keep); ``resume`` continues the live folder in place when a kill left one,
+    else starts from a copy of the files in DIR."""
 
     def __init__(self, folder, out_dir, identity, rig, resume):
         self.folder = folder
         self.out_dir = os.path.abspath(out_dir)
-        self.rig = rig
         self.state = None
-        self._session_start = float(rig.elapsed_s)
+        self.in_place = False
+        self._created_dir = not os.path.exists(self.out_dir)
         self._earlier_rig_s = 0.0
+        live = _live_checkpoint(self.path(RECORD_FILE))
         record_path = os.path.join(self.out_dir, RECORD_FILE)
         if not resume:
             try:
-                saved = _saved_checkpoint(record_path)
+                saved = live or _saved_checkpoint(record_path)
             except InputError:
                 saved = None    # not a checkpoint: a fresh run replaces it, as any old file
             if saved is not None:
                 raise InputError("--out %s: holds an interrupted inspection (use --resume to "
                                  "continue it, or another folder)" % out_dir)
             self.identity = identity
+            self._start(rig, copy_from=None)
             return
-        saved = _saved_checkpoint(record_path)
+        saved = live if live is not None else _saved_checkpoint(record_path)
         if saved is None:
             raise InputError("--resume: %s holds no interrupted inspection to continue"
                              % out_dir)
         self.identity = _same_identity(saved.get("options"), identity, out_dir)
-        with open(record_path) as fh:
-            check_same_rig(json.load(fh), rig, identity["seed"], record_path)
+        source = self.path(RECORD_FILE) if live is not None else record_path
+        with open(source) as fh:
+            check_same_rig(json.load(fh), rig, identity["seed"], source)
         self.state = saved
         self._earlier_rig_s = float(saved.get("rig_s", 0.0))
-        os.makedirs(folder)
-        for name in CHECKPOINT_FILES:
-            if os.path.exists(os.path.join(self.out_dir, name)):
-                shutil.copyfile(os.path.join(self.out_dir, name), self.path(name))
+        self.in_place = live is not None
+        self._start(rig, copy_from=None if self.in_place else self.out_dir)
+
+    def _start(self, rig, copy_from):
+        """The live folder (a fresh one, the files of ``copy_from`` copied in, or the one a
+        kill left) and the journaled rig writing into it."""
+        if not self.in_place:
+            shutil.rmtree(self.folder, ignore_errors=True)   # a kill before its first record
+            os.makedirs(self.folder)
+            if copy_from is not None:
+                # scan.json last and whole: it is what makes the folder a checkpoint.
+                for name in CHECKPOINT_FILES:
+                    if os.path.exists(os.path.join(copy_from, name)):
+                        _durable_copy(os.path.join(copy_from, name), self.path(name))
+        self.rig = JournaledRig(rig, self.path(JOURNAL_FILE), keep=self.in_place)
+        self._session_start = float(self.rig.elapsed_s)
 
     def path(self, name):
         return os.path.join(self.folder, name)
@@ -688,14 +719,26 @@ class _Checkpoint:
         record.pop(CHECKPOINT, None)
         return record
 
-    def save(self, state, record=None):
+    def save(self, state, record=None, journal=True):
         """Records where the loop stands (after a completed section: the rows on disk are
-        exactly those the state counts)."""
+        exactly those the state counts, and so are the journal's passes, which then start
+        afresh). ``journal`` False leaves the journal's count as ``state`` has it."""
         record = self.record() if record is None else dict(record)
         self.state = dict(state, options=self.identity, complete=False, rig_s=self.rig_s())
+        if journal:
+            self.state["journal_passes"] = self.rig.passes
         record[CHECKPOINT] = self.state
         record["complete"] = False
         write_record(self.path(RECORD_FILE), record)
+        if journal:
+            self.rig.commit()
+
+    def mark_blind(self, record):
+        """The blind scan's scan.json, as scan_to_dir writes it: marked as this inspection's
+        checkpoint from the first write on (the journal's count is scan_to_dir's own)."""
+        record[CHECKPOINT] = dict(self.state if self.state is not None else {},
+                                  phase="blind", options=self.identity, complete=False,
+                                  rig_s=self.rig_s())
 
     def keep(self):
         """After a DeviceError or a cancel: the measured data goes to DIR as a checkpoint to resume, in
@@ -703,8 +746,8 @@ class _Checkpoint:
         if not os.path.exists(self.path(RECORD_FILE)):
             return
         state = self.state if self.state is not None else {"phase": "blind"}
-        self.save(state)
-        os.makedirs(self.out_dir, exist_ok=True)
+        # The journal stays behind: the kept checkpoint is the completed sections, as before.
+        self.save(state, journal=False)
         for name in RESULT_FILES:
             if os.path.exists(os.path.join(self.out_dir, name)):
                 os.remove(os.path.join(self.out_dir, name))
@@ -714,6 +757,19 @@ class _Checkpoint:
                 os.replace(self.path(name), os.path.join(self.out_dir, name))
             elif os.path.exists(os.path.join(self.out_dir, name)):
                 os.remove(os.path.join(self.out_dir, name))
+
+    def discard(self):
+        """The live folder goes: the result, or the kept checkpoint, is in DIR."""
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def abandon(self):
+        """After an InputError: nothing of this run is left, except a live folder that a kill
+        left, which stays resumable (it holds measurements made before this run)."""
+        if self.in_place:
+            return
+        self.discard()
+        if self._created_dir and os.path.isdir(self.out_dir) and not os.listdir(self.out_dir):
+            os.rmdir(self.out_dir)
 
     def truncate_points(self, size):
         path = self.path(POINTS_FILE)
@@ -748,6 +804,24 @@ class _Checkpoint:
             fh.write("".join(lines))
             fh.flush()
             os.fsync(fh.fileno())
+
+
+def _live_checkpoint(record_path):
+    """The loop's state in the live folder's scan.json, or None when there is none to resume
+    (no folder, or one killed before its first record)."""
+    try:
+        return _saved_checkpoint(record_path)
+    except InputError:
+        return None
+
+
+def _durable_copy(source, target):
+    """Copy ``source`` to ``target`` all at once and on disk (a temporary file replaced)."""
+    tmp = target + ".part"
+    shutil.copyfile(source, tmp)
+    with open(tmp, "rb+") as fh:
+        os.fsync(fh.fileno())
+    os.replace(tmp, target)
 
 
 def _saved_checkpoint(record_path):

@@ -3,11 +3,15 @@ DIR/scan.json (per-section record, times, the simulator's truth, the checkpoint)
 
 Both files grow one COMPLETED section at a time: the points are appended, then scan.json is
 replaced atomically (temporary file + os.replace) with a checkpoint holding the strategy's
-state, the rig's pass counter and the byte length of points.csv. A scan cut short (a
-DeviceError mid-section, a cancel) keeps its finished sections, and ``resume=True`` continues
-after the last of them: points.csv is cut back to the checkpoint (dropping a section's rows
-appended just before the interruption) and the strategy carries on from its saved state, so
-nothing is measured twice or lost and a simulated rig reads exactly what it would have.
+state, the rig's pass counter, the byte length of points.csv and the number of passes it
+holds. Within a section every pass goes to DIR/readings.journal as it ends (rig.journal), so a
+scan cut short - a DeviceError, a cancel, or a kill -9 / power cut mid-section - keeps its
+finished sections and the finished passes of the section in flight. ``resume=True`` continues
+after the last finished section: points.csv is cut back to the checkpoint (dropping a
+section's rows appended just before the interruption), the strategy carries on from its saved
+state, and the journal's passes are given back to it in place of the rig's until the rig
+takes over at the pass that was in flight; so nothing is measured twice or lost and a
+simulated rig reads exactly what it would have.
 """
 
 import json
@@ -17,6 +21,7 @@ import tempfile
 import numpy as np
 
 from ..core.errors import DeviceError, InputError
+from .journal import JOURNAL_FILE, JournaledRig, inner_rig
 from .strategy import ScanStrategy, StrategyState
 
 POINTS_FILE = "points.csv"
@@ -52,12 +57,15 @@ def demo_nominal():
 
 
 def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None, phase=None,
-                **strategy_options):
+                on_record=None, **strategy_options):
     """Run the blind scan (rig.strategy.ScanStrategy with ``strategy_options``) and write it
     to ``out_dir`` section by section. Returns the scan record (what scan.json holds, plus
     ``points``: the number of points). ``progress(fraction, message)`` is called per section.
     ``phase``: a value for a last ``phase`` column of points.csv (``inspect`` appends its
-    planned rows to the same file).
+    planned rows to the same file). ``on_record(record)`` may add to each scan.json before it
+    is written. ``rig`` may be journaled already (rig.journal.JournaledRig: the caller keeps
+    the journal, as `inspect` does); else the journal is DIR/readings.journal, removed when the
+    scan is complete.
 
     A folder holding a previous scan is an InputError unless ``resume``; on resume the saved
     options are used (the scan continues as it began) and the rig must be the same one."""
@@ -85,16 +93,24 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
         check_same_rig(record, rig, seed, record_path)
         options = record["options"]
         state = StrategyState.from_dict(record["checkpoint"]["strategy"])
-    # Options are checked before anything is written.
-    strategy = ScanStrategy(rig, state=state, **_strategy_kwargs(options))
+    kwargs = _strategy_kwargs(options)
     if fresh:
+        # A bad option fails here, before anything is written.
+        ScanStrategy(rig, **kwargs)
         os.makedirs(out_dir, exist_ok=True)
+    own_journal = not isinstance(rig, JournaledRig)
+    if own_journal:
+        rig = JournaledRig(rig, os.path.join(out_dir, JOURNAL_FILE), keep=not fresh)
+    if fresh:
         with open(points_path, "w") as f:
             f.write(POINTS_HEADER if phase is None else POINTS_HEADER[:-1] + ",phase\n")
         record["checkpoint"]["points_bytes"] = os.path.getsize(points_path)
-        write_record(record_path, record)
+        record["checkpoint"]["journal_passes"] = rig.passes
+        _write(record_path, record, on_record)
     else:
         _truncate_points(points_path, record["checkpoint"]["points_bytes"])
+        rig.resume(record["checkpoint"].get("journal_passes"))
+    strategy = ScanStrategy(rig, state=state, **kwargs)
     start_elapsed = rig.elapsed_s
     base_simulated = record["simulated_s"]
     try:
@@ -108,16 +124,20 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
             record["section_y"] = [float(v) for v in strategy.section_y]
             record["complete"] = strategy.state.next_section >= len(strategy.section_y)
             record["checkpoint"] = {"strategy": strategy.state.to_dict(),
-                                    "points_bytes": os.path.getsize(points_path)}
-            write_record(record_path, record)
+                                    "points_bytes": os.path.getsize(points_path),
+                                    "journal_passes": rig.passes}
+            _write(record_path, record, on_record)
+            rig.commit()
     except InputError as exc:
         # A device failure leaves the scan to resume; a scan that found nothing to measure
         # leaves nothing that looks like a result.
         if fresh and not record["sections"] and not isinstance(exc, DeviceError):
-            for path in (points_path, record_path):
+            for path in (points_path, record_path) + ((rig.path,) if own_journal else ()):
                 if os.path.exists(path):
                     os.remove(path)
         raise
+    if own_journal and record["complete"]:
+        os.remove(rig.path)
     if progress is not None:
         progress(1.0, "scan complete: %d sections, %d points"
                  % (len(record["sections"]), record["points"]))
@@ -125,6 +145,12 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
 
 
 # ---------------------------------------------------------------- record
+
+def _write(path, record, on_record):
+    if on_record is not None:
+        on_record(record)
+    write_record(path, record)
+
 
 def _strategy_kwargs(options):
     allowed = ("n_sections", "span_range", "section_spacing", "point_spacing", "probe_spacing",
@@ -158,7 +184,7 @@ def _new_record(rig, seed, options):
     record = {
         "software": {"name": "BladeInspect", "version": version},
         "kind": "blind section scan",
-        "rig": type(rig).__name__,
+        "rig": type(inner_rig(rig)).__name__,
         "seed": int(seed),
         "options": _json_options(options),
         "sensor": sensor.to_dict() if hasattr(sensor, "to_dict") else None,
@@ -185,9 +211,10 @@ def check_same_rig(record, rig, seed, path):
     if int(record.get("seed", seed)) != int(seed):
         raise InputError("%s: the scan was made with seed %s, not %s"
                          % (path, record.get("seed"), seed))
-    if record.get("rig") != type(rig).__name__:
+    kind = type(inner_rig(rig)).__name__
+    if record.get("rig") != kind:
         raise InputError("%s: the scan was made on a %s rig, not a %s"
-                         % (path, record.get("rig"), type(rig).__name__))
+                         % (path, record.get("rig"), kind))
     truth = getattr(rig, "table_to_cad", None)
     if truth is not None and "table_to_cad" in record:
         if not np.allclose(np.asarray(record["table_to_cad"]), truth, atol=1e-9):
@@ -262,6 +289,6 @@ def _real_time(rig, record):
     """A simulated rig's time plus the per-pass overhead a real one adds; a real rig's
     elapsed time is already real."""
     from .simulated import SimulatedRig
-    if isinstance(rig, SimulatedRig):
+    if isinstance(inner_rig(rig), SimulatedRig):
         return record["simulated_s"] + PASS_OVERHEAD_S * record["passes"]
     return record["simulated_s"]
