@@ -29,6 +29,7 @@ from ..core import bspline
 from ..core.bspline import SurfaceData
 from ..core.errors import InputError
 from ..core.trim import TrimDomain
+from .orient import face_sides, side_warnings
 
 # Number of nearest samples whose faces become Newton candidates for a point.
 K_CANDIDATES = 8
@@ -226,7 +227,7 @@ class Nominal:
 
     @property
     def face_side_warnings(self):
-        from .orient import side_warnings
+        """Lines for result.json's warnings: faces whose outside is a guess or a user's."""
         return side_warnings(self.face_sides)
 
     # ------------------------------------------------------------------ exact distance
@@ -554,7 +555,6 @@ def nominal_from_shape(shape, roles=None, sample_spacing=None, flip_faces=()):
     decided orientations, so the fast path (``_reversed``), OCC's ``normalAt`` in the fallback
     and the ray caster all see the same outward side.
     """
-    from .orient import face_sides
     if shape is None or shape.isNull() or len(shape.Faces) == 0:
         raise InputError("CAD shape has no faces")
     if sample_spacing is not None and not (np.isfinite(sample_spacing) and sample_spacing > 0):
