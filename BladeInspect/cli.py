@@ -54,6 +54,20 @@ def _heights(text):
     return values
 
 
+def _face_indices(text):
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected comma-separated face indices, got %r" % text)
+    if not values or min(values) < 0:
+        raise argparse.ArgumentTypeError("expected face indices 0, 1, ..., got %r" % text)
+    return values
+
+
+FLIP_FACE_HELP = ("CAD faces (indices, as result.json's cad_faces lists them) whose outward "
+                  "side is reversed: for open faces whose side the tool could not decide")
+
+
 class Parser(argparse.ArgumentParser):
     """argparse that ends with exit status 2 and one line, as every other bad input does."""
 
@@ -76,6 +90,7 @@ def build_parser():
     r.add_argument("--points", required=True)
     r.add_argument("--out", required=True)
     r.add_argument("--seed", type=_seed, default=0)
+    r.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
 
     s = sub.add_parser("simulate", help="the paper's simulation test bed (4.1)")
     s.add_argument("--cad", default=None, help="CAD file (default: the built-in demo blade)")
@@ -113,6 +128,7 @@ def build_parser():
     rp.add_argument("--section-heights", type=_heights, default=None,
                     help="section planes in %% of span (default 10,30,50,70,90)")
     rp.add_argument("--seed", type=_seed, default=0)
+    rp.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
 
     b = sub.add_parser("batch", help="inspect every point file of a production lot")
     b.add_argument("--cad", required=True)
@@ -136,6 +152,7 @@ def build_parser():
     i.add_argument("--resume", action="store_true",
                    help="continue an inspection in DIR interrupted by a rig failure, from its "
                         "last complete section (same CAD, seed and options)")
+    i.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
 
     c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
     c.add_argument("--out", required=True, help="RIG.json to write")
@@ -160,13 +177,17 @@ def _print_result(result, out_dir, stream=sys.stdout):
                  % (result.pose_uncertainty_mm * 1000.0))
     if result.coarse.get("warning"):
         stream.write("  warning: %s\n" % result.coarse["warning"])
+    for warning in result.warnings:
+        if warning != result.coarse.get("warning"):
+            stream.write("  warning: %s\n" % warning)
     stream.write("  timing: %s\n" % ", ".join("%s %.2f s" % kv for kv in result.timing_s.items()))
     stream.write("results in %s\n" % os.path.abspath(out_dir))
 
 
 def cmd_register(args):
     from .inspect.pipeline import run_register
-    result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress())
+    result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress(),
+                          flip_faces=args.flip_face)
     _print_result(result, args.out)
 
 
@@ -242,7 +263,7 @@ def cmd_report(args, cad=None, points=None):
         options["heights_pct"] = args.section_heights
     summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
                          tolerance=args.tolerance, seed=args.seed, progress=Progress(),
-                         **options)
+                         flip_faces=args.flip_face, **options)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -260,7 +281,7 @@ def cmd_inspect(args):
                           section_heights=args.section_heights, complete=args.complete,
                           pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
                           seed=args.seed, rig_file=args.rig_file, progress=Progress(),
-                          resume=args.resume)
+                          resume=args.resume, flip_faces=args.flip_face)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 

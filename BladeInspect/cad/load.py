@@ -125,18 +125,22 @@ def read_points_any(path):
 
 
 
-def load_nominal(cad_path=None, sample_spacing=None):
+def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     """The nominal geometry every command measures against: a CAD file, a blade section table
     (.dat, the NASA Rotor 67 format, lofted into B-spline faces), or the built-in demo blade
-    when ``cad_path`` is None."""
+    when ``cad_path`` is None. ``flip_faces``: indices of faces whose outward side the user
+    reverses (``--flip-face``, see cad.orient)."""
     from .nominal import nominal_from_shape
     if cad_path is None:
         from .demo_blade import make_demo_blade
         model = make_demo_blade()
-        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing)
+        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing,
+                                  flip_faces=flip_faces)
     if cad_path.lower().endswith(".dat"):
         _check_file(cad_path, "section table")
         from .rotor67 import make_rotor67_blade
         model = make_rotor67_blade(cad_path)
-        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing)
-    return nominal_from_shape(load_shape(cad_path), sample_spacing=sample_spacing)
+        return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing,
+                                  flip_faces=flip_faces)
+    return nominal_from_shape(load_shape(cad_path), sample_spacing=sample_spacing,
+                              flip_faces=flip_faces)

@@ -29,6 +29,7 @@ from ..core import bspline
 from ..core.bspline import SurfaceData
 from ..core.errors import InputError
 from ..core.trim import TrimDomain
+from .orient import face_sides, side_warnings
 
 # Number of nearest samples whose faces become Newton candidates for a point.
 K_CANDIDATES = 8
@@ -201,13 +202,15 @@ class Nominal:
     """The nominal CAD: faces, their exact surfaces, dense samples and the distance queries."""
 
     def __init__(self, shape, faces, nurbs_faces, surfaces, domains, reversed_, samples,
-                 bbox_corners, roles):
+                 bbox_corners, roles, face_sides):
         self.shape = shape
         self.faces = faces
         self.surfaces = surfaces
         self.samples = samples
         self.bbox_corners = bbox_corners
         self.roles = roles
+        # cad.orient.FaceSide per face: how its outward side was decided
+        self.face_sides = face_sides
         self._nurbs_faces = nurbs_faces
         self._domains = domains
         self._reversed = np.asarray(reversed_, bool)
@@ -216,6 +219,16 @@ class Nominal:
         self._face_compound = Part.makeCompound(faces)
         self._edge_faces = None
         self._tessellation = None
+
+    @property
+    def cad_faces(self):
+        """result.json's ``cad_faces``: per face, how its outward side was decided."""
+        return [side.to_json() for side in self.face_sides]
+
+    @property
+    def face_side_warnings(self):
+        """Lines for result.json's warnings: faces whose outside is a guess or a user's."""
+        return side_warnings(self.face_sides)
 
     # ------------------------------------------------------------------ exact distance
 
@@ -531,11 +544,16 @@ def _sample_face(surf, domain, reverse, spacing):
     return S[keep], nrm, uv[keep], area[keep] * du * dv
 
 
-def nominal_from_shape(shape, roles=None, sample_spacing=None):
+def nominal_from_shape(shape, roles=None, sample_spacing=None, flip_faces=()):
     """Nominal of a solid, shell or compound of (open) faces.
 
     sample_spacing: distance between samples in mm; by default chosen so the whole CAD gets
     about DEFAULT_SAMPLE_COUNT samples (at least MIN_SAMPLES_PER_SIDE^2 per face).
+    Faces outside a closed solid are turned outward by cad.orient's rule (``flip_faces``:
+    indices whose side the user reverses); ``Nominal.face_sides`` says how each was decided.
+    The faces the Nominal keeps (and, for a shape without solids, its shape) carry the
+    decided orientations, so the fast path (``_reversed``), OCC's ``normalAt`` in the fallback
+    and the ray caster all see the same outward side.
     """
     if shape is None or shape.isNull() or len(shape.Faces) == 0:
         raise InputError("CAD shape has no faces")
@@ -550,6 +568,14 @@ def nominal_from_shape(shape, roles=None, sample_spacing=None):
         surfaces.append(surf)
         domains.append(_face_domain(nface, surf, isinstance(face.Surface, Part.Plane)))
         reversed_.append(face.Orientation == "Reversed")
+    sides = face_sides(shape, faces, surfaces, domains, reversed_, flip_faces)
+    flipped = [s.index for s in sides if s.flip]
+    for i in flipped:
+        faces[i] = faces[i].reversed()
+        nurbs[i] = nurbs[i].reversed()
+        reversed_[i] = not reversed_[i]
+    if flipped and not shape.Solids:
+        shape = Part.makeCompound(faces)
     if sample_spacing is None:
         area = sum(f.Area for f in faces)
         sample_spacing = max(np.sqrt(area / DEFAULT_SAMPLE_COUNT), 1e-6)
@@ -562,4 +588,4 @@ def nominal_from_shape(shape, roles=None, sample_spacing=None):
         uv=np.concatenate([p[2] for p in parts]),
         weight=np.concatenate([p[3] for p in parts]))
     return Nominal(shape, faces, nurbs, surfaces, domains, reversed_, samples,
-                   _bbox_corners(shape), {k: list(v) for k, v in (roles or {}).items()})
+                   _bbox_corners(shape), {k: list(v) for k, v in (roles or {}).items()}, sides)

@@ -146,12 +146,13 @@ def make_rotor67_blade(dat_path, sections=None):
 _CACHE = {}
 
 
-def _build(dat_path, sections):
+def side_faces(table, sections):
+    """([suction, pressure] open B-spline faces, their common spanwise parameters) through the
+    1-based ``sections`` of a read_rotor67 table; each face's normal is its Su x Sv, u along
+    the chord from the leading edge, v along the span."""
     import Part
-    from .surface_build import interpolate_grid, close_sides
+    from .surface_build import interpolate_grid
 
-    table = read_rotor67(dat_path)
-    sections = list(range(1, table["ns"] + 1) if sections is None else sections)
     upper, lower = blade_sections(table, sections)
     # Both sides use one spanwise parameter so their shared LE/TE boundary curves coincide.
     v = _chord_params(np.concatenate([upper, lower], axis=1).transpose(1, 0, 2))
@@ -159,6 +160,16 @@ def _build(dat_path, sections):
     for side in (upper, lower):
         # A side's u parameter: chord length along each section, averaged over sections.
         faces.append(Part.Face(interpolate_grid(side, _chord_params(side), v)))
+    return faces, v
+
+
+def _build(dat_path, sections):
+    import Part
+    from .surface_build import close_sides
+
+    table = read_rotor67(dat_path)
+    sections = list(range(1, table["ns"] + 1) if sections is None else sections)
+    faces, v = side_faces(table, sections)
     hub = [Part.Edge(f.Surface.vIso(v[0])) for f in faces]
     tip = [Part.Edge(f.Surface.vIso(v[-1])) for f in faces]
     solid, (i_s, i_p, i_h, i_t) = close_sides(faces[0], faces[1], hub, tip, planar_caps=False)

@@ -181,7 +181,7 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         pose_covariance=fit.covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
-        timing_s=timing, warnings=warnings, source=pointset.source)
+        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces)
 
 
 def _sections_json(table, plan):
@@ -206,13 +206,14 @@ def _pointset(xyz, snr, columns, source):
 def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGHTS,
                 complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
-                scan_options=None, on_plan=None, resume=False):
+                scan_options=None, on_plan=None, resume=False, flip_faces=()):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (rig.scan.scan_to_dir, e.g. n_sections).
     ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
     ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
-    ``scan_options`` None takes the interrupted run's).
+    ``scan_options`` None takes the interrupted run's). ``flip_faces``: CAD faces whose
+    outward side is reversed (``--flip-face``, cad.orient).
     Returns a summary dict. The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
@@ -247,7 +248,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
-        nominal = pipeline.load_nominal(cad_path)
+        nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
     kinematics = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
     identity = _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics,
                          scan_options)

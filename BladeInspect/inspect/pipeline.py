@@ -48,11 +48,11 @@ def _no_progress(fraction, message):
 
 # ---------------------------------------------------------------- inputs
 
-def load_nominal(cad_path=None, sample_spacing=None):
+def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     """The nominal geometry (see cad.load.load_nominal): a CAD file, a section table, or the
-    demo blade when ``cad_path`` is None."""
+    demo blade when ``cad_path`` is None; ``flip_faces`` as ``--flip-face``."""
     from ..cad.load import load_nominal as load
-    return load(cad_path, sample_spacing=sample_spacing)
+    return load(cad_path, sample_spacing=sample_spacing, flip_faces=flip_faces)
 
 
 def load_points(path):
@@ -230,7 +230,8 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
     xyz = _check_points(pointset)
     snr = None if pointset.snr is None else np.asarray(pointset.snr, dtype=float)
     rng = np.random.default_rng(seed)
-    warnings = []
+    # A CAD face whose outside could not be decided signs its deviations by a guess: say so.
+    warnings = list(nominal.face_side_warnings)
 
     pca_points = None
     t0 = time.perf_counter()
@@ -286,7 +287,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
         columns=dict(pointset.columns), n_rows_skipped=int(pointset.n_rows_skipped),
         rms_mm=rms, pose_covariance=fit.covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty), deviation_stats=stats, coarse=coarse_out,
-        timing_s=timing, warnings=warnings, source=pointset.source)
+        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces)
 
 
 # ---------------------------------------------------------------- outputs
@@ -315,6 +316,7 @@ def result_json(result, extra=None):
         "timing_s": result.timing_s,
         "software": {"name": NAME, "version": __version__, "FreeCAD version": freecad_version()},
         "coarse": result.coarse,
+        "cad_faces": result.cad_faces,
         "warnings": result.warnings,
         "points_file": result.source,
         "cad_file": result.cad_source,
@@ -414,10 +416,10 @@ def _json_default(value):
     raise TypeError("not JSON serialisable: %r" % type(value))
 
 
-def run_register(cad_path, points_path, out_dir, seed=0, progress=None):
+def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=()):
     """The `register` command: load, register, write. Returns the RegistrationResult."""
     t0 = time.perf_counter()
-    nominal = load_nominal(cad_path)
+    nominal = load_nominal(cad_path, flip_faces=flip_faces)
     t_cad = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = load_points(points_path)

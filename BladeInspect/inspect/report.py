@@ -525,11 +525,12 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
                seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
-               nominal=None, document=True):
+               nominal=None, document=True, flip_faces=()):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
     made in a private folder beside out_dir and moved in only when every one is complete.
-    ``nominal`` skips loading the CAD (a batch loads it once). Returns a summary dict."""
+    ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
+    ``--flip-face`` (cad.orient). Returns a summary dict."""
     from . import pipeline
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
@@ -538,7 +539,7 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
-        nominal = pipeline.load_nominal(cad_path)
+        nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
     timing["load_cad"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = pipeline.load_points(points_path)

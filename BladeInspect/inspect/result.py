@@ -29,6 +29,7 @@ class RegistrationResult:
     warnings: list = field(default_factory=list)
     source: str = ""
     cad_source: str = ""
+    cad_faces: list = field(default_factory=list)   # how each CAD face's outside was decided
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
