@@ -255,7 +255,8 @@ class _Problem:
 
 @dataclass
 class FitOptions:
-    max_iter: int = 40            # closest-point evaluations
+    max_iter: int = 100           # closest-point evaluations (Gauss-Newton converges only
+                                  # linearly when locked DOFs leave large residuals)
     step_tol_mm: float = 1e-9     # a step moving no point more than this has converged
     gain_tol_mm: float = 1e-9     # Chebyshev: a predicted gain below this has converged
     exchange_rows: int = 50       # constraints added to the linear programme per exchange
