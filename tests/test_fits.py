@@ -142,6 +142,22 @@ class LockedLeastSquares(unittest.TestCase):
             np.testing.assert_allclose(result.twist[3:], angle * axis, atol=1e-11)
             self.assertTrue(np.all(result.twist[:3] == 0.0))
 
+    def test_two_rotations_free_is_the_constrained_optimum(self):
+        """rz and the translations locked: the rotation vector (rx, ry, 0) about c minimising
+        the exact objective, found by BFGS over those two components."""
+        rng = np.random.default_rng(16)
+        for _ in range(5):
+            p, q, w = correspondences(rng)
+            c = rng.uniform(-10, 10, 3)
+            result = self.fit(p, q, w, fits.parse_free("rx,ry"), c)
+
+            def cost(xy):
+                R = tf.rotation_from_vector([xy[0], xy[1], 0.0])
+                return w @ np.sum((q - c - (p - c) @ R.T) ** 2, axis=1)
+            best = minimize(cost, np.zeros(2), method="BFGS", options={"gtol": 1e-10}).x
+            np.testing.assert_allclose(result.twist[3:5], best, atol=1e-7)
+            self.assertTrue(np.all(result.twist[[0, 1, 2, 5]] == 0.0))
+
     def test_rotations_locked_is_the_weighted_mean_shift(self):
         rng = np.random.default_rng(13)
         for _ in range(10):
