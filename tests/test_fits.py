@@ -158,6 +158,27 @@ class LockedLeastSquares(unittest.TestCase):
             np.testing.assert_allclose(result.twist[3:5], best, atol=1e-7)
             self.assertTrue(np.all(result.twist[[0, 1, 2, 5]] == 0.0))
 
+    def test_in_plane_section_fit_is_2d_procrustes(self):
+        """Points in a plane, targets moved in the plane and off it: the in-plane fit is the
+        weighted 2D Kabsch solution and the points stay in their plane."""
+        rng = np.random.default_rng(17)
+        for _ in range(10):
+            frame = tf.random_rotation(rng)
+            u, v, normal = frame.T
+            uv = rng.uniform(-30.0, 30.0, (50, 2)) * [1.0, 0.2]
+            p = uv @ np.vstack([u, v]) + 7.0 * normal
+            angle = rng.uniform(-0.3, 0.3)
+            rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+            quv = uv @ rot.T + rng.uniform(-2, 2, 2) + rng.normal(0.0, 0.01, (50, 2))
+            q = quv @ np.vstack([u, v]) + (7.0 + rng.normal(0.0, 0.05, 50))[:, None] * normal
+            w = rng.uniform(0.5, 2.0, 50)
+            result = self.fit(p, q, w, fits.in_plane_free(normal, u + 0.3 * normal), None)
+            R2, t2 = kabsch(np.c_[uv, np.zeros(50)], np.c_[quv, np.zeros(50)], w)
+            moved = tf.apply_transform(result.transform, p)
+            expected = (np.c_[uv, np.zeros(50)] @ R2.T + t2)[:, :2]
+            np.testing.assert_allclose(moved @ np.vstack([u, v]).T, expected, atol=1e-9)
+            np.testing.assert_allclose(moved @ normal, 7.0, atol=1e-9)
+
     def test_rotations_locked_is_the_weighted_mean_shift(self):
         rng = np.random.default_rng(13)
         for _ in range(10):

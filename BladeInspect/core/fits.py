@@ -114,6 +114,19 @@ def free_dof(names=DOF_NAMES, axes=None, option="--free"):
     return FreeDOF(names, basis)
 
 
+def in_plane_free(normal, chord_dir):
+    """The three in-plane degrees of freedom of a section fit (2D, in the plane of unit normal
+    ``normal``): translations along the chord and across it, rotation about the normal (with
+    the fit's centre in the plane, a rotation in the plane). The other three stay exactly 0,
+    so the points never leave their plane."""
+    normal = np.asarray(normal, dtype=float)
+    chord = np.asarray(chord_dir, dtype=float)
+    chord = chord - (chord @ normal) / (normal @ normal) * normal
+    cross = np.cross(normal, chord)
+    return free_dof(("t_chord", "t_cross", "r_normal"),
+                    {"chord": chord, "cross": cross, "normal": normal}, option="section fit")
+
+
 def _known(axes):
     named = ", ".join("t_%s/r_%s" % (a, a) for a in sorted(axes))
     return ", ".join(DOF_NAMES) + (", " + named if named else "")
