@@ -422,6 +422,20 @@ class PlaneCases(unittest.TestCase):
             self.assertAlmostEqual(fit.twist[2], 0.5 * (b - a), delta=1e-9)
             self.assertEqual(fit.fits, a + b >= 0)
 
+    def test_minimax_leaves_what_the_plane_does_not_fix(self):
+        """All six free on a plane: the flatness zone over tz, rx, ry (against SLSQP on the
+        exact distance), and tx, ty, rz, which no point constrains, left at 0."""
+        rng = np.random.default_rng(32)
+        for _ in range(5):
+            xy = rng.uniform(-20.0, 20.0, (300, 2))
+            z = rng.normal(0.0, 0.002, 300) + 0.05 * (np.hypot(xy[:, 0] - 15, xy[:, 1]) < 4.0)
+            points = np.column_stack([xy, z + 1e-3 * xy[:, 0]])
+            mm = fits.minimax_fit(points, self.plane, np.eye(4), np.ones(300))
+            self.assertTrue(mm.converged)
+            self.assertTrue(np.all(np.abs(mm.twist[[0, 1, 5]]) < 1e-12))
+            best = -exact_epigraph(points, lambda x: x[:, 2], 0.0, 0.0, [2, 3, 4], mm.center)
+            self.assertLess(abs(mm.max_abs_deviation - best), 0.5 * UM)
+
     def test_bad_input(self):
         points = np.zeros((10, 3))
         with self.assertRaises(InputError):

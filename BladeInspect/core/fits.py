@@ -274,6 +274,7 @@ class FitOptions:
     gain_tol_mm: float = 1e-9     # Chebyshev: a predicted gain below this has converged
     exchange_rows: int = 50       # constraints added to the linear programme per exchange
     lp_tol_mm: float = 1e-10      # a constraint violated by less is satisfied
+    step_penalty: float = 1e-6    # margin (mm) traded per mm of step (see _max_min_step)
 
 
 @dataclass
@@ -364,18 +365,22 @@ def _max_min_step(J, distances, lower, upper, radius, options):
     """The step delta (|delta_j| <= radius) maximising min_i of the linearised slacks
     min(d_i + J_i delta - l_i, u_i - d_i - J_i delta), and that minimum.
 
-    Rows (delta, m):  -J_i delta + m <= d_i - l_i  and  J_i delta + m <= u_i - d_i.
+    Variables (delta+, delta-, m), delta = delta+ - delta-, rows
+        -J_i delta + m <= d_i - l_i   and   J_i delta + m <= u_i - d_i,
+    objective  -m + step_penalty * sum |delta|: where the optimum is not unique (a direction
+    no binding point constrains, e.g. a slide along a surface that does not fix it) the
+    smallest step is taken instead of an arbitrary corner of the trust box; the penalty costs
+    at most step_penalty * |delta| of margin.
     Solved on a working set of rows, starting from the most binding ones, adding the most
     violated rows of the rest until the step violates none.
     """
-    k = J.shape[1]
-    A = np.vstack([np.hstack([-J, np.ones((len(J), 1))]), np.hstack([J, np.ones((len(J), 1))])])
+    n, k = J.shape
+    ones = np.ones((n, 1))
+    A = np.vstack([np.hstack([-J, J, ones]), np.hstack([J, -J, ones])])
     b = np.concatenate([distances - lower, upper - distances])
-    order = np.argsort(b)
-    working = order[:max(options.exchange_rows, 4 * (k + 1))]
-    cost = np.zeros(k + 1)
-    cost[k] = -1.0
-    bounds = [(-radius, radius)] * k + [(None, None)]
+    working = np.argsort(b)[:max(options.exchange_rows, 4 * (k + 1))]
+    cost = np.r_[np.full(2 * k, options.step_penalty), -1.0]
+    bounds = [(0.0, radius)] * (2 * k) + [(None, None)]
     while True:
         solution = linprog(cost, A_ub=A[working], b_ub=b[working], bounds=bounds,
                            method="highs-ds",
@@ -387,7 +392,7 @@ def _max_min_step(J, distances, lower, upper, radius, options):
         excess = A @ x - b
         violated = np.flatnonzero(excess > options.lp_tol_mm)
         if not len(violated):
-            return x[:k], x[k]
+            return x[:k] - x[k:2 * k], x[2 * k]
         worst = violated[np.argsort(-excess[violated])][:options.exchange_rows]
         working = np.union1d(working, worst)
 
