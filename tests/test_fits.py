@@ -100,7 +100,7 @@ class FreeAndZoneParsing(unittest.TestCase):
                 fits.parse_zone_weights(text, zones)
             self.assertIn(fragment, str(cm.exception))
         np.testing.assert_array_equal(
-            fits.zone_multipliers(np.array(["LE", "", "TE", "suction"], dtype=object),
+            fits.per_zone(np.array(["LE", "", "TE", "suction"], dtype=object),
                                   {"LE": 2.0, "suction": 0.0}), [2.0, 1.0, 1.0, 0.0])
 
 
@@ -196,7 +196,7 @@ class LockedLeastSquares(unittest.TestCase):
             p, q, w = correspondences(rng)
             zone = rng.choice(np.array(["LE", "TE", "suction", "pressure"], dtype=object),
                               len(p))
-            z = fits.zone_multipliers(zone, fits.parse_zone_weights("LE=3,TE=2,suction=0.5"))
+            z = fits.per_zone(zone, fits.parse_zone_weights("LE=3,TE=2,suction=0.5"))
             result = self.fit(p, q, w, None, None, multipliers=z)
             R, t = kabsch(p, q, w * z)
             np.testing.assert_allclose(result.transform[:3, :3], R, atol=1e-10)

@@ -21,7 +21,7 @@ Parametrisation (what a locked degree of freedom means)
 
 Objectives (d_i the signed deviation of inlier i at T(xi))
     least squares  min sum w_i z_i d_i^2, w_i the ICP's weights and z_i region (zone)
-                   multipliers (zone_multipliers), by Gauss-Newton.
+                   multipliers (per_zone), by Gauss-Newton.
     minimax        min max |d_i| (the Chebyshev or minimum-zone fit; unweighted: every inlier
                    must lie in the zone).
     tolerance      max min s_i with s_i = min(d_i - lower_i, upper_i - d_i) the slack of point i
@@ -146,7 +146,7 @@ def parse_free(text, axes=None, option="--free"):
 
 def parse_zone_weights(text, zones=None, option="--weights-by-zone"):
     """{zone: weight} of 'LE=2,TE=2,suction=1,pressure=1'. Weights are finite and >= 0 (0
-    leaves a zone out of the fit); a zone not named keeps weight 1 (zone_multipliers).
+    leaves a zone out of the fit); a zone not named keeps weight 1 (per_zone).
     ``zones``: the labels allowed (e.g. inspect.sections.ZONES), or None for any."""
     weights = {}
     for entry in str(text).split(","):
@@ -169,13 +169,14 @@ def parse_zone_weights(text, zones=None, option="--weights-by-zone"):
     return weights
 
 
-def zone_multipliers(labels, zone_weights, default=1.0):
-    """(N,) multiplier of each point from its zone label; labels not in ``zone_weights`` (and
-    points outside every zone) get ``default``."""
+def per_zone(labels, values, default=1.0):
+    """(N,) value of each point from its zone label: region weights (parse_zone_weights) or a
+    tolerance limit per zone; labels not in ``values`` (and points outside every zone, label
+    '') get ``default``."""
     labels = np.asarray(labels, dtype=object)
     out = np.full(len(labels), float(default))
-    for name, weight in zone_weights.items():
-        out[labels == name] = weight
+    for name, value in values.items():
+        out[labels == name] = value
     return out
 
 
@@ -320,7 +321,7 @@ def _result(problem, objective, theta, distances, J, multipliers, iterations, co
 def least_squares_fit(points, closest_fn, init, weights, free=None, multipliers=None,
                       center=None, options=None):
     """min sum w z d^2 over the free degrees of freedom (FreeDOF; None = all six), z the
-    region multipliers (zone_multipliers; None = 1). Gauss-Newton on the exact Jacobian,
+    region multipliers (per_zone; None = 1). Gauss-Newton on the exact Jacobian,
     halving a step that raises the objective."""
     options = options or FitOptions()
     problem = _Problem(points, closest_fn, init, weights, free, center)
