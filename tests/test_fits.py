@@ -321,6 +321,28 @@ class ChebyshevFits(unittest.TestCase):
             locked = [i for i in range(6) if i not in rows]
             self.assertTrue(np.all(mm.twist[locked] == 0.0))
 
+    def test_known_start_saves_an_evaluation(self):
+        rng = np.random.default_rng(23)
+        measured, truth = bumped_ellipsoid(rng, 300, 0.03, 0.002)
+        ls = self.least_squares(measured, truth, rng)
+        calls = []
+
+        def counted(points):
+            calls.append(len(points))
+            return ellipsoid_closest(points)
+        _, normals, distances = ellipsoid_closest(tf.apply_transform(ls.transform, measured))
+        w = np.ones(len(measured))
+        for fit in (fits.least_squares_fit, fits.minimax_fit):
+            plain = fit(measured, counted, ls.transform, w)
+            n_plain = len(calls)
+            known = fit(measured, counted, ls.transform, w, at_init=(distances, normals))
+            self.assertEqual(len(calls) - n_plain, n_plain - 1)
+            self.assertEqual(known.iterations, plain.iterations - 1)
+            np.testing.assert_allclose(known.transform, plain.transform, atol=1e-12)
+            del calls[:]
+        with self.assertRaises(InputError):
+            fits.minimax_fit(measured, counted, ls.transform, w, at_init=(distances[1:], normals))
+
     def test_tolerance_fit_passes_where_least_squares_fails(self):
         rng = np.random.default_rng(22)
         for _ in range(3):

@@ -236,13 +236,18 @@ class _Problem:
     def transform(self, theta):
         return pose_from_twist(self.init, self.center, self.twist(theta))
 
-    def evaluate(self, theta):
-        """(distances (N,), Jacobian (N, k) in scaled parameters, normals) at theta."""
+    def evaluate(self, theta, known=None):
+        """(distances (N,), Jacobian (N, k) in scaled parameters, normals) at theta; ``known``:
+        (distances, normals) already evaluated there, to save the closest-point call."""
         xi = self.twist(theta)
         R = rotation_from_vector(xi[3:])
         arm = (self.start - self.center) @ R.T        # R (x0 - c)
-        moved = self.center + arm + xi[:3]
-        _, normals, distances = self.closest_fn(moved)
+        if known is None:
+            _, normals, distances = self.closest_fn(self.center + arm + xi[:3])
+        else:
+            distances, normals = (np.asarray(a, dtype=float) for a in known)
+            if distances.shape != (len(arm),) or normals.shape != arm.shape:
+                raise InputError("fit: at_init must be (distances (N,), normals (N, 3))")
         J6 = np.hstack([normals, np.cross(arm, normals) @ left_jacobian(xi[3:])])
         return np.asarray(distances, dtype=float), J6 @ self.free.basis / self.scale, normals
 
@@ -289,7 +294,7 @@ class FitResult:
     center: np.ndarray            # (3,) CAD frame
     max_abs_deviation: float      # largest |d| of the inliers, mm
     rms: float                    # RMS of the inliers' d, mm
-    iterations: int
+    iterations: int               # closest-point evaluations
     converged: bool
     covariance: np.ndarray        # (6,6) about center (see the module docstring)
     covariance_kind: str
@@ -319,10 +324,12 @@ def _result(problem, objective, theta, distances, J, multipliers, iterations, co
 # ---------------------------------------------------------------- least squares
 
 def least_squares_fit(points, closest_fn, init, weights, free=None, multipliers=None,
-                      center=None, options=None):
+                      center=None, options=None, at_init=None):
     """min sum w z d^2 over the free degrees of freedom (FreeDOF; None = all six), z the
     region multipliers (per_zone; None = 1). Gauss-Newton on the exact Jacobian,
-    halving a step that raises the objective."""
+    halving a step that raises the objective. ``at_init``: (distances, normals) of the points
+    at ``init`` when the caller has them (ICPResult.distances and the normals), which saves a
+    closest-point evaluation; likewise for the other fits."""
     options = options or FitOptions()
     problem = _Problem(points, closest_fn, init, weights, free, center)
     z = (np.ones(len(problem.weights)) if multipliers is None
@@ -335,9 +342,9 @@ def least_squares_fit(points, closest_fn, init, weights, free=None, multipliers=
                          % (np.count_nonzero(w), problem.free.size))
     sw = np.sqrt(w[w > 0])
     theta = np.zeros(problem.free.size)
-    distances, J, _ = problem.evaluate(theta)
+    distances, J, _ = problem.evaluate(theta, at_init)
     cost = float(np.sum(w * distances ** 2))
-    iterations, converged = 1, False
+    iterations, converged = int(at_init is None), False
     while iterations < options.max_iter:
         step = np.linalg.lstsq(J[w > 0] * sw[:, None], -distances[w > 0] * sw, rcond=1e-12)[0]
         if np.abs(step).sum() < options.step_tol_mm:
@@ -398,16 +405,16 @@ def _max_min_step(J, distances, lower, upper, radius, options):
         working = np.union1d(working, worst)
 
 
-def _chebyshev_fit(problem, objective, lower, upper, options):
+def _chebyshev_fit(problem, objective, lower, upper, options, at_init):
     keep = problem.inlier
     lo, hi = lower[keep], upper[keep]
     theta = np.zeros(problem.free.size)
-    distances, J, _ = problem.evaluate(theta)
+    distances, J, _ = problem.evaluate(theta, at_init)
     margin = float(np.min(_slack(distances[keep], lo, hi)))
     # Trust box (mm at the points' extremes): the fit's moves are of the size of the
     # deviations themselves.
     radius = max(float(np.max(np.abs(distances[keep]))), 1e3 * options.step_tol_mm)
-    iterations, converged = 1, False
+    iterations, converged = int(at_init is None), False
     while iterations < options.max_iter:
         step, predicted = _max_min_step(J[keep], distances[keep], lo, hi, radius, options)
         gain = predicted - margin
@@ -430,15 +437,16 @@ def _chebyshev_fit(problem, objective, lower, upper, options):
                    margin if objective == "tolerance" else None)
 
 
-def minimax_fit(points, closest_fn, init, weights, free=None, center=None, options=None):
+def minimax_fit(points, closest_fn, init, weights, free=None, center=None, options=None,
+                at_init=None):
     """min over the free degrees of freedom of max |d| of the inliers (weight > 0)."""
     problem = _Problem(points, closest_fn, init, weights, free, center)
     zero = np.zeros(len(problem.weights))
-    return _chebyshev_fit(problem, "minimax", zero, zero, options or FitOptions())
+    return _chebyshev_fit(problem, "minimax", zero, zero, options or FitOptions(), at_init)
 
 
 def tolerance_fit(points, closest_fn, init, weights, lower, upper, free=None, center=None,
-                  options=None):
+                  options=None, at_init=None):
     """The pose of the largest margin in the tolerance zones [lower_i, upper_i] (mm, one per
     point or one for all), or of the least largest violation when none fits (module
     docstring); FitResult.margin, .fits and .violation say which."""
@@ -451,4 +459,4 @@ def tolerance_fit(points, closest_fn, init, weights, lower, upper, free=None, ce
         raise InputError("fit: every judged point needs a finite lower and upper tolerance")
     if np.any(lower[keep] > upper[keep]):
         raise InputError("fit: a tolerance zone has its lower limit above its upper limit")
-    return _chebyshev_fit(problem, "tolerance", lower, upper, options or FitOptions())
+    return _chebyshev_fit(problem, "tolerance", lower, upper, options or FitOptions(), at_init)
