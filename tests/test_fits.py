@@ -458,6 +458,29 @@ class PlaneCases(unittest.TestCase):
             best = -exact_epigraph(points, lambda x: x[:, 2], 0.0, 0.0, [2, 3, 4], mm.center)
             self.assertLess(abs(mm.max_abs_deviation - best), 0.5 * UM)
 
+    def test_dispatch_and_json(self):
+        import json
+        rng = np.random.default_rng(33)
+        points = np.column_stack([rng.uniform(-5, 5, (50, 2)), rng.normal(0, 0.01, 50)])
+        w = np.ones(50)
+        free = fits.parse_free("tz,rx,ry")
+        direct = fits.tolerance_fit(points, self.plane, np.eye(4), w, -0.02, 0.03, free=free)
+        named = fits.fit("tolerance", points, self.plane, np.eye(4), w, free=free,
+                         lower=-0.02, upper=0.03)
+        np.testing.assert_array_equal(direct.transform, named.transform)
+        record = json.loads(json.dumps(named.to_json(), allow_nan=False))
+        self.assertEqual(record["free"], ["tz", "rx", "ry"])
+        self.assertEqual(record["fits"], named.fits)
+        self.assertEqual(record["covariance"][0][0], 0.0)     # tx locked
+        for kwargs, fragment in ((dict(objective="chebyshev"), "unknown objective"),
+                                 (dict(objective="minimax", multipliers=w), "least-squares"),
+                                 (dict(objective="tolerance"), "needed"),
+                                 (dict(objective="minimax", lower=0, upper=1), "only")):
+            with self.assertRaises(InputError) as cm:
+                fits.fit(points=points, closest_fn=self.plane, init=np.eye(4), weights=w,
+                         **kwargs)
+            self.assertIn(fragment, str(cm.exception))
+
     def test_bad_input(self):
         points = np.zeros((10, 3))
         with self.assertRaises(InputError):

@@ -306,6 +306,21 @@ class FitResult:
         """Tolerance fit: the largest violation of the best pose (0 when it fits), mm."""
         return None if self.margin is None else max(0.0, -self.margin)
 
+    def to_json(self):
+        """The fit as result.json records it (plain lists and numbers; infinities as None)."""
+        def plain(a):
+            return [None if not np.isfinite(v) else float(v) for v in np.ravel(a)]
+        return {"objective": self.objective, "free": list(self.free),
+                "measured_to_cad": np.asarray(self.transform).tolist(),
+                "center_mm": plain(self.center),
+                "twist": {"t_mm": plain(self.twist[:3]), "w_rad": plain(self.twist[3:])},
+                "max_abs_deviation_mm": self.max_abs_deviation, "rms_mm": self.rms,
+                "n_inliers": int(np.count_nonzero(self.inlier)),
+                "iterations": self.iterations, "converged": self.converged,
+                "covariance": np.reshape(plain(self.covariance), (6, 6)).tolist(),
+                "covariance_kind": self.covariance_kind, "margin_mm": self.margin,
+                "fits": self.fits, "violation_mm": self.violation}
+
 
 def _result(problem, objective, theta, distances, J, multipliers, iterations, converged,
             kind, margin=None):
@@ -460,3 +475,25 @@ def tolerance_fit(points, closest_fn, init, weights, lower, upper, free=None, ce
     if np.any(lower[keep] > upper[keep]):
         raise InputError("fit: a tolerance zone has its lower limit above its upper limit")
     return _chebyshev_fit(problem, "tolerance", lower, upper, options or FitOptions(), at_init)
+
+
+def fit(objective, points, closest_fn, init, weights, free=None, center=None, multipliers=None,
+        lower=None, upper=None, options=None, at_init=None):
+    """The fit named by ``objective`` (one of OBJECTIVES, as ``--fit`` names it); region
+    multipliers belong to least squares, tolerance zones to the tolerance fit."""
+    if objective not in OBJECTIVES:
+        raise InputError("--fit: unknown objective '%s' (use %s)"
+                         % (objective, ", ".join(OBJECTIVES)))
+    if multipliers is not None and objective != "least-squares":
+        raise InputError("--weights-by-zone: region weights apply to the least-squares fit "
+                         "only, not to %s" % objective)
+    if (lower is None or upper is None) == (objective == "tolerance"):
+        raise InputError("--fit %s: tolerance zones are %s" % (
+            objective, "needed" if objective == "tolerance" else "for --fit tolerance only"))
+    common = dict(free=free, center=center, options=options, at_init=at_init)
+    if objective == "least-squares":
+        return least_squares_fit(points, closest_fn, init, weights, multipliers=multipliers,
+                                 **common)
+    if objective == "minimax":
+        return minimax_fit(points, closest_fn, init, weights, **common)
+    return tolerance_fit(points, closest_fn, init, weights, lower, upper, **common)
