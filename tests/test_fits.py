@@ -458,6 +458,19 @@ class PlaneCases(unittest.TestCase):
             best = -exact_epigraph(points, lambda x: x[:, 2], 0.0, 0.0, [2, 3, 4], mm.center)
             self.assertLess(abs(mm.max_abs_deviation - best), 0.5 * UM)
 
+    def test_a_wrong_gradient_is_not_reported_as_converged(self):
+        """Normals opposite to the distance's gradient: every predicted gain is a loss; the
+        fit keeps the start and says it did not converge."""
+        rng = np.random.default_rng(34)
+        points = np.column_stack([rng.uniform(-5, 5, (50, 2)), rng.normal(0.01, 0.01, 50)])
+
+        def wrong(p):
+            closest, normals, d = self.plane(p)
+            return closest, -normals, d
+        mm = fits.minimax_fit(points, wrong, np.eye(4), np.ones(50), free=fits.parse_free("tz"))
+        self.assertFalse(mm.converged)
+        self.assertAlmostEqual(mm.max_abs_deviation, np.max(np.abs(points[:, 2])), delta=1e-15)
+
     def test_dispatch_and_json(self):
         import json
         rng = np.random.default_rng(33)

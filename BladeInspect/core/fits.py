@@ -447,6 +447,8 @@ def _chebyshev_fit(problem, objective, lower, upper, options, at_init):
                 radius *= 2.0
         if ratio < 0.25:
             radius = 0.25 * float(np.max(np.abs(step)))
+            if radius < options.step_tol_mm:
+                break   # the linearisation predicts a gain no small step delivers: stalled
     return _result(problem, objective, theta, distances, J, np.ones(len(distances)),
                    iterations, converged, COVARIANCE_OF_LEAST_SQUARES,
                    margin if objective == "tolerance" else None)
