@@ -1,6 +1,6 @@
 """Fit objectives (core.fits): agreement with independent solutions and time per fit.
 
-    scripts/fcpython bench/bench_fits.py [--points 20000] [--trials 3] [--no-demo]
+    scripts/fcpython bench/bench_fits.py [--points 20000] [--trials 2] [--no-demo]
 
 1. A triaxial ellipsoid patch (blade-sized axes, exact closest points by Newton) with a 30 um
    bump and 2 um noise, every point judged: least squares with DOFs locked from a perturbed
@@ -8,7 +8,8 @@
    two optima, and a zone too tight to fit) and minimax with DOFs locked. Minimax against the
    iterated full linear programme of tests/test_fits.py (every point, HiGHS interior point).
 2. The demo blade (exact OCC-backed distance): the paper's simulated scan (uniform +-6 um,
-   2 % gross outliers), registered by the pipeline's ICP from near the truth; the fits on its inliers and weights.
+   2 % gross outliers), registered by the pipeline's ICP from near the truth; the fits on
+   its inliers and weights, all sharing one closest-point evaluation at the ICP pose.
 """
 import argparse
 import time
