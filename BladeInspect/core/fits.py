@@ -14,9 +14,10 @@ Parametrisation (what a locked degree of freedom means)
     rotation vector (rad, R(w) its exponential) about the fixed centre c (``center``; by
     default the weighted centroid of the inliers at T0, in the CAD frame). xi = B theta with B
     the (6, k) basis of the free degrees of freedom (FreeDOF) and theta the k fitted
-    parameters. The components of xi outside the free ones are exactly 0 (not small: B's
-    rows for them are zero), so a locked translation keeps the point c where T0 put it and a
-    locked rotation keeps the part's attitude about c. A rotation about a line (the engine axis)
+    parameters. With the CAD-axis names (tx ... rz) the components of xi outside the free ones
+    are exactly 0 (not small: B's rows for them are zero), so a locked translation keeps the
+    point c where T0 put it and a locked rotation keeps the part's attitude about c; with a
+    named direction (r_<axis>, t_<axis>) xi lies exactly in the span of the free directions. A rotation about a line (the engine axis)
     is a rotation about a direction with ``center`` on that line.
 
 Objectives (d_i the signed deviation of inlier i at T(xi))
@@ -117,8 +118,8 @@ def free_dof(names=DOF_NAMES, axes=None, option="--free"):
 def in_plane_free(normal, chord_dir):
     """The three in-plane degrees of freedom of a section fit (2D, in the plane of unit normal
     ``normal``): translations along the chord and across it, rotation about the normal (with
-    the fit's centre in the plane, a rotation in the plane). The other three stay exactly 0,
-    so the points never leave their plane."""
+    the fit's centre in the plane, a rotation in the plane). The twist stays in their span,
+    so the points stay in their plane."""
     normal = np.asarray(normal, dtype=float)
     chord = np.asarray(chord_dir, dtype=float)
     chord = chord - (chord @ normal) / (normal @ normal) * normal
