@@ -372,6 +372,15 @@ class ChebyshevFits(unittest.TestCase):
             self.assertGreater(fit.violation, 0.0)
             self.assertLess(abs(fit.margin - best), 0.5 * UM)
 
+            # The same with only tx, ty, rz free.
+            free = fits.parse_free("tx,ty,rz")
+            fit = fits.tolerance_fit(measured, ellipsoid_closest, ls.transform,
+                                     np.ones(len(measured)), lower, upper, free=free)
+            best = exact_epigraph(start, ellipsoid_distance, lower, upper, [0, 1, 5],
+                                  fit.center)
+            self.assertLess(abs(fit.margin - best), 0.5 * UM)
+            self.assertTrue(np.all(fit.twist[[2, 3, 4]] == 0.0))
+
 
 class DemoBlade(unittest.TestCase):
     """The demo blade's exact CAD distance (OCC-backed), a scan-like cloud on its suction and
