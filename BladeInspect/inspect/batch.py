@@ -79,13 +79,13 @@ def _read_done(folder):
         return None     # unreadable: the file is simply done again
 
 
-def report_one(cad_path, points_path, folder, tolerance, seed):
+def report_one(cad_path, points_path, folder, tolerance, seed, allow_mismatch=False):
     """One file of the lot, in whichever process runs it: a summary row, never an exception."""
     from .report import run_report
     name = os.path.basename(points_path)
     try:
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
-                   nominal=_nominal_for(cad_path))
+                   nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -129,12 +129,13 @@ def _csv_value(v):
 
 
 def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
-              tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None):
+              tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None,
+              allow_mismatch=False):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
-    'message': one line for the command line}."""
+    'message': one line for the command line}. ``allow_mismatch``: as for `report`."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
@@ -163,9 +164,9 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
 
     t0 = time.perf_counter()
     if todo and scheduler:
-        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished)
+        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch)
     elif todo:
-        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished)
+        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
     count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)
@@ -178,24 +179,24 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     return {"rows": ordered, "summary_csv": summary_path, "message": message}
 
 
-def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished):
+def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch):
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
     if workers == 1 or len(todo) == 1:
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
-                                      seed))
+                                      seed, allow_mismatch))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                               tolerance, seed): stem for stem, path in todo}
+                               tolerance, seed, allow_mismatch): stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
-def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished):
+def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch):
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -210,7 +211,7 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished):
         stems, futures = {}, []
         for stem, path in todo:
             fut = client.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                                tolerance, seed, pure=False)
+                                tolerance, seed, allow_mismatch, pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):

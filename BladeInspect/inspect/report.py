@@ -523,12 +523,16 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
                seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
-               nominal=None, document=True):
+               nominal=None, document=True, allow_mismatch=False):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
     made in a private folder beside out_dir and moved in only when every one is complete.
-    ``nominal`` skips loading the CAD (a batch loads it once). Returns a summary dict."""
+    ``nominal`` skips loading the CAD (a batch loads it once). ``allow_mismatch``: write the
+    result of a scan that does not fit the CAD, with the warning (pipeline.register).
+    Returns a summary dict."""
     from . import pipeline
+    from .checks import check_out_dir
+    check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not np.isfinite(tolerance) or tolerance <= 0:
@@ -543,7 +547,9 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
     timing["load_points"] = time.perf_counter() - t0
     result = pipeline.register(nominal, points, seed=seed,
-                               progress=lambda f, m: progress(0.8 * f, m))
+                               progress=lambda f, m: progress(0.8 * f, m),
+                               allow_mismatch=allow_mismatch, tolerance=tolerance,
+                               cad_source=cad_path or "the demo blade")
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
 

@@ -29,6 +29,8 @@ class RegistrationResult:
     warnings: list = field(default_factory=list)
     source: str = ""
     cad_source: str = ""
+    pose_unmeasured: list = field(default_factory=list)   # inspect.checks.describe_unmeasured
+    surface_fit: Optional[dict] = None                     # inspect.checks.surface_fit
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
