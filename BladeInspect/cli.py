@@ -158,7 +158,8 @@ def build_parser():
     return p
 
 
-def _print_result(result, out_dir, stream=sys.stdout):
+def _print_result(result, out_dir, stream=None):
+    stream = stream or sys.stdout   # looked up at the call, so a redirected stdout gets it
     stats = result.deviation_stats
     stream.write("registered %d points (%d inliers, %d rows skipped)\n"
                  % (result.n_points, result.n_inliers, result.n_rows_skipped))
