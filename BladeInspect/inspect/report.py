@@ -326,7 +326,12 @@ def pose_rows(result):
     T = np.asarray(result.measured_to_cad)
     cov = np.asarray(result.pose_covariance)
     sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-    return [
+    # The 1 sigma figures cover the measured directions only (inspect.checks).
+    unmeasured = [["Not measured by the points (not in the 1 sigma figures)",
+                   "; ".join(u["motion"].replace(" is not measured", "")
+                             for u in result.pose_unmeasured)]] \
+        if getattr(result, "pose_unmeasured", None) else []
+    return unmeasured + [
         ["Points (inliers)", "%d (%d)" % (result.n_points, result.n_inliers)],
         ["Rows skipped", "%d" % result.n_rows_skipped],
         ["Residual RMS of inliers", "%.4f mm" % result.rms_mm],
