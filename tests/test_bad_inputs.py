@@ -219,6 +219,29 @@ class TestTimeLimit(unittest.TestCase):
         self.assertIn("time limit", str(ctx.exception))
 
 
+    def test_a_spent_budget_ends_the_coarse_stage_with_a_message(self):
+        from unittest import mock
+        from BladeInspect.core.errors import InputError
+        from BladeInspect.inspect import pipeline
+        from BladeInspect.inspect.simulate import simulate_measurement
+        scan, _, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
+                                             section_heights=())
+        with mock.patch.object(pipeline, "COARSE_TIME_LIMIT_S", 0.0), \
+                self.assertRaises(InputError) as ctx:
+            pipeline.register(demo_nominal(), scan)
+        self.assertIn("coarse registration: stopped at its 0 s time limit", str(ctx.exception))
+
+    def test_icp_stops_at_its_time_limit(self):
+        from BladeInspect.core import icp
+        from BladeInspect.inspect.pipeline import exact_closest_fn
+        from BladeInspect.inspect.simulate import simulate_measurement
+        scan, truth, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
+                                                 section_heights=())
+        fit = icp.icp(scan.xyz, scan.snr, exact_closest_fn(demo_nominal()), truth,
+                      icp.ICPOptions(time_limit_s=0.0))
+        self.assertEqual((fit.stopped, fit.iterations, fit.converged), ("time limit", 0, False))
+
+
 class TestUnmeasuredDirections(unittest.TestCase):
     """core.icp.split_information on Fisher informations whose null directions are known in
     closed form: points on a cylinder (any cross-section) slide along its axis; on a circular

@@ -365,7 +365,8 @@ def icp(points, snr, closest_fn, init, options=None):
     stopped = ""
     started = time.monotonic()
     while iterations < options.max_iter:
-        if options.time_limit_s is not None and time.monotonic() - started > options.time_limit_s:
+        if options.time_limit_s is not None \
+                and time.monotonic() - started >= options.time_limit_s:
             stopped = "time limit"
             break
         moved = points @ T[:3, :3].T + T[:3, 3]

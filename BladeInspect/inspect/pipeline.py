@@ -42,6 +42,10 @@ SEARCH_MEDIAN_MM = 0.015
 SEARCH_ROUNDS = 4
 SEARCH_SHIFTS_MM = (-6.0, -3.0, 3.0, 6.0)
 SEARCH_TURNS_DEG = (-8.0, -4.0, 4.0, 8.0)
+# Wall-clock budget of the coarse stage, checked at each candidate and search step it reports:
+# its ICPs and search rounds are bounded in number, so this only ends a stage that a slow
+# distance (points far inside or off the CAD) would stretch to minutes. Half the fine stage's.
+COARSE_TIME_LIMIT_S = 60.0
 # Wall-clock budget of the fine stage: twelve times DESIGN.md's 10 s for the whole
 # registration of the paper's 269k-point cloud on two cores. A fit still iterating then is
 # lost (its points are not on this CAD), not slow; its iteration counts are bounded as well.
@@ -208,29 +212,46 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
                   time_limit_s=FINE_TIME_LIMIT_S):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
-    information (and its covariance is the whole cloud's)."""
+    information (and its covariance is the whole cloud's). Both runs together get
+    ``time_limit_s``; an InputError says so when it is spent."""
     rng = np.random.default_rng(1) if rng is None else rng
     closest = exact_closest_fn(nominal)
+    deadline = time.monotonic() + time_limit_s
+
+    def remaining():
+        return max(deadline - time.monotonic(), 0.0)
     T = init
     n = len(measured_xyz)
     if n > FINE_SUBSAMPLE:
         sub = _subsample(n, FINE_SUBSAMPLE, rng)
         progress(0.1, "fine registration on %d of %d points" % (len(sub), n))
         fit = icp_mod.icp(measured_xyz[sub], None if snr is None else snr[sub], closest, T,
-                          icp_mod.ICPOptions(time_limit_s=time_limit_s))
+                          icp_mod.ICPOptions(time_limit_s=remaining()))
         _check_time(fit, time_limit_s)
         T = fit.transform
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
                                      trans_tol=FULL_CLOUD_TOL_MM, rot_tol=FULL_CLOUD_TOL_RAD,
                                      linear_update_mm=FULL_CLOUD_TOL_MM,
                                      linear_update_rad=FULL_CLOUD_TOL_RAD,
-                                     time_limit_s=time_limit_s)
+                                     time_limit_s=remaining())
     else:
-        options = icp_mod.ICPOptions(time_limit_s=time_limit_s)
+        options = icp_mod.ICPOptions(time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
     fit = icp_mod.icp(measured_xyz, snr, closest, T, options)
     _check_time(fit, time_limit_s)
     return fit
+
+
+def _with_deadline(progress, limit_s, what):
+    """``progress`` that raises an InputError once ``limit_s`` has passed since it was made."""
+    deadline = time.monotonic() + limit_s
+
+    def report(fraction, message):
+        if time.monotonic() > deadline:
+            raise InputError("%s: stopped at its %g s time limit (%s) - the points do not "
+                             "settle on this CAD" % (what, limit_s, message))
+        progress(fraction, message)
+    return report
 
 
 def _check_time(fit, time_limit_s):
@@ -279,7 +300,10 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
 
     t0 = time.perf_counter()
     coarse = coarse_register(xyz, snr, nominal, pca_points=pca_points, rng=rng,
-                             progress=lambda f, m: progress(0.05 + 0.25 * f, m))
+                             progress=_with_deadline(
+                                 lambda f, m: progress(0.05 + 0.25 * f, m),
+                                 COARSE_TIME_LIMIT_S, "%s: against %s: coarse registration"
+                                 % (source, cad_label)))
     timing["coarse"] = time.perf_counter() - t0
     if coarse["warning"]:
         warnings.append(coarse["warning"])
