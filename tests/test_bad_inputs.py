@@ -314,6 +314,18 @@ class TestUnmeasuredDirections(unittest.TestCase):
         words = describe_unmeasured(split, SimpleNamespace(samples=samples, roles={}))
         self.assertEqual([w["motion"] for w in words],
                          ["position along the span is not measured"])
+        # A circular one turns about its axis as well, whose line is off the centre here.
+        points, normals = self.cylinder(15.0, 15.0, seed=1)
+        H, icp = self.information(points, normals, points[:200].mean(axis=0))
+        split = icp.split_information(H, 1e-5, 80.0, len(points))
+        samples = SimpleNamespace(xyz=points, weight=np.ones(len(points)),
+                                  face=np.zeros(len(points), int))
+        words = describe_unmeasured(split, SimpleNamespace(samples=samples, roles={}))
+        self.assertEqual([w["motion"] for w in words],
+                         ["position along the span is not measured",
+                          "rotation about the span axis is not measured"])
+        for w in words:
+            self.assertGreater(abs(w["direction"][2]), 0.999)
 
 
 class TestPrismSectionsThroughTheCommandLine(unittest.TestCase):

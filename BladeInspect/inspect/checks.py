@@ -190,13 +190,13 @@ def describe_unmeasured(split, nominal):
     U = split.unmeasured                      # (6, k), y = [t mm, length * w]
     named = part_axes(nominal)
     out = []
-    # Rotational content: the directions of w the subspace contains.
-    A, s, _ = np.linalg.svd(U[3:], full_matrices=False)
-    rot = A[:, s > _ROTATION_CONTENT_TOL]
-    # Pure translations: the combinations whose rotation part vanishes.
-    _, s_all, Vt = np.linalg.svd(U[3:])
-    rank = int(np.count_nonzero(s_all > _ROTATION_CONTENT_TOL))
-    trans = U[:3] @ Vt[rank:].T if rank < U.shape[1] else np.zeros((3, 0))
+    # The rotation parts' singular vectors: the axis directions the subspace turns about
+    # (with whatever shift puts the axis where it is), and the combinations of its basis whose
+    # rotation part vanishes, its pure translations.
+    A, s, Vt = np.linalg.svd(U[3:])
+    rank = int(np.count_nonzero(s > _ROTATION_CONTENT_TOL))
+    rot = A[:, :rank]
+    trans = U[:3] @ Vt[rank:].T
     if trans.shape[1]:
         trans = np.linalg.qr(trans)[0]
     for kind, basis in (("translation", trans), ("rotation", rot)):
