@@ -167,7 +167,7 @@ class TestAnotherBlade(BadInputCase):
         from BladeInspect.inspect.simulate import simulate_measurement
         other = make_demo_blade(BladeParams(twist_deg=40.0, camber_root=0.11, chord_root=46.0))
         cls.other_nominal = nominal_from_shape(other.shape, roles=other.roles)
-        scan, _, _, _ = simulate_measurement(cls.other_nominal, n_points=800, seed=4,
+        scan, _, _, _ = simulate_measurement(cls.other_nominal, n_points=300, seed=4,
                                              section_heights=())
         cls.other = write_csv(os.path.join(cls.tmp, "other_blade.csv"), scan.xyz, scan.snr)
 
@@ -193,6 +193,9 @@ class TestAnotherBlade(BadInputCase):
         distance = result["surface_fit"]["distance_mm"]
         self.assertAlmostEqual(result["surface_fit"]["fraction_within"],
                                np.mean(np.abs(dev) <= distance), places=3)
+
+    def test_report_refuses_it(self):
+        self.assert_refused(self.other, "does not fit %s" % self.cad, command="report")
 
     def test_the_right_scan_fits(self):
         out = os.path.join(self.out_dir(), "good")
