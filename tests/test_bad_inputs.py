@@ -131,7 +131,9 @@ class TestRefusedFiles(BadInputCase):
         normal = np.array([0.0, 0.6, 0.8])
         a = np.array([1.0, 0.0, 0.0])
         b = np.cross(normal, a)
+        # A flat patch as the sensor measures it: its noise across the plane.
         xyz = (rng.uniform(-25, 25, (500, 1)) * a + rng.uniform(-10, 10, (500, 1)) * b
+               + rng.uniform(-SENSOR_ACCURACY_MM, SENSOR_ACCURACY_MM, (500, 1)) * normal
                + [0.0, 3.0, 30.0])
         path = write_csv(os.path.join(self.tmp, "plane.csv"), xyz)
         line = self.assert_refused(path, "one plane", "translation along that normal")

@@ -4,7 +4,7 @@ A metrology result must be right or say it cannot be trusted, so a registration 
 with one line naming the file and the problem, when
 
 * the points are too degenerate to fix a pose (one point, a line, a plane: their spread has
-  fewer than three directions above the sensor's noise) - checked before any fitting;
+  fewer than three directions above the sensor's accuracy) - checked before any fitting;
 * the cloud's size does not match the CAD's (a scan in metres, inches, micrometres) - checked
   before any fitting, with the factor found;
 * the scan does not fit the CAD after the best candidate (another blade's scan): fewer than
@@ -26,11 +26,10 @@ from ..core import pca as pca_mod
 from ..rig.sensor import SensorModel
 from .verdict import DEFAULT_TOLERANCE
 
-# The sensor's error bound at the reference SNR (DESIGN.md: accuracy < 6 um). Its standard
-# deviation (uniform error on +-accuracy) is the smallest spread that carries information:
-# a cloud thinner than that in some direction has no extent there, only noise.
+# The sensor's error bound at the reference SNR (DESIGN.md: accuracy < 6 um). A cloud whose
+# spread (standard deviation) in some direction is within it has no extent there, only noise:
+# noise of that bound spreads a flat patch by 3.5 um (uniform) or 2 um (clipped normal).
 SENSOR_ACCURACY_MM = SensorModel().accuracy
-SENSOR_NOISE_SD_MM = SENSOR_ACCURACY_MM / np.sqrt(3.0)
 
 # Unit factors a scan in the wrong unit shows as its extent over the CAD's. Each is judged
 # within a factor UNIT_BAND either side, half the (logarithmic) distance between the two
@@ -67,7 +66,7 @@ def check_out_dir(out_dir):
 
 
 def check_spread(xyz, source, coincide_only=False):
-    """Refuse a cloud whose spread has fewer than three directions above the sensor's noise:
+    """Refuse a cloud whose spread has fewer than three directions above the sensor's accuracy:
     one point, a line or a plane cannot fix a rigid pose against any CAD, and the message
     names the motions it leaves free. ``coincide_only``: the single-point test alone (which
     the unit check must come after, a point having no size; the line and plane tests are in
@@ -76,10 +75,10 @@ def check_spread(xyz, source, coincide_only=False):
     values, vectors = np.linalg.eigh(centred.T @ centred / len(xyz))
     spread = np.sqrt(np.maximum(values[::-1], 0.0))
     vectors = vectors[:, ::-1]
-    thin = spread <= SENSOR_NOISE_SD_MM
+    thin = spread <= SENSOR_ACCURACY_MM
     if not thin.any():
         return
-    noise = "the sensor's noise, %.1f um" % (1e3 * SENSOR_NOISE_SD_MM)
+    noise = "the sensor's accuracy, %.3g um" % (1e3 * SENSOR_ACCURACY_MM)
     if thin[0]:
         raise InputError(
             "%s: all %d points coincide (spread %.3g mm, below %s): a single point cannot fix "
