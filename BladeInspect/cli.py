@@ -75,6 +75,11 @@ class Parser(argparse.ArgumentParser):
         raise InputError(message)
 
 
+ALLOW_MISMATCH_HELP = ("write the result even when the scan does not fit the CAD (fewer than "
+                       "half of its points within the tolerance plus the sensor's accuracy of "
+                       "the surface), with the warning in result.json")
+
+
 def build_parser():
     p = Parser(prog="bladeinspect", description="Register turbine blade scans to their CAD "
                "and report the deviations.")
@@ -91,6 +96,7 @@ def build_parser():
     r.add_argument("--out", required=True)
     r.add_argument("--seed", type=_seed, default=0)
     r.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
+    r.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
 
     s = sub.add_parser("simulate", help="the paper's simulation test bed (4.1)")
     s.add_argument("--cad", default=None, help="CAD file (default: the built-in demo blade)")
@@ -129,6 +135,7 @@ def build_parser():
                     help="section planes in %% of span (default 10,30,50,70,90)")
     rp.add_argument("--seed", type=_seed, default=0)
     rp.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
+    rp.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
 
     b = sub.add_parser("batch", help="inspect every point file of a production lot")
     b.add_argument("--cad", required=True)
@@ -137,6 +144,7 @@ def build_parser():
     b.add_argument("--tolerance", type=float, default=0.04)
     b.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     b.add_argument("--scheduler", default=None, help="Dask scheduler tcp://HOST:PORT")
+    b.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
 
     i = sub.add_parser("inspect", help="blind scan, register, CAD-planned scan, report")
     i.add_argument("--cad", default=None)
@@ -153,6 +161,7 @@ def build_parser():
                    help="continue an inspection in DIR interrupted by a rig failure, from its "
                         "last complete section (same CAD, seed and options)")
     i.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
+    i.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
 
     c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
     c.add_argument("--out", required=True, help="RIG.json to write")
@@ -167,19 +176,23 @@ def build_parser():
     return p
 
 
-def _print_result(result, out_dir, stream=sys.stdout):
+def _print_result(result, out_dir, stream=None):
+    stream = stream or sys.stdout   # looked up at the call, so a redirected stdout gets it
     stats = result.deviation_stats
     stream.write("registered %d points (%d inliers, %d rows skipped)\n"
                  % (result.n_points, result.n_inliers, result.n_rows_skipped))
     stream.write("  residual RMS %.4f mm, deviations %.4f .. %.4f mm\n"
                  % (result.rms_mm, stats["min"], stats["max"]))
-    stream.write("  pose uncertainty (1 sigma, worst bounding-box corner) %.2f um\n"
-                 % (result.pose_uncertainty_mm * 1000.0))
-    if result.coarse.get("warning"):
-        stream.write("  warning: %s\n" % result.coarse["warning"])
+    unmeasured = getattr(result, "pose_unmeasured", None) or []
+    stream.write("  pose uncertainty (1 sigma, worst bounding-box corner) %.2f um%s\n"
+                 % (result.pose_uncertainty_mm * 1000.0,
+                    " in the measured directions" if unmeasured else ""))
+    for direction in unmeasured:
+        stream.write("  %s\n" % direction["motion"])
     for warning in result.warnings:
-        if warning != result.coarse.get("warning"):
-            stream.write("  warning: %s\n" % warning)
+        stream.write("  warning: %s\n" % warning)
+    if result.coarse.get("warning") and result.coarse["warning"] not in result.warnings:
+        stream.write("  warning: %s\n" % result.coarse["warning"])
     stream.write("  timing: %s\n" % ", ".join("%s %.2f s" % kv for kv in result.timing_s.items()))
     stream.write("results in %s\n" % os.path.abspath(out_dir))
 
@@ -187,7 +200,7 @@ def _print_result(result, out_dir, stream=sys.stdout):
 def cmd_register(args):
     from .inspect.pipeline import run_register
     result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress(),
-                          flip_faces=args.flip_face)
+                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch)
     _print_result(result, args.out)
 
 
@@ -263,7 +276,8 @@ def cmd_report(args, cad=None, points=None):
         options["heights_pct"] = args.section_heights
     summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
                          tolerance=args.tolerance, seed=args.seed, progress=Progress(),
-                         flip_faces=args.flip_face, **options)
+                         flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
+                         **options)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -271,7 +285,8 @@ def cmd_report(args, cad=None, points=None):
 def cmd_batch(args):
     from .inspect.batch import run_batch
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
-                        scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress())
+                        scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
+                        allow_mismatch=args.allow_mismatch)
     sys.stdout.write("%s\n" % summary["message"])
 
 
@@ -281,7 +296,8 @@ def cmd_inspect(args):
                           section_heights=args.section_heights, complete=args.complete,
                           pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
                           seed=args.seed, rig_file=args.rig_file, progress=Progress(),
-                          resume=args.resume, flip_faces=args.flip_face)
+                          resume=args.resume, flip_faces=args.flip_face,
+                          allow_mismatch=args.allow_mismatch)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -314,10 +330,17 @@ COMMANDS = {"demo": cmd_demo, "register": cmd_register, "simulate": cmd_simulate
             "inspect": cmd_inspect, "calibrate": cmd_calibrate}
 
 
+# Commands whose --out is a folder (calibrate's is the RIG.json file itself).
+OUT_FOLDER_COMMANDS = ("demo", "register", "simulate", "scan", "report", "batch", "inspect")
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         args = build_parser().parse_args(argv)
+        if args.command in OUT_FOLDER_COMMANDS:
+            from .inspect.checks import check_out_dir
+            check_out_dir(args.out)
         COMMANDS[args.command](args)
     except (InputError, DeviceError) as exc:
         sys.stderr.write("bladeinspect: error: %s\n" % exc)

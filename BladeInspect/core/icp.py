@@ -26,6 +26,7 @@ the exact distance is the normal, the Gauss-Newton fixed point is a stationary p
 exact objective above, not of a surrogate.
 """
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,9 @@ class ICPOptions:
     # taper band, converge linearly and slowly; iterating on moves the pose by nothing that
     # matters against its uncertainty.
     uncertainty_fraction: float = 0.01
+    # Wall-clock budget, s (None: none): iterations stop once it is spent, with
+    # ICPResult.stopped saying so, so a fit that is lost ends instead of running for minutes.
+    time_limit_s: float = None
 
 
 @dataclass
@@ -71,6 +75,8 @@ class ICPResult:
     converged: bool
     covariance: np.ndarray      # (6,6) [translation mm, rotation rad] about `center`
     center: np.ndarray          # (3,) weighted centroid of the points in the CAD frame
+    split: "PoseSplit" = None   # the covariance of the measured directions, and the others
+    stopped: str = ""           # why the iterations ended early: "time limit" or ""
 
 
 def horn(target, source, weights=None):
@@ -222,6 +228,76 @@ def _jacobian(points_cad, normals, center):
     return np.hstack([normals, np.cross(points_cad - center, normals)])
 
 
+def pose_information(points_cad, normals, weights, residuals, center):
+    """(H, s^2, n_w): the pose's Fisher information H = sum w_i J_i^T J_i,
+    J_i = [n_i, (p_i - c) x n_i], the unit-weight residual variance
+    s^2 = sum w_i r_i^2 / (n_w - 6), and n_w, the number of points with w_i > 0
+    (H None when n_w <= 6: too few points for any covariance)."""
+    w = np.asarray(weights, dtype=float)
+    r = np.asarray(residuals, dtype=float)
+    keep = w > 0
+    n_w = int(np.count_nonzero(keep))
+    if n_w <= 6:
+        return None, np.inf, n_w
+    J = _jacobian(np.asarray(points_cad)[keep], np.asarray(normals)[keep], center)
+    H = (J * w[keep, None]).T @ J
+    return H, float(np.sum(w[keep] * r[keep] ** 2)) / (n_w - 6), n_w
+
+
+@dataclass
+class PoseSplit:
+    """The pose's covariance split into the directions the points measure and those they do
+    not (see split_information). Motions are (translation mm, rotation rad) about the
+    covariance's centre, in the CAD frame."""
+    covariance: np.ndarray   # (6,6) covariance of the measured directions (0 in the others)
+    unmeasured: np.ndarray   # (6,k) orthonormal basis of the unmeasured directions in
+    #                          (translation mm, rotation rad * length) units
+    length: float            # mm: the points' extent, the scale of rotations and the threshold
+    eigenvalues: np.ndarray  # (6,) of the scaled information, ascending
+
+    @property
+    def complete(self):
+        return self.unmeasured.shape[1] == 0
+
+
+def split_information(H, s2, length, n_terms):
+    """Eigen-decomposition of the Fisher information H with rotations scaled by ``length``
+    (y = [t, length * w], so every coordinate is a displacement in mm at the points' extent).
+
+    A direction of eigenvalue lambda has a 1 sigma of sqrt(s^2 / lambda) mm. It is unmeasured
+    when that exceeds ``length`` itself - the points cannot place the part even to within its
+    own size, so the linearised covariance says nothing there - or when lambda is below the
+    rounding of the sum that built H (n_terms * eps * lambda_max; this is what an exact
+    symmetry gives, and what catches it when s^2 = 0, noiseless data). The covariance is the
+    inverse restricted to the measured eigen-directions (a pseudo-inverse); it equals
+    s^2 H^-1 when every direction is measured."""
+    length = float(length)
+    scale = np.r_[np.ones(3), np.full(3, length)]
+    Hy = H / np.outer(scale, scale)
+    values, vectors = np.linalg.eigh(Hy)
+    floor = max(s2 / length ** 2 if np.isfinite(s2) else 0.0,
+                n_terms * np.finfo(float).eps * max(values[-1], 0.0))
+    measured = values > floor
+    inv = (vectors[:, measured] / values[measured]) @ vectors[:, measured].T
+    cov = s2 * inv / np.outer(scale, scale)
+    return PoseSplit(covariance=cov, unmeasured=vectors[:, ~measured], length=length,
+                     eigenvalues=values)
+
+
+def _extent(points):
+    return max(float(np.linalg.norm(np.ptp(points, axis=0))), 1e-9)
+
+
+def pose_split(points_cad, normals, weights, residuals, center):
+    """split_information of the points' own Fisher information, ``length`` their extent
+    (bounding-box diagonal). None when too few points carry weight."""
+    H, s2, n_w = pose_information(points_cad, normals, weights, residuals, center)
+    if H is None:
+        return None
+    keep = np.asarray(weights) > 0
+    return split_information(H, s2, _extent(np.asarray(points_cad)[keep]), n_w)
+
+
 def pose_covariance(points_cad, normals, weights, residuals, center):
     """C = s^2 (sum w_i J_i^T J_i)^-1, J_i = [n_i, (p_i - c) x n_i],
     s^2 = sum w_i r_i^2 / (n_w - 6), n_w = number of points with w_i > 0.
@@ -229,22 +305,13 @@ def pose_covariance(points_cad, normals, weights, residuals, center):
     With w = a * rho this is the weighted least-squares covariance of the points the robust
     weight keeps: exact when rho is 0 or 1 (all but the few points in the taper band); s^2 is
     the variance of a unit-weight residual, so the weights' normalisation cancels out.
-    Infinite when the points do not fix all six degrees of freedom (e.g. a sphere).
+    Infinite when the points do not fix all six degrees of freedom (e.g. a sphere; the rule is
+    split_information's, and pose_split gives the covariance of the directions they do fix).
     """
-    w = np.asarray(weights, dtype=float)
-    r = np.asarray(residuals, dtype=float)
-    keep = w > 0
-    dof = int(np.count_nonzero(keep)) - 6
-    if dof <= 0:
+    split = pose_split(points_cad, normals, weights, residuals, center)
+    if split is None or not split.complete:
         return np.full((6, 6), np.inf)
-    J = _jacobian(np.asarray(points_cad)[keep], np.asarray(normals)[keep], center)
-    H = (J * w[keep, None]).T @ J
-    s2 = float(np.sum(w[keep] * r[keep] ** 2)) / dof
-    # Conditioning judged on the matrix scaled to unit diagonal, so mm and rad do not mix.
-    d = np.sqrt(np.diag(H))
-    if np.any(d == 0) or np.linalg.cond(H / np.outer(d, d)) > 1e12:
-        return np.full((6, 6), np.inf)
-    return s2 * np.linalg.inv(H)
+    return split.covariance
 
 
 def pose_uncertainty(cov, center, corners):
@@ -295,7 +362,13 @@ def icp(points, snr, closest_fn, init, options=None):
     iterations = 0
     last_step = None   # (moved, normals, distances, center, dt, dw) of the last Gauss-Newton step
     previous_motion = np.nan
+    stopped = ""
+    started = time.monotonic()
     while iterations < options.max_iter:
+        if options.time_limit_s is not None \
+                and time.monotonic() - started >= options.time_limit_s:
+            stopped = "time limit"
+            break
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
@@ -344,11 +417,14 @@ def icp(points, snr, closest_fn, init, options=None):
     w = a * rho
     inlier = rho > 0
     center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)
-    cov = pose_covariance(moved, normals, w, distances, center)
+    split = pose_split(moved, normals, w, distances, center)
+    cov = (split.covariance if split is not None and split.complete
+           else np.full((6, 6), np.inf))
     keep = w > 0
     dof = max(int(np.count_nonzero(keep)) - 6, 1)
     return ICPResult(
         transform=T, distances=distances, inlier=inlier, weights=w,
         rms=float(np.sqrt(np.mean(distances[inlier] ** 2))) if inlier.any() else float("nan"),
         sigma0=float(np.sqrt(np.sum(w[keep] * distances[keep] ** 2) / dof)),
-        iterations=iterations, converged=converged, covariance=cov, center=center)
+        iterations=iterations, converged=converged, covariance=cov, center=center,
+        split=split, stopped=stopped)

@@ -15,6 +15,12 @@ import numpy as np
 from .errors import InputError
 
 MIN_POINTS = 10
+# |coordinate| beyond which a number is not a measurement in millimetres but a corrupt field
+# (an overflow, a misplaced exponent): a kilometre, three orders of magnitude past any
+# inspection rig's travel, yet far enough that a scan in micrometres (a blade of 1e5 um)
+# still reaches the unit check, which names the unit. A NaN or an infinity is a sensor's "no
+# reading" and is skipped; a huge finite number is written wrong, and so may be the rest.
+MAX_COORDINATE_MM = 1e6
 SNR_RANGE = (0.0, 100.0)
 CSV_EXTENSIONS = (".csv",)
 WHITESPACE_EXTENSIONS = (".xyz", ".asc", ".txt")
@@ -220,7 +226,21 @@ def _build(path, names, columns, skipped):
         else:
             extra[name] = values[usable]
     xyz = np.column_stack([parsed["x"], parsed["y"], parsed["z"]])[usable]
+    check_magnitude(path, xyz, rows=np.flatnonzero(usable))
     return PointSet(xyz=xyz, snr=snr, columns=extra, n_rows_skipped=int(skipped), source=path)
+
+
+def check_magnitude(path, xyz, rows=None):
+    """InputError when a coordinate is beyond MAX_COORDINATE_MM; ``rows`` maps points to data
+    rows (0-based) for the message."""
+    far = np.flatnonzero(np.any(np.abs(xyz) > MAX_COORDINATE_MM, axis=1))
+    if len(far):
+        first = far[0]
+        where = "data row %d" % (rows[first] + 1) if rows is not None else "point %d" % first
+        value = xyz[first][np.argmax(np.abs(xyz[first]))]
+        raise InputError("%s: %d point%s with a coordinate beyond +-%g mm (%s: %g): not a "
+                         "measurement in millimetres" % (path, len(far), "s" * (len(far) > 1),
+                                                         MAX_COORDINATE_MM, where, value))
 
 
 def write_points_csv(path, xyz, columns=None):

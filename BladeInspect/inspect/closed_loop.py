@@ -166,22 +166,27 @@ def _result_of_all(nominal, blind, blind_sections, later, phase, xyz, snr, fit, 
 def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     """A RegistrationResult for points registered by a fine ICP from a known start, built the
     way pipeline.register builds its own."""
-    from ..core import icp as icp_mod
     from ..core import stats as stats_mod
     from .result import RegistrationResult
     points_cad = tf.apply_transform(fit.transform, pointset.xyz)
     dist = nominal.signed_distance(points_cad)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
-    uncertainty = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
+    from .pipeline import pose_summary
+    from .checks import unmeasured_warning
+    covariance, uncertainty, unmeasured = pose_summary(fit, nominal)
+    if unmeasured:
+        warnings = [w for w in warnings if w != unmeasured_warning(unmeasured)]
+        warnings.append(unmeasured_warning(unmeasured))
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face,
         snr=pointset.snr, columns=dict(pointset.columns), n_rows_skipped=0, rms_mm=rms,
-        pose_covariance=fit.covariance, center=fit.center,
+        pose_covariance=covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
-        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces)
+        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
+        pose_unmeasured=unmeasured)
 
 
 def _sections_json(table, plan):
@@ -206,14 +211,16 @@ def _pointset(xyz, snr, columns, source):
 def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGHTS,
                 complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
-                scan_options=None, on_plan=None, resume=False, flip_faces=()):
+                scan_options=None, on_plan=None, resume=False, flip_faces=(),
+                allow_mismatch=False):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (rig.scan.scan_to_dir, e.g. n_sections).
     ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
     ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
     ``scan_options`` None takes the interrupted run's). ``flip_faces``: CAD faces whose
-    outward side is reversed (``--flip-face``, cad.orient).
+    outward side is reversed (``--flip-face``, cad.orient). ``allow_mismatch``: go on with a
+    blind scan that does not fit the CAD, with the warning (pipeline.register).
     Returns a summary dict. The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
@@ -261,18 +268,21 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
             checkpoint = _Checkpoint(os.path.join(os.path.abspath(out_dir), LIVE_FOLDER),
                                      out_dir, identity, rig, resume)
             scan_options = dict(checkpoint.identity["scan_options"] or {})
+            register_options = {"allow_mismatch": allow_mismatch, "tolerance": tolerance,
+                                "cad_source": cad_path or "the demo blade"}
             try:
                 if complete:
                     summary = _complete_loop(nominal, checkpoint.rig, kinematics, heights,
                                              seed, epsilon, cmm_data, tolerance, pitch, out,
                                              checkpoint, timing, progress, document,
-                                             scan_options, cad_path or "built-in demo blade")
+                                             scan_options, cad_path or "built-in demo blade",
+                                             register_options)
                 else:
                     summary = _loop(nominal, checkpoint.rig, kinematics, heights, seed, epsilon,
                                     cmm_data, tolerance, out, checkpoint, timing, progress,
                                     plan_sections, scan_mod, pipeline, sections_mod,
                                     verdict_mod, write_report, document, scan_options,
-                                    cad_path or "built-in demo blade")
+                                    cad_path or "built-in demo blade", register_options)
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
@@ -291,10 +301,11 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
 
 
 def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-                 scan_mod, pipeline, scan_share, register_share):
+                 scan_mod, pipeline, scan_share, register_share, **register_options):
     """The blind section scan into the checkpoint and its registration: nothing is known of
     the pose yet, so only what the sensor reads is used. A resumed inspection continues an
     interrupted blind scan (scan_to_dir's own resume) or reads the finished one back.
+    ``register_options``: pipeline.register's allow_mismatch, tolerance and cad_source.
     Returns (the blind scan's record, points, rig time spent, registration)."""
     t0 = time.perf_counter()
     state = checkpoint.state
@@ -316,7 +327,7 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
     t0 = time.perf_counter()
     first = pipeline.register(
         nominal, blind, seed=seed,
-        progress=lambda f, m: progress(scan_share + register_share * f, m))
+        progress=lambda f, m: progress(scan_share + register_share * f, m), **register_options)
     timing["register_blind"] = time.perf_counter() - t0
     if state is not None and state["phase"] != "blind":
         # The saved pose plans the rest; a registration that no longer lands there means the
@@ -332,12 +343,12 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
 
 def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out,
           checkpoint, timing, progress, plan_sections, scan_mod, pipeline, sections_mod,
-          verdict_mod, write_report, document, scan_options, cad_label):
+          verdict_mod, write_report, document, scan_options, cad_label, register_options):
     # 1-2. blind section scan and its registration
     resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "planned" else None
     scan_record, blind, blind_rig_s, first = _blind_stage(
         nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-        scan_mod, pipeline, scan_share=0.25, register_share=0.2)
+        scan_mod, pipeline, scan_share=0.25, register_share=0.2, **register_options)
     n_blind = len(blind.xyz)
     blind_sections = _blind_column(blind, "section", n_blind)
     # Planned sections are numbered after the blind ones, so a `report` of points.csv by its
@@ -528,7 +539,8 @@ def _blind_column(pointset, name, n):
 
 
 def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
-                   out, checkpoint, timing, progress, document, scan_options, cad_label):
+                   out, checkpoint, timing, progress, document, scan_options, cad_label,
+                   register_options):
     """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
     the whole blade rastered every ``pitch`` mm (rig.complete) from that pose, ICP on every
     point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
@@ -541,7 +553,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "complete" else None
     scan_record, blind, blind_rig_s, first = _blind_stage(
         nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-        scan_mod, pipeline, scan_share=0.15, register_share=0.1)
+        scan_mod, pipeline, scan_share=0.15, register_share=0.1, **register_options)
     n_blind = len(blind.xyz)
     blind_sections = _blind_column(blind, "section", n_blind)
     first_line = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0

@@ -19,8 +19,10 @@ from ..core import pca as pca_mod
 from ..core import stats as stats_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
-from ..core.pointio import MIN_POINTS, PointSet
+from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
+from . import checks
 from .result import RegistrationResult
+from .verdict import DEFAULT_TOLERANCE
 
 # Points used for the ICP ranking of each PCA candidate and for the fine fit's inner
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
@@ -40,6 +42,14 @@ SEARCH_MEDIAN_MM = 0.015
 SEARCH_ROUNDS = 4
 SEARCH_SHIFTS_MM = (-6.0, -3.0, 3.0, 6.0)
 SEARCH_TURNS_DEG = (-8.0, -4.0, 4.0, 8.0)
+# Wall-clock budget of the coarse stage, checked at each candidate and search step it reports:
+# its ICPs and search rounds are bounded in number, so this only ends a stage that a slow
+# distance (points far inside or off the CAD) would stretch to minutes. Half the fine stage's.
+COARSE_TIME_LIMIT_S = 60.0
+# Wall-clock budget of the fine stage: twelve times DESIGN.md's 10 s for the whole
+# registration of the paper's 269k-point cloud on two cores. A fit still iterating then is
+# lost (its points are not on this CAD), not slow; its iteration counts are bounded as well.
+FINE_TIME_LIMIT_S = 120.0
 
 
 def _no_progress(fraction, message):
@@ -70,6 +80,7 @@ def _check_points(pointset):
                          % (pointset.source or "points", len(xyz), MIN_POINTS))
     if not np.all(np.isfinite(xyz)):
         raise InputError("%s: points contain NaN or infinite coordinates" % pointset.source)
+    check_magnitude(pointset.source or "points", xyz)
     return xyz
 
 
@@ -197,37 +208,78 @@ def exact_closest_fn(nominal):
     return closest
 
 
-def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress):
+def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
+                  time_limit_s=FINE_TIME_LIMIT_S):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
-    information (and its covariance is the whole cloud's)."""
+    information (and its covariance is the whole cloud's). Both runs together get
+    ``time_limit_s``; an InputError says so when it is spent."""
     rng = np.random.default_rng(1) if rng is None else rng
     closest = exact_closest_fn(nominal)
+    deadline = time.monotonic() + time_limit_s
+
+    def remaining():
+        return max(deadline - time.monotonic(), 0.0)
     T = init
     n = len(measured_xyz)
     if n > FINE_SUBSAMPLE:
         sub = _subsample(n, FINE_SUBSAMPLE, rng)
         progress(0.1, "fine registration on %d of %d points" % (len(sub), n))
         fit = icp_mod.icp(measured_xyz[sub], None if snr is None else snr[sub], closest, T,
-                          icp_mod.ICPOptions())
+                          icp_mod.ICPOptions(time_limit_s=remaining()))
+        _check_time(fit, time_limit_s)
         T = fit.transform
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
                                      trans_tol=FULL_CLOUD_TOL_MM, rot_tol=FULL_CLOUD_TOL_RAD,
                                      linear_update_mm=FULL_CLOUD_TOL_MM,
-                                     linear_update_rad=FULL_CLOUD_TOL_RAD)
+                                     linear_update_rad=FULL_CLOUD_TOL_RAD,
+                                     time_limit_s=remaining())
     else:
-        options = icp_mod.ICPOptions()
+        options = icp_mod.ICPOptions(time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
-    return icp_mod.icp(measured_xyz, snr, closest, T, options)
+    fit = icp_mod.icp(measured_xyz, snr, closest, T, options)
+    _check_time(fit, time_limit_s)
+    return fit
+
+
+def _with_deadline(progress, limit_s, what):
+    """``progress`` that raises an InputError once ``limit_s`` has passed since it was made."""
+    deadline = time.monotonic() + limit_s
+
+    def report(fraction, message):
+        if time.monotonic() > deadline:
+            raise InputError("%s: stopped at its %g s time limit (%s) - the points do not "
+                             "settle on this CAD" % (what, limit_s, message))
+        progress(fraction, message)
+    return report
+
+
+def _check_time(fit, time_limit_s):
+    if fit.stopped:
+        raise InputError("fine registration: stopped after %d iterations at its %g s time "
+                         "limit without converging - the points do not settle on this CAD"
+                         % (fit.iterations, time_limit_s))
 
 
 # ---------------------------------------------------------------- the whole registration
 
-def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
-    """Register a measured point set to the nominal with no knowledge of its pose."""
+def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
+             allow_mismatch=False, tolerance=DEFAULT_TOLERANCE, cad_source=None):
+    """Register a measured point set to the nominal with no knowledge of its pose.
+
+    Refused (InputError) before any fitting when the points are too degenerate to fix a pose
+    or do not match the CAD's size, and after it when they do not fit the CAD (see
+    inspect.checks; ``allow_mismatch`` keeps the result with a warning instead, and
+    ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
+    in those messages."""
     progress = progress or _no_progress
     timing = {}
     xyz = _check_points(pointset)
+    source = pointset.source or "points"
+    cad_label = cad_source or "the CAD"
+    checks.check_spread(xyz, source, coincide_only=True)
+    extent_ratio = checks.check_scale(xyz, nominal, source, cad_label)
+    checks.check_spread(xyz, source)
     snr = None if pointset.snr is None else np.asarray(pointset.snr, dtype=float)
     rng = np.random.default_rng(seed)
     # A CAD face whose outside could not be decided signs its deviations by a guess: say so.
@@ -249,15 +301,24 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
 
     t0 = time.perf_counter()
     coarse = coarse_register(xyz, snr, nominal, pca_points=pca_points, rng=rng,
-                             progress=lambda f, m: progress(0.05 + 0.25 * f, m))
+                             progress=_with_deadline(
+                                 lambda f, m: progress(0.05 + 0.25 * f, m),
+                                 COARSE_TIME_LIMIT_S, "%s: against %s: coarse registration"
+                                 % (source, cad_label)))
     timing["coarse"] = time.perf_counter() - t0
     if coarse["warning"]:
         warnings.append(coarse["warning"])
 
     t0 = time.perf_counter()
-    fit = fine_register(xyz, snr, nominal, coarse["measured_to_cad"], rng=rng,
-                        progress=lambda f, m: progress(0.3 + 0.6 * f, m))
+    try:
+        fit = fine_register(xyz, snr, nominal, coarse["measured_to_cad"], rng=rng,
+                            progress=lambda f, m: progress(0.3 + 0.6 * f, m))
+    except InputError as exc:
+        raise InputError("%s: against %s: %s" % (source, cad_label, exc)) from None
     timing["fine"] = time.perf_counter() - t0
+    if not fit.converged:
+        warnings.append("fine registration: not converged after %d iterations"
+                        % fit.iterations)
 
     t0 = time.perf_counter()
     progress(0.92, "signed deviations of %d points" % len(xyz))
@@ -266,7 +327,17 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
-    uncertainty = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
+    fit_record = checks.surface_fit(dist.distance, tolerance)
+    fit_record["extent_ratio"] = extent_ratio
+    if not fit_record["fits"]:
+        message = checks.mismatch_message(fit_record, source, cad_label)
+        if not allow_mismatch:
+            raise InputError(message)
+        fit_record["warning"] = message
+        warnings.append(message)
+    covariance, uncertainty, unmeasured = pose_summary(fit, nominal)
+    if unmeasured:
+        warnings.append(checks.unmeasured_warning(unmeasured))
     timing["deviations"] = time.perf_counter() - t0
     progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
              % (rms, uncertainty * 1000.0))
@@ -285,9 +356,21 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
         columns=dict(pointset.columns), n_rows_skipped=int(pointset.n_rows_skipped),
-        rms_mm=rms, pose_covariance=fit.covariance, center=fit.center,
+        rms_mm=rms, pose_covariance=covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty), deviation_stats=stats, coarse=coarse_out,
-        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces)
+        timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
+        pose_unmeasured=unmeasured, surface_fit=fit_record)
+
+
+def pose_summary(fit, nominal):
+    """(covariance, 1 sigma at the worst CAD corner, unmeasured directions) of an ICP fit: the
+    covariance of the directions the points measure (core.icp.split_information) and the
+    others named (inspect.checks.describe_unmeasured); the full covariance when all are."""
+    split = fit.split
+    if split is None:
+        return fit.covariance, float("inf"), []
+    uncertainty = icp_mod.pose_uncertainty(split.covariance, fit.center, nominal.bbox_corners)
+    return split.covariance, float(uncertainty), checks.describe_unmeasured(split, nominal)
 
 
 # ---------------------------------------------------------------- outputs
@@ -320,6 +403,8 @@ def result_json(result, extra=None):
         "warnings": result.warnings,
         "points_file": result.source,
         "cad_file": result.cad_source,
+        "pose_unmeasured": list(result.pose_unmeasured),
+        "surface_fit": result.surface_fit,
     }
     if extra:
         doc.update(extra)
@@ -360,6 +445,7 @@ class AtomicOutput:
     all of them are complete, so an error never leaves a half-written result."""
 
     def __init__(self, out_dir):
+        checks.check_out_dir(out_dir)
         self.out_dir = os.path.abspath(out_dir)
         parent = os.path.dirname(self.out_dir)
         os.makedirs(parent, exist_ok=True)
@@ -416,15 +502,18 @@ def _json_default(value):
     raise TypeError("not JSON serialisable: %r" % type(value))
 
 
-def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=()):
+def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),
+                 allow_mismatch=False):
     """The `register` command: load, register, write. Returns the RegistrationResult."""
+    checks.check_out_dir(out_dir)
     t0 = time.perf_counter()
     nominal = load_nominal(cad_path, flip_faces=flip_faces)
     t_cad = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = load_points(points_path)
     t_pts = time.perf_counter() - t0
-    result = register(nominal, points, seed=seed, progress=progress)
+    result = register(nominal, points, seed=seed, progress=progress,
+                      allow_mismatch=allow_mismatch, cad_source=cad_path or "the demo blade")
     result.timing_s = dict(load_cad=t_cad, load_points=t_pts, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
     write_register_outputs(out_dir, result)

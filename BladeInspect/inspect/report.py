@@ -328,7 +328,12 @@ def pose_rows(result):
     T = np.asarray(result.measured_to_cad)
     cov = np.asarray(result.pose_covariance)
     sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-    return [
+    # The 1 sigma figures cover the measured directions only (inspect.checks).
+    unmeasured = [["Not measured by the points (not in the 1 sigma figures)",
+                   "; ".join(u["motion"].replace(" is not measured", "")
+                             for u in result.pose_unmeasured)]] \
+        if getattr(result, "pose_unmeasured", None) else []
+    return unmeasured + [
         ["Points (inliers)", "%d (%d)" % (result.n_points, result.n_inliers)],
         ["Rows skipped", "%d" % result.n_rows_skipped],
         ["Residual RMS of inliers", "%.4f mm" % result.rms_mm],
@@ -525,13 +530,16 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
                seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
-               nominal=None, document=True, flip_faces=()):
+               nominal=None, document=True, flip_faces=(), allow_mismatch=False):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
     made in a private folder beside out_dir and moved in only when every one is complete.
     ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
-    ``--flip-face`` (cad.orient). Returns a summary dict."""
+    ``--flip-face`` (cad.orient). ``allow_mismatch``: write the result of a scan that does not
+    fit the CAD, with the warning (pipeline.register). Returns a summary dict."""
     from . import pipeline
+    from .checks import check_out_dir
+    check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not np.isfinite(tolerance) or tolerance <= 0:
@@ -546,7 +554,9 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
     timing["load_points"] = time.perf_counter() - t0
     result = pipeline.register(nominal, points, seed=seed,
-                               progress=lambda f, m: progress(0.8 * f, m))
+                               progress=lambda f, m: progress(0.8 * f, m),
+                               allow_mismatch=allow_mismatch, tolerance=tolerance,
+                               cad_source=cad_path or "the demo blade")
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
 

@@ -30,6 +30,8 @@ class RegistrationResult:
     source: str = ""
     cad_source: str = ""
     cad_faces: list = field(default_factory=list)   # how each CAD face's outside was decided
+    pose_unmeasured: list = field(default_factory=list)   # inspect.checks.describe_unmeasured
+    surface_fit: Optional[dict] = None                     # inspect.checks.surface_fit
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
