@@ -98,6 +98,14 @@ class TestRefusedFiles(BadInputCase):
             fh.write("\n".join(rows) + "\n")
         self.assert_refused(path, "data row 4", "1e+300", "not a measurement in millimetres")
 
+    def test_an_infinite_coordinate_is_refused_naming_its_row(self):
+        rows = open(self.points).read().splitlines()
+        rows.insert(6, "3,inf,2,50")
+        path = os.path.join(self.tmp, "infinite.csv")
+        with open(path, "w") as fh:
+            fh.write("\n".join(rows) + "\n")
+        self.assert_refused(path, "data row 6", "y is inf", "not a measurement")
+
     def test_a_huge_coordinate_is_refused_by_report_too(self):
         xyz = self.scan.xyz.copy()
         xyz[7, 1] = -3e250

@@ -65,7 +65,7 @@ class TestCsv(PointFileCase):
         rows[9] = "8,16,-8,,blind"               # no snr
         rows[12] = "11,22,-11,50"                # short row
         rows[15] = "14,28,abc,50,blind"          # garbage
-        rows[18] = "17,inf,-17,50,blind"         # not finite
+        rows[18] = "17,NaN,-17,50,blind"         # no reading, spelt otherwise
         rows.insert(10, "")                      # blank lines are not rows
         rows.insert(20, "# a comment")
         ps = pointio.read_points(self.write("b.csv", "\n".join(rows)))
@@ -98,6 +98,11 @@ class TestCsv(PointFileCase):
         self.assertInputError(self.write("few.csv", header + "".join(
             "%d,%d,%d,50\n" % (i, i, i) for i in range(9))), "9 usable points")
         self.assertInputError(self.write("snr.csv", header + good + "1,2,3,250\n"), "snr")
+        # an infinity is an overflow, not a missing reading: refused, naming the row
+        self.assertInputError(self.write("inf.csv", header + good + "1,inf,3,50\n"),
+                              "data row 13: y is inf")
+        self.assertInputError(self.write("ninf.csv", header + "-inf,1,1,50\n" + good),
+                              "data row 1: x is -inf")
         self.assertInputError(self.write("neg.csv", header + good + "1,2,3,-1\n"), "snr")
         self.assertInputError(self.write("dup.csv", "x,y,z,X\n" + good), "duplicate")
         self.assertInputError(self.write("a.ply", "ply\n"), "FreeCAD")

@@ -18,8 +18,9 @@ MIN_POINTS = 10
 # |coordinate| beyond which a number is not a measurement in millimetres but a corrupt field
 # (an overflow, a misplaced exponent): a kilometre, three orders of magnitude past any
 # inspection rig's travel, yet far enough that a scan in micrometres (a blade of 1e5 um)
-# still reaches the unit check, which names the unit. A NaN or an infinity is a sensor's "no
-# reading" and is skipped; a huge finite number is written wrong, and so may be the rest.
+# still reaches the unit check, which names the unit. A NaN (or an empty field) is a sensor's
+# "no reading" and is skipped; an infinity or a huge finite number is an overflow or a field
+# written wrong, and so may be the rest of the file: it is refused.
 MAX_COORDINATE_MM = 1e6
 SNR_RANGE = (0.0, 100.0)
 CSV_EXTENSIONS = (".csv",)
@@ -202,6 +203,12 @@ def _build(path, names, columns, skipped):
     parsed = {name: _parse_floats(columns[name]) for name in required}
     usable = np.ones(n_rows, dtype=bool)
     for name in required:
+        infinite = np.flatnonzero(np.isinf(parsed[name]))
+        if len(infinite):
+            raise InputError("%s: data row %d: %s is %g, not a measurement (%d row%s with an "
+                             "infinite value)" % (path, infinite[0] + 1, name,
+                                                  parsed[name][infinite[0]], len(infinite),
+                                                  "s" * (len(infinite) > 1)))
         usable &= np.isfinite(parsed[name])
     n_usable = int(np.count_nonzero(usable))
     skipped += n_rows - n_usable
