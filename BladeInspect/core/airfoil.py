@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from scipy.interpolate import CubicSpline, splev, splprep
+from scipy.interpolate import CubicSpline, PPoly, splprep
 from scipy.spatial import ConvexHull, cKDTree
 
 from .errors import InputError
@@ -38,6 +38,11 @@ _NEWTON_ITERATIONS = 12
 _FEET = 400                 # feet on one side seeding the inscribed circles
 _END_FEET = 17              # finer feet closing in on each end of the camber line
 _END_ROUNDS = 4
+_ZONE_ROUNDS = 20
+_ZONE_SAMPLES = 400
+_END_WINDOW_MM = 0.5
+_CIRCULAR_EDGE = 1e-2
+_EDGE_CORE = 1e-3
 _MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
 # A camber-line circle clears the profile round the edge by this fraction of its radius; the
 # camber line thus stops within 1e-4 r of an exact circular edge's centre.
@@ -71,14 +76,29 @@ class Profile:
         self.point_params = u[:-1]
         smoothing = len(pts) * float(noise_mm) ** 2
         self._tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)
+        pieces = [PPoly.from_spline((self._tck[0], cx, 3)) for cx in self._tck[1]]
+        keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
+        keep &= np.diff(pieces[0].x) > 0
+        self._breaks = pieces[0].x[:-1][keep]
+        self._coef = np.stack([pp.c[:, keep] for pp in pieces], axis=-1).transpose(1, 0, 2)
         n_dense = int(np.clip(self.length / _DENSE_SPACING_MM, _DENSE_MIN, _DENSE_MAX))
         self.dense_u = np.linspace(0.0, self.length, n_dense, endpoint=False)
         self.dense = self.eval(self.dense_u)
         self._tree = cKDTree(self.dense)
 
     def eval(self, u, der=0):
-        u = np.mod(np.asarray(u, dtype=float), self.length)
-        return np.column_stack(splev(u, self._tck, der=der))
+        return self.eval3(u)[der]
+
+    def eval3(self, u):
+        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+        u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
+        i = np.clip(np.searchsorted(self._breaks, u, side="right") - 1, 0, len(self._coef) - 1)
+        t = (u - self._breaks[i])[:, None]
+        c0, c1, c2, c3 = (self._coef[i, k] for k in range(4))
+        p = ((c0 * t + c1) * t + c2) * t + c3
+        d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
+        d2 = 6.0 * c0 * t + 2.0 * c1
+        return p, d1, d2
 
     def outward_normal(self, u):
         d = self.eval(u, 1)
@@ -100,14 +120,18 @@ class Profile:
         xy = np.atleast_2d(xy)
         u = self.nearest_param(xy) if u0 is None else np.array(u0, dtype=float)
         for _ in range(_NEWTON_ITERATIONS):
-            u = self._newton_stationary(u, xy)
+            new = self._newton_stationary(u, xy)
             if lo is not None:
-                u = np.clip(u, lo, hi)
+                new = np.clip(new, lo, hi)
+            done = np.max(np.abs(new - u), initial=0.0) < 1e-13 * self.length
+            u = new
+            if done:
+                break
         return u, self.eval(u)
 
     def _newton_stationary(self, u, xy):
         # Stationary points of |S(u) - xy|^2: the closest point when started next to it.
-        s, s1, s2 = self.eval(u), self.eval(u, 1), self.eval(u, 2)
+        s, s1, s2 = self.eval3(u)
         d = s - xy
         g = np.einsum("ij,ij->i", d, s1)
         h = np.einsum("ij,ij->i", s1, s1) + np.einsum("ij,ij->i", d, s2)
@@ -298,7 +322,7 @@ class CamberLine:
     """Inscribed-circle centres (a cubic spline in arc length) extended straight along the end
     tangents to the profile: the LE point at s = 0, the TE point at s = length."""
 
-    def __init__(self, le, centres, te):
+    def __init__(self, le, centres, te, le_tangent, te_tangent):
         self.centres = centres
         seg = np.linalg.norm(np.diff(centres, axis=0), axis=1)
         s = np.concatenate([[0.0], np.cumsum(seg)])
@@ -308,8 +332,7 @@ class CamberLine:
         self.inner_length = float(s[-1])
         self.length = self.le_extension + self.inner_length + float(
             np.linalg.norm(te - centres[-1]))
-        self.le_tangent = _unit(self._spline(0.0, 1))
-        self.te_tangent = _unit(self._spline(s[-1], 1))
+        self.le_tangent, self.te_tangent = le_tangent, te_tangent
 
     def at(self, s):
         """Points and unit tangents (LE -> TE) at arc lengths s from the LE point."""
@@ -328,6 +351,49 @@ class CamberLine:
 
     def sample(self, n=400):
         return self.at(np.linspace(0.0, self.length, n))[0]
+
+
+def _line_end(centres, radii, end, edge=None):
+    """The camber line's centres and its unit tangent at its first (end=0) or last (end=-1)
+    centre, pointing out of that end: the slope of a least-squares parabola (in arc length)
+    through the centres within the end window (the end circle's radius, at least
+    _END_WINDOW_MM, at most a tenth of the line) -- a parabola over a window rather than an
+    interpolating spline's end slope, which the closely packed last centres of a circular edge
+    and noise would tilt.
+
+    With ``edge`` (the fitted edge circle) centred within _CIRCULAR_EDGE of its radius from the
+    last centre, the edge is circular and the locus ends at the edge circle's centre (where
+    its inscribed circles become the edge circle): the centres nearer to it than _EDGE_CORE of
+    its radius (ill-conditioned bisectors) are dropped and the parabola is followed up to the
+    point nearest to it, which becomes the line's end."""
+    c = centres if end == -1 else centres[::-1]
+    r = radii if end == -1 else radii[::-1]
+    if edge is not None and np.linalg.norm(c[-1] - edge.center) < _CIRCULAR_EDGE * edge.radius:
+        far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
+        c, r = c[far], r[far]
+    else:
+        edge = None
+    seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    s = s - s[-1]
+    window = min(max(r[-1], _END_WINDOW_MM), 0.1 * -s[0])
+    sel = s >= -window
+    if sel.sum() < 4:
+        sel = np.arange(len(s)) >= len(s) - 4
+    coef = np.polyfit(s[sel], c[sel], 2)
+    tangent = _unit(coef[1])
+    if edge is not None:
+        reach = 0.0
+        for _ in range(5):
+            p = (coef[0] * reach + coef[1]) * reach + coef[2]
+            d = _unit(2 * coef[0] * reach + coef[1])
+            reach += float((edge.center - p) @ d)
+        tip = (coef[0] * reach + coef[1]) * reach + coef[2]
+        tangent = _unit(2 * coef[0] * reach + coef[1])
+        c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
+    if end == 0:
+        return c[::-1], r[::-1], tangent
+    return c, r, tangent
 
 
 def _ray_hit(profile, origin, direction):
@@ -408,6 +474,8 @@ def extent(profile, direction):
 def _farthest_pair(profile):
     """Maximum Feret (caliper) diameter: the two profile points furthest apart."""
     hull = profile.dense[ConvexHull(profile.dense).vertices]
+    # A coarse pair is enough to start: the Newton rounds below find the exact diameter.
+    hull = hull[::max(1, len(hull) // 400)]
     d2 = np.sum((hull[:, None, :] - hull[None, :, :]) ** 2, axis=2)
     i, j = np.unravel_index(np.argmax(d2), d2.shape)
     ui = profile.nearest_param(hull[i])
@@ -489,14 +557,48 @@ def fit_circle_2d(xy):
     return c, float(r), float(np.sqrt(np.mean(res ** 2)))
 
 
-def _edge_circle(profile, end_centre, outward, zone_deg):
-    v = profile.points - end_centre
-    ang = np.degrees(np.arccos(np.clip(_unit(v) @ outward, -1.0, 1.0)))
-    near = np.linalg.norm(v, axis=1) < 3.0 * np.max(np.linalg.norm(v[ang <= zone_deg], axis=1),
-                                                    initial=0.0)
-    zone = (ang <= zone_deg) & near
-    c, r, rms = fit_circle_2d(profile.points[zone])
-    return CircleFit2D(c, r, rms, int(zone.sum()), zone_deg)
+def _edge_circle(profile, end_centre, outward, edge_u, zone_deg):
+    """Circle fitted to the edge zone: the stretch of profile round the edge point (parameter
+    edge_u) seen within +-zone_deg of the camber line's outward direction from the fitted
+    circle's own centre (first from the last inscribed circle's centre; re-fitted until the
+    zone stops changing). The fit is to the profile curve resampled finely over the zone."""
+    centre = np.asarray(end_centre, dtype=float)
+    zone = None
+    for _ in range(_ZONE_ROUNDS):
+        lo, hi = _zone_range(profile, centre, outward, edge_u, zone_deg)
+        if zone is not None and abs(lo - zone[0]) < 1e-9 and abs(hi - zone[1]) < 1e-9:
+            break
+        zone = (lo, hi)
+        xy = profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES))
+        centre, radius, rms = fit_circle_2d(xy)
+    return CircleFit2D(centre, radius, rms, _ZONE_SAMPLES, zone_deg)
+
+
+def _zone_range(profile, centre, outward, edge_u, zone_deg):
+    """Unwrapped parameter range round edge_u where the profile is seen from ``centre``
+    within zone_deg of ``outward`` (to the exact crossing of the zone's bounding rays)."""
+    cos_zone = np.cos(np.radians(zone_deg))
+    h = profile.length / len(profile.dense)
+    bounds = []
+    for step in (-1.0, 1.0):
+        u = edge_u
+        while abs(u - edge_u) < profile.length / 2:
+            nxt = u + step * h
+            if _unit(profile.eval(nxt)[0] - centre) @ outward < cos_zone:
+                break
+            u = nxt
+        else:
+            raise InputError("edge zone: the whole profile is within the edge zone")
+        # Bisect to the ray's crossing between u and the first sample outside.
+        a, b = u, u + step * h
+        for _ in range(40):
+            m = 0.5 * (a + b)
+            if _unit(profile.eval(m)[0] - centre) @ outward >= cos_zone:
+                a = m
+            else:
+                b = m
+        bounds.append(a)
+    return bounds[0], bounds[1]
 
 
 # ---------------------------------------------------------------- the characteristics
@@ -587,13 +689,20 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     centres, radii = _medial_axis(profile, side_a, side_b)
 
     # Camber line end tangents, extended to the profile: the two edge points.
-    seg = np.linalg.norm(np.diff(centres, axis=0), axis=1)
-    spline = CubicSpline(np.concatenate([[0.0], np.cumsum(seg)]), centres, axis=0)
-    t0, t1 = _unit(spline(0.0, 1)), _unit(spline(seg.sum(), 1))
-    ua_end, end_a = _ray_hit(profile, centres[0], -t0)
-    ub_end, end_b = _ray_hit(profile, centres[-1], t1)
-    circle_a = _edge_circle(profile, centres[0], -t0, edge_zone_deg)
-    circle_b = _edge_circle(profile, centres[-1], t1, edge_zone_deg)
+    # First the edge circles about the locus's ends, then the ends closed onto circular edges.
+    _, _, out_a = _line_end(centres, radii, 0)
+    _, _, out_b = _line_end(centres, radii, -1)
+    circle_a = _edge_circle(profile, centres[0], out_a, _ray_hit(profile, centres[0], out_a)[0][0],
+                            edge_zone_deg)
+    circle_b = _edge_circle(profile, centres[-1], out_b,
+                            _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
+    centres, radii, out_a = _line_end(centres, radii, 0, circle_a)
+    centres, radii, out_b = _line_end(centres, radii, -1, circle_b)
+    ua_end, end_a = _ray_hit(profile, centres[0], out_a)
+    ub_end, end_b = _ray_hit(profile, centres[-1], out_b)
+    circle_a = _edge_circle(profile, circle_a.center, out_a, ua_end[0], edge_zone_deg)
+    circle_b = _edge_circle(profile, circle_b.center, out_b, ub_end[0], edge_zone_deg)
+    t0, t1 = -out_a, out_b
     if le_hint is not None:
         hint = np.asarray(le_hint, dtype=float).reshape(2)
         a_is_le = np.linalg.norm(end_a[0] - hint) <= np.linalg.norm(end_b[0] - hint)
@@ -608,7 +717,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         centres, radii = centres[::-1], radii[::-1]
         le, te, le_u, te_u = end_b[0], end_a[0], ub_end[0], ua_end[0]
         le_circle, te_circle = circle_b, circle_a
-    mcl = CamberLine(le, centres, te)
+    mcl = CamberLine(le, centres, te, t0 if a_is_le else -t1, t1 if a_is_le else -t0)
 
     nose_tail = float(np.linalg.norm(te - le))
     chord_dir = (te - le) / nose_tail
