@@ -23,7 +23,7 @@ from .errors import InputError
 DEFAULT_EDGE_OFFSETS_MM = (0.5, 1.0, 2.0)
 # Edge zone of the LE/TE circle fit: profile points seen from the end of the inscribed-circle
 # locus within this angle of the mean camber line's outward direction (docs/airfoil.md).
-DEFAULT_EDGE_ZONE_DEG = 30.0
+DEFAULT_EDGE_ZONE_DEG = 45.0
 # An inscribed circle belongs to the camber line only while its two contacts are at least this
 # far apart as seen from its centre; closer, the circle sits in an edge and its centre is
 # ill-conditioned (the bisector of two nearly parallel normals).
@@ -40,6 +40,7 @@ _END_FEET = 17              # finer feet closing in on each end of the camber li
 _END_ROUNDS = 4
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
+_ZONE_MIN_POINTS = 12
 _END_WINDOW_MM = 0.5
 _CIRCULAR_EDGE = 1e-2
 _EDGE_CORE = 1e-3
@@ -200,8 +201,8 @@ def _refine_centres(profile, a, b, centre, ua, ub):
     d_a - d_b along its gradient (the difference of the unit vectors from the feet)."""
     c = centre.copy()
     for _ in range(30):
-        ua, fa = _foot(profile, a, c, ua)
-        ub, fb = _foot(profile, b, c, ub)
+        ua, fa = _foot(profile, a, c)
+        ub, fb = _foot(profile, b, c)
         va, vb = c - fa, c - fb
         da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
         g = va / da[:, None] - vb / db[:, None]
@@ -211,8 +212,8 @@ def _refine_centres(profile, a, b, centre, ua, ub):
         c[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
         if np.all(np.abs(f) < 1e-11):
             break
-    ua, fa = _foot(profile, a, c, ua)
-    ub, fb = _foot(profile, b, c, ub)
+    ua, fa = _foot(profile, a, c)
+    ub, fb = _foot(profile, b, c)
     return c, ua, ub, fa, fb
 
 
@@ -569,9 +570,20 @@ def _edge_circle(profile, end_centre, outward, edge_u, zone_deg):
         if zone is not None and abs(lo - zone[0]) < 1e-9 and abs(hi - zone[1]) < 1e-9:
             break
         zone = (lo, hi)
-        xy = profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES))
+        xy = _zone_points(profile, lo, hi)
         centre, radius, rms = fit_circle_2d(xy)
-    return CircleFit2D(centre, radius, rms, _ZONE_SAMPLES, zone_deg)
+    return CircleFit2D(centre, radius, rms, len(xy), zone_deg)
+
+
+def _zone_points(profile, lo, hi):
+    """The input points in the parameter range [lo, hi] (unwrapped) when there are at least
+    _ZONE_MIN_POINTS of them -- measured points fit without any smoothing's bias -- else the
+    profile curve resampled finely over it."""
+    u = np.mod(profile.point_params - lo, profile.length)
+    inside = u <= hi - lo
+    if inside.sum() >= _ZONE_MIN_POINTS:
+        return profile.points[inside]
+    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES))
 
 
 def _zone_range(profile, centre, outward, edge_u, zone_deg):
