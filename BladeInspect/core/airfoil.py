@@ -590,27 +590,26 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     """Unwrapped parameter range round edge_u where the profile is seen from ``centre``
     within zone_deg of ``outward`` (to the exact crossing of the zone's bounding rays)."""
     cos_zone = np.cos(np.radians(zone_deg))
-    h = profile.length / len(profile.dense)
-    bounds = []
-    for step in (-1.0, 1.0):
-        u = edge_u
-        while abs(u - edge_u) < profile.length / 2:
-            nxt = u + step * h
-            if _unit(profile.eval(nxt)[0] - centre) @ outward < cos_zone:
-                break
-            u = nxt
-        else:
-            raise InputError("edge zone: the whole profile is within the edge zone")
-        # Bisect to the ray's crossing between u and the first sample outside.
-        a, b = u, u + step * h
-        for _ in range(40):
-            m = 0.5 * (a + b)
-            if _unit(profile.eval(m)[0] - centre) @ outward >= cos_zone:
-                a = m
-            else:
-                b = m
-        bounds.append(a)
-    return bounds[0], bounds[1]
+
+    def inside(u):
+        return _unit(profile.eval(u) - centre) @ outward >= cos_zone
+
+    n = len(profile.dense)
+    h = profile.length / n
+    i0 = int(np.round(np.mod(edge_u, profile.length) / h)) % n
+    seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
+    if seen.all():
+        raise InputError("edge zone: the whole profile is within the edge zone")
+    ahead = int(np.argmin(seen))                 # first sample outside, going forwards
+    behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
+    base = profile.dense_u[i0]
+    a = np.array([base - behind * h, base + (ahead - 1) * h])
+    b = a + np.array([-h, h])
+    for _ in range(40):
+        m = 0.5 * (a + b)
+        ok = inside(m)
+        a, b = np.where(ok, m, a), np.where(ok, b, m)
+    return float(a[0]), float(a[1])
 
 
 # ---------------------------------------------------------------- the characteristics
