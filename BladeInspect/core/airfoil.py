@@ -38,6 +38,7 @@ _NEWTON_ITERATIONS = 12
 _FEET = 400                 # feet on one side seeding the inscribed circles
 _END_FEET = 17              # finer feet closing in on each end of the camber line
 _END_ROUNDS = 4
+_SEED_STRIDE = 4
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_MIN_POINTS = 12
@@ -93,7 +94,8 @@ class Profile:
     def eval3(self, u):
         """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
         u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
-        i = np.clip(np.searchsorted(self._breaks, u, side="right") - 1, 0, len(self._coef) - 1)
+        i = np.searchsorted(self._breaks, u, side="right") - 1
+        i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
         t = (u - self._breaks[i])[:, None]
         c0, c1, c2, c3 = (self._coef[i, k] for k in range(4))
         p = ((c0 * t + c1) * t + c2) * t + c3
@@ -123,7 +125,7 @@ class Profile:
         for _ in range(_NEWTON_ITERATIONS):
             new = self._newton_stationary(u, xy)
             if lo is not None:
-                new = np.clip(new, lo, hi)
+                new = np.minimum(np.maximum(new, lo), hi)
             done = np.max(np.abs(new - u), initial=0.0) < 1e-13 * self.length
             u = new
             if done:
@@ -196,13 +198,15 @@ def _foot(profile, side, xy, u0=None):
     return profile.closest(xy, u0, side.lo, side.hi)
 
 
-def _refine_centres(profile, a, b, centre, ua, ub):
+def _refine_centres(profile, a, b, centre):
     """Centres equidistant from sides a and b (the medial axis between them), by Newton on
-    d_a - d_b along its gradient (the difference of the unit vectors from the feet)."""
+    d_a - d_b along its gradient (the difference of the unit vectors from the feet). The feet
+    are global nearest points at the start and the end, Newton-tracked in between."""
     c = centre.copy()
+    ua, ub = None, None
     for _ in range(30):
-        ua, fa = _foot(profile, a, c)
-        ub, fb = _foot(profile, b, c)
+        ua, fa = _foot(profile, a, c, ua)
+        ub, fb = _foot(profile, b, c, ub)
         va, vb = c - fa, c - fb
         da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
         g = va / da[:, None] - vb / db[:, None]
@@ -223,16 +227,18 @@ def _circles_from_feet(profile, a, b, ua0):
     radii, feet parameters on a, and whether each is a circle of the camber line."""
     fa = profile.eval(ua0)
     inward = -profile.outward_normal(ua0)
-    d = b.xy[None, :, :] - fa[:, None, :]
-    num = np.einsum("ijk,ijk->ij", d, d)
-    den = 2.0 * np.einsum("ijk,ik->ij", d, inward)
+    # Seeds need only be near: every _SEED_STRIDE-th point of b.
+    q = b.xy[::_SEED_STRIDE]
+    dx = q[None, :, 0] - fa[:, None, 0]
+    dy = q[None, :, 1] - fa[:, None, 1]
+    num = dx * dx + dy * dy
+    den = 2.0 * (dx * inward[:, None, 0] + dy * inward[:, None, 1])
     with np.errstate(divide="ignore", invalid="ignore"):
         radius = np.where(den > 1e-12, num / den, np.inf)
-    j = np.argmin(radius, axis=1)
-    r0 = radius[np.arange(len(ua0)), j]
+    r0 = radius.min(axis=1)
     r0 = np.where(np.isfinite(r0), r0, 0.0)
     centre = fa + r0[:, None] * inward
-    c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre, ua0.copy(), b.u[j])
+    c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
     r = np.linalg.norm(fa - c, axis=1)
     va, vb = _unit(fa - c), _unit(fb - c)
     contact = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", va, vb), -1, 1)))
@@ -751,7 +757,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     s_max = s_c[k] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
     s_max = float(np.clip(s_max, s_c[k - 1], s_c[k + 1]))
     seed, _ = mcl.at(mcl.le_extension + s_max)
-    c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed, None, None)
+    c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed)
     max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
     max_pos = 100.0 * float((c_max[0] - le) @ chord_dir) / nose_tail
 
