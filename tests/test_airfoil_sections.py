@@ -38,9 +38,9 @@ class DemoBladeSection(unittest.TestCase):
         loop = self.frame.to_3d(self.xy)
         face = Part.Face(Part.makePolygon([FreeCAD.Vector(*p) for p in
                                            np.vstack([loop, loop[:1]])]))
-        self.assertAlmostEqual(self.ch.area_mm2, face.Area, delta=1e-3 * face.Area)
+        self.assertAlmostEqual(self.ch.area_mm2, face.Area, delta=1e-6 * face.Area)
         com = self.frame.to_2d(np.array(face.CenterOfMass))[0]
-        self.assertLess(np.linalg.norm(com - self.ch.centroid_mm), 0.01)
+        self.assertLess(np.linalg.norm(com - self.ch.centroid_mm), 1e-3)
 
     def test_blade_like_characteristics(self):
         ch = self.ch
