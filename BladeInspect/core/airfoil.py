@@ -479,20 +479,29 @@ def extent(profile, direction):
 
 
 def _farthest_pair(profile):
-    """Maximum Feret (caliper) diameter: the two profile points furthest apart."""
+    """Maximum Feret (caliper) diameter: the two profile points furthest apart. Each end is the
+    point of the curve furthest from the other: the furthest dense sample, then Newton steps
+    kept within one sample spacing (a step must not run off to the nearest point, which is
+    stationary too)."""
     hull = profile.dense[ConvexHull(profile.dense).vertices]
-    # A coarse pair is enough to start: the Newton rounds below find the exact diameter.
     hull = hull[::max(1, len(hull) // 400)]
     d2 = np.sum((hull[:, None, :] - hull[None, :, :]) ** 2, axis=2)
     i, j = np.unravel_index(np.argmax(d2), d2.shape)
-    ui = profile.nearest_param(hull[i])
+    spacing = profile.length / len(profile.dense)
     uj = profile.nearest_param(hull[j])
-    for _ in range(20):
-        # Each end of the diameter is the point of the curve furthest from the other.
-        for _ in range(3):
-            ui = profile._newton_stationary(ui, profile.eval(uj))
-        for _ in range(3):
-            uj = profile._newton_stationary(uj, profile.eval(ui))
+
+    def furthest_from(u_other):
+        p = profile.eval(u_other)[0]
+        u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
+        start = u.copy()
+        for _ in range(_NEWTON_ITERATIONS):
+            u = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+        return u
+
+    ui = furthest_from(uj)
+    for _ in range(6):
+        uj = furthest_from(ui)
+        ui = furthest_from(uj)
     return ui[0], uj[0], profile.eval(ui)[0], profile.eval(uj)[0]
 
 
