@@ -108,11 +108,6 @@ class Profile:
         d /= np.linalg.norm(d, axis=1)[:, None]
         return np.column_stack([d[:, 1], -d[:, 0]])
 
-    def curvature(self, u):
-        """Signed curvature, positive where the profile is convex."""
-        d1, d2 = self.eval(u, 1), self.eval(u, 2)
-        return _cross2(d1, d2) / np.linalg.norm(d1, axis=1) ** 3
-
     def nearest_param(self, xy):
         _, i = self._tree.query(np.atleast_2d(xy))
         return self.dense_u[i]
