@@ -257,6 +257,23 @@ class LeanBow(unittest.TestCase):
         self.assertAlmostEqual(out["bow_magnitude_mm"][2], 0.005, delta=1e-12)
 
 
+class Corners(unittest.TestCase):
+    def test_a_sharp_trailing_edge_is_flagged(self):
+        """NACA 0012 closed by its own formula's sides meeting at a point: a corner."""
+        sec = NacaSection("0012", c=50.0)
+        xi = np.linspace(0.0, 1.0, 2500)
+        upper, lower = sec.surface(xi, True), sec.surface(xi, False)
+        upper[-1] = lower[-1] = [50.0, 0.0]
+        pts = np.vstack([lower, upper[::-1][1:-1]])
+        ch = airfoil.characteristics(pts)
+        self.assertEqual(len(ch.warnings), 1)
+        self.assertIn("corner at the TE", ch.warnings[0])
+
+    def test_round_edges_raise_no_warning(self):
+        for pts in (ArcSection().points(), NacaSection("0012", x0=0.97).points()):
+            self.assertEqual(airfoil.characteristics(pts).warnings, [])
+
+
 class BadInput(unittest.TestCase):
     def test_one_line_errors(self):
         with self.assertRaises(InputError):

@@ -39,6 +39,9 @@ _FEET = 400                 # feet on one side seeding the inscribed circles
 _END_FEET = 17              # finer feet closing in on each end of the camber line
 _END_ROUNDS = 4
 _SEED_STRIDE = 4
+# Consecutive input segments turning by more than this make a corner (not a rounded edge).
+_CORNER_DEG = 20.0
+_CORNER_RUN = 5
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_MIN_POINTS = 12
@@ -72,6 +75,7 @@ class Profile:
         if _signed_area(pts) < 0:
             pts = pts[::-1].copy()
         self.points = pts
+        self.corners = _corners(pts) if noise_mm == 0 else np.zeros(0, int)
         closed = np.vstack([pts, pts[:1]])
         u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
         self.length = float(u[-1])
@@ -143,6 +147,22 @@ class Profile:
         x, w = np.polynomial.legendre.leggauss(order)
         a, b = knots[:-1, None], knots[1:, None]
         return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
+
+
+def _corners(pts):
+    """Indices of input points where the polyline turns by more than _CORNER_DEG: a corner no
+    smooth curve through the points has (a sharp edge, a kink between faces)."""
+    d = np.diff(np.vstack([pts[-1:], pts, pts[:1]]), axis=0)
+    a = np.arctan2(d[:, 1], d[:, 0])
+    turn = np.abs(np.degrees(np.angle(np.exp(1j * np.diff(a)))))
+    sharp = np.flatnonzero(turn > _CORNER_DEG)
+    # A corner may bend over a few points: one index (the sharpest) per run of them.
+    if not len(sharp):
+        return sharp
+    groups = np.split(sharp, np.flatnonzero(np.diff(sharp) > _CORNER_RUN) + 1)
+    if len(groups) > 1 and groups[0][0] + len(pts) - groups[-1][-1] <= _CORNER_RUN:
+        groups = [np.concatenate([groups[-1], groups[0]])] + groups[1:-1]
+    return np.array([g[np.argmax(turn[g])] for g in groups], dtype=int)
 
 
 def _signed_area(pts):
@@ -661,6 +681,7 @@ class Characteristics:
     profile: Profile = field(repr=False)
     suction_range: tuple = ()     # unwrapped parameter ranges of the two sides
     pressure_range: tuple = ()
+    warnings: list = field(default_factory=list)
 
     def as_dict(self):
         return {
@@ -681,7 +702,7 @@ class Characteristics:
             "inlet_angle_deg": self.inlet_angle_deg, "outlet_angle_deg": self.outlet_angle_deg,
             "area_mm2": self.area_mm2, "centroid_mm": self.centroid_mm.tolist(),
             "le_point_mm": self.le_point.tolist(), "te_point_mm": self.te_point.tolist(),
-            "le_rule": self.le_rule,
+            "le_rule": self.le_rule, "warnings": list(self.warnings),
         }
 
 
@@ -773,6 +794,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     te_thk = _thickness_normal(profile, mcl, mcl.length - np.array(offsets)).tolist()
 
     area, centroid = area_centroid(profile)
+    warnings = _corner_warnings(profile, le, te, nose_tail)
     return Characteristics(
         chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
@@ -786,7 +808,21 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         centroid_mm=centroid, le_point=le, te_point=te, chord_dir=chord_dir, engine_axis=axis,
         le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
         profile=profile, suction_range=(suction.lo, suction.hi),
-        pressure_range=(pressure.lo, pressure.hi))
+        pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
+
+
+def _corner_warnings(profile, le, te, chord):
+    """One line per corner of the input points: the spline rounds a corner off over a point
+    spacing, so an edge radius, edge point and chord read there are not the part's."""
+    out = []
+    for i in profile.corners:
+        p = profile.points[i]
+        where = ("at the LE" if np.linalg.norm(p - le) < 0.02 * chord else
+                 "at the TE" if np.linalg.norm(p - te) < 0.02 * chord else "on a side")
+        out.append("corner %s at (%.4f, %.4f) mm: the profile is not smooth there; "
+                   "characteristics near it (edge radius, edge point, chords, metal angle) "
+                   "are not trustworthy" % (where, p[0], p[1]))
+    return out
 
 
 def _stations_to_arc(mcl, le, chord_dir, chord, stations_pct):
