@@ -13,7 +13,7 @@ from . import sections
 
 # Finer than the cut for deviations: the interpolating spline through it then misses a G1
 # junction of an edge circle and a flank by nanometres (about h^2 times the curvature jump).
-AIRFOIL_SPACING = 0.005
+AIRFOIL_SPACING = 0.01
 
 
 @dataclass

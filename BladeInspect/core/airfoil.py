@@ -35,9 +35,9 @@ CHORD_METHODS = ("nose-tail", "caliper", "tangent")
 ZONES = ("LE", "TE", "suction", "pressure")
 
 _NEWTON_ITERATIONS = 12
-_FEET = 400                 # feet on one side seeding the inscribed circles
+_FEET = 300                 # feet on one side seeding the inscribed circles
 _END_FEET = 17              # finer feet closing in on each end of the camber line
-_END_ROUNDS = 4
+_END_ROUNDS = 3
 _SEED_STRIDE = 4
 # Consecutive input segments turning by more than this make a corner (not a rounded edge).
 _CORNER_DEG = 20.0
@@ -101,7 +101,8 @@ class Profile:
         i = np.searchsorted(self._breaks, u, side="right") - 1
         i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
         t = (u - self._breaks[i])[:, None]
-        c0, c1, c2, c3 = (self._coef[i, k] for k in range(4))
+        c = self._coef[i]
+        c0, c1, c2, c3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
         p = ((c0 * t + c1) * t + c2) * t + c3
         d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
         d2 = 6.0 * c0 * t + 2.0 * c1
@@ -774,13 +775,21 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         raise InputError("chord method tangent: the pressure side is not concave, no line "
                          "touches the profile at both edges across it")
 
-    # Largest inscribed circle: parabola through the largest discrete circle and its
-    # neighbours (in camber-line arc length), its centre re-solved exactly on the axis.
+    # Largest inscribed circle: the radius along the camber line is flat at its maximum, so
+    # it is zoomed in on twice by exact circles at 9 arc lengths and a parabola through them.
     k = int(np.clip(np.argmax(radii), 1, len(radii) - 2))
     s_c = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(centres, axis=0), axis=1))])
-    a2, a1, _ = np.polyfit(s_c[k - 1:k + 2] - s_c[k], radii[k - 1:k + 2], 2)
-    s_max = s_c[k] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
-    s_max = float(np.clip(s_max, s_c[k - 1], s_c[k + 1]))
+    lo_s, hi_s = s_c[k - 1], s_c[k + 1]
+    for _ in range(2):
+        s_try = np.linspace(lo_s, hi_s, 9)
+        seeds, _ = mcl.at(mcl.le_extension + s_try)
+        cs, _, _, fs, _ = _refine_centres(profile, side_a, side_b, seeds)
+        r_try = np.linalg.norm(fs - cs, axis=1)
+        a2, a1, _ = np.polyfit(s_try - s_try[4], r_try, 2)
+        s_max = s_try[4] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
+        s_max = float(np.clip(s_max, lo_s, hi_s))
+        half = (hi_s - lo_s) / 8.0
+        lo_s, hi_s = s_max - half, s_max + half
     seed, _ = mcl.at(mcl.le_extension + s_max)
     c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed)
     max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
