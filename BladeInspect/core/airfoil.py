@@ -46,7 +46,7 @@ _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_MIN_POINTS = 12
 _END_WINDOW_MM = 0.5
-_CIRCULAR_EDGE = 1e-2
+_END_SKIP = 0.5
 _EDGE_CORE = 1e-3
 _MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
 # A camber-line circle clears the profile round the edge by this fraction of its radius; the
@@ -384,39 +384,60 @@ def _line_end(centres, radii, end, edge=None):
     interpolating spline's end slope, which the closely packed last centres of a circular edge
     and noise would tilt.
 
-    With ``edge`` (the fitted edge circle) centred within _CIRCULAR_EDGE of its radius from the
-    last centre, the edge is circular and the locus ends at the edge circle's centre (where
-    its inscribed circles become the edge circle): the centres nearer to it than _EDGE_CORE of
-    its radius (ill-conditioned bisectors) are dropped and the parabola is followed up to the
-    point nearest to it, which becomes the line's end."""
+    With ``edge`` (the fitted edge circle): the centres nearer to its centre than _EDGE_CORE of
+    its radius are dropped (ill-conditioned bisectors on a circular edge), and when its centre
+    lies ahead of the line's end, the parabola is followed on (at most one edge radius) to the
+    point nearest to it, which becomes the line's end -- on a circular edge the inscribed
+    circles end as the edge circle, at its centre; on a varying-curvature nose the line ends
+    abreast of the fitted circle's centre. When that centre lies before the end (the nose's
+    curvature grows beyond it), the line is cut back to its point nearest the centre. Either
+    way the line ends abreast of the fitted edge circle's centre, a rule continuous in the
+    geometry and blind to the last, ill-conditioned centres."""
     c = centres if end == -1 else centres[::-1]
     r = radii if end == -1 else radii[::-1]
-    if edge is not None and np.linalg.norm(c[-1] - edge.center) < _CIRCULAR_EDGE * edge.radius:
+    if edge is not None:
         far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
         c, r = c[far], r[far]
-    else:
-        edge = None
+        c, r = _cut_abreast(c, r, edge.center)
     seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     s = s - s[-1]
+    # The last stretch of the locus bends towards the centre of curvature of the edge's
+    # tightest point when the edge is not a circle: it is left out of the fit.
+    skip = _END_SKIP * (r[-1] if edge is None else edge.radius)
     window = min(max(r[-1], _END_WINDOW_MM), 0.1 * -s[0])
-    sel = s >= -window
+    sel = (s >= -(skip + window)) & (s <= -skip)
     if sel.sum() < 4:
         sel = np.arange(len(s)) >= len(s) - 4
     coef = np.polyfit(s[sel], c[sel], 2)
     tangent = _unit(coef[1])
-    if edge is not None:
+    ahead = 0.0 if edge is None else float((edge.center - c[-1]) @ tangent)
+    if ahead > 0:
         reach = 0.0
         for _ in range(5):
             p = (coef[0] * reach + coef[1]) * reach + coef[2]
             d = _unit(2 * coef[0] * reach + coef[1])
-            reach += float((edge.center - p) @ d)
+            reach = min(reach + float((edge.center - p) @ d), edge.radius)
         tip = (coef[0] * reach + coef[1]) * reach + coef[2]
         tangent = _unit(2 * coef[0] * reach + coef[1])
         c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
     if end == 0:
         return c[::-1], r[::-1], tangent
     return c, r, tangent
+
+
+def _cut_abreast(c, r, point):
+    """The polyline of centres c (radii r) cut at its point nearest ``point`` when that lies
+    before its last centre (a nose whose curvature still grows beyond the fitted circle)."""
+    a, b = c[:-1], c[1:]
+    e = b - a
+    t = np.clip(np.einsum("ij,ij->i", point - a, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
+    foot = a + t[:, None] * e
+    i = int(np.argmin(np.linalg.norm(foot - point, axis=1)))
+    if i == len(e) - 1 and t[i] >= 1.0:
+        return c, r
+    rr = r[i] + t[i] * (r[i + 1] - r[i])
+    return np.vstack([c[:i + 1], foot[i]]), np.concatenate([r[:i + 1], [rr]])
 
 
 def _ray_hit(profile, origin, direction):
