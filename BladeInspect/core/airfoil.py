@@ -47,6 +47,7 @@ _ZONE_SAMPLES = 400
 _ZONE_MIN_POINTS = 12
 _END_WINDOW_MM = 0.5
 _END_SKIP = 0.5
+_BEND_WARN_DEG = 1.0
 _EDGE_CORE = 1e-3
 _MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
 # A camber-line circle clears the profile round the edge by this fraction of its radius; the
@@ -411,19 +412,49 @@ def _line_end(centres, radii, end, edge=None):
         sel = np.arange(len(s)) >= len(s) - 4
     coef = np.polyfit(s[sel], c[sel], 2)
     tangent = _unit(coef[1])
+    # How far the last stretch turns from that tangent: the metal angle's definition spread.
+    last = s >= -skip
+    bend = 0.0
+    if last.sum() >= 2 and np.linalg.norm(c[-1] - c[last][0]) > 0:
+        chord = _unit(c[-1] - c[last][0])
+        bend = float(np.degrees(np.arccos(np.clip(chord @ tangent, -1.0, 1.0))))
     ahead = 0.0 if edge is None else float((edge.center - c[-1]) @ tangent)
     if ahead > 0:
+        # Along the parabola, moved to pass through the last centre (where the locus bends
+        # the fitted parabola misses it), on to the point abreast of the edge circle's centre.
+        offset = c[-1] - coef[2]
         reach = 0.0
         for _ in range(5):
-            p = (coef[0] * reach + coef[1]) * reach + coef[2]
+            p = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
             d = _unit(2 * coef[0] * reach + coef[1])
             reach = min(reach + float((edge.center - p) @ d), edge.radius)
-        tip = (coef[0] * reach + coef[1]) * reach + coef[2]
+        tip = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
         tangent = _unit(2 * coef[0] * reach + coef[1])
         c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
     if end == 0:
-        return c[::-1], r[::-1], tangent
-    return c, r, tangent
+        return c[::-1], r[::-1], tangent, bend
+    return c, r, tangent, bend
+
+
+def _closed_end(profile, centres, radii, end, circle, notes):
+    """The line closed onto the fitted edge circle at one end (see _line_end) and its edge
+    point; when the closed end's tangent does not meet the profile (a corner, a clipped
+    section), the unclosed end, with a note saying so."""
+    c, r, out, bend = _line_end(centres, radii, end, circle)
+    try:
+        u, point = _ray_hit(profile, c[end], out)
+    except InputError:
+        c, r, out, bend = _line_end(centres, radii, end)
+        u, point = _ray_hit(profile, c[end], out)
+        notes.append("the camber line's end at (%.4f, %.4f) mm could not be brought abreast "
+                     "of its edge circle; it ends at its last inscribed circle"
+                     % tuple(c[end]))
+    if bend > _BEND_WARN_DEG:
+        notes.append("the camber line turns %.2f deg from its end tangent within its last "
+                     "half edge radius near (%.4f, %.4f) mm (the edge is not a circle): the "
+                     "metal angle there depends on the rule (docs/airfoil.md)"
+                     % (bend, c[end][0], c[end][1]))
+    return c, r, out, u, point
 
 
 def _cut_abreast(c, r, point):
@@ -754,16 +785,17 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
 
     # Camber line end tangents, extended to the profile: the two edge points.
     # First the edge circles about the locus's ends, then the ends closed onto circular edges.
-    _, _, out_a = _line_end(centres, radii, 0)
-    _, _, out_b = _line_end(centres, radii, -1)
+    out_a = _line_end(centres, radii, 0)[2]
+    out_b = _line_end(centres, radii, -1)[2]
     circle_a = _edge_circle(profile, centres[0], out_a, _ray_hit(profile, centres[0], out_a)[0][0],
                             edge_zone_deg)
     circle_b = _edge_circle(profile, centres[-1], out_b,
                             _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
-    centres, radii, out_a = _line_end(centres, radii, 0, circle_a)
-    centres, radii, out_b = _line_end(centres, radii, -1, circle_b)
-    ua_end, end_a = _ray_hit(profile, centres[0], out_a)
-    ub_end, end_b = _ray_hit(profile, centres[-1], out_b)
+    notes = []
+    centres, radii, out_a, ua_end, end_a = _closed_end(profile, centres, radii, 0, circle_a,
+                                                       notes)
+    centres, radii, out_b, ub_end, end_b = _closed_end(profile, centres, radii, -1, circle_b,
+                                                       notes)
     circle_a = _edge_circle(profile, circle_a.center, out_a, ua_end[0], edge_zone_deg)
     circle_b = _edge_circle(profile, circle_b.center, out_b, ub_end[0], edge_zone_deg)
     t0, t1 = -out_a, out_b
@@ -824,7 +856,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     te_thk = _thickness_normal(profile, mcl, mcl.length - np.array(offsets)).tolist()
 
     area, centroid = area_centroid(profile)
-    warnings = _corner_warnings(profile, le, te, nose_tail)
+    warnings = _corner_warnings(profile, le, te, nose_tail) + notes
     return Characteristics(
         chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
