@@ -11,9 +11,9 @@ import numpy as np
 from ..core.errors import InputError
 from . import sections
 
-# Finer than the cut for deviations: the interpolating spline through it then misses a G1
-# junction of an edge circle and a flank by nanometres (about h^2 times the curvature jump).
-AIRFOIL_SPACING = 0.01
+# The cut's own spacing: the interpolating spline through it misses a G1 junction of an edge
+# circle and a flank by about h^2 times the curvature jump / 8 -- nanometres.
+AIRFOIL_SPACING = sections.DEFAULT_SPACING
 
 
 @dataclass
