@@ -577,10 +577,12 @@ def _tangent_from(profile, point, u):
     """Newton on cross(S(u) - point, S'(u)) = 0: where a line from ``point`` touches."""
     u = np.atleast_1d(float(u))
     for _ in range(_NEWTON_ITERATIONS):
-        d = profile.eval(u) - point
-        f = _cross2(d, profile.eval(u, 1))
-        df = _cross2(d, profile.eval(u, 2))
-        u = u - f / np.where(np.abs(df) > 1e-15, df, 1e-15)
+        p, d1, d2 = profile.eval3(u)
+        d = p - point
+        step = _cross2(d, d1) / np.where(np.abs(_cross2(d, d2)) > 1e-15, _cross2(d, d2), 1e-15)
+        u = u - step
+        if abs(step[0]) < 1e-13 * profile.length:
+            break
     return u[0]
 
 
@@ -595,8 +597,11 @@ def _pressure_bitangent(profile, pressure, le_u, te_u):
         return None
     u1, u2 = hu[k], hu[k] + gaps[k]
     for _ in range(20):
+        before = (u1, u2)
         u1 = _tangent_from(profile, profile.eval([u2])[0], u1)
         u2 = _tangent_from(profile, profile.eval([u1])[0], u2)
+        if max(abs(u1 - before[0]), abs(u2 - before[1])) < 1e-12 * profile.length:
+            break
     p1, p2 = profile.eval([u1])[0], profile.eval([u2])[0]
     le = profile.eval([le_u])[0]
     if np.linalg.norm(p1 - le) > np.linalg.norm(p2 - le):
@@ -688,7 +693,7 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     base = profile.dense_u[i0]
     a = np.array([base - behind * h, base + (ahead - 1) * h])
     b = a + np.array([-h, h])
-    for _ in range(40):
+    for _ in range(32):          # h / 2**32: far below a nanometre
         m = 0.5 * (a + b)
         ok = inside(m)
         a, b = np.where(ok, m, a), np.where(ok, b, m)
