@@ -1,0 +1,1048 @@
+"""Airfoil characteristics of one closed 2D section profile (issue 15), numpy/scipy only.
+
+Input: the profile in its section plane as an (N, 2) array of points ordered around the loop
+(either direction; a repeated closing point is dropped). Unordered measured points are first
+ordered by their foot on the nominal (``order_by_nominal``). The profile is represented by a
+periodic cubic spline through the points (interpolating; or smoothing with ``noise_mm``, the
+points' 1-sigma scatter), parametrised by chord length (about arc length, in mm).
+
+Every definition (mean camber line, chords, edge radii, thicknesses, angles, contour errors)
+is written out in docs/airfoil.md; the names here are the fields of result.json's ``airfoil``
+block. Lengths in mm, angles in degrees, counter-clockwise positive in the section's 2D frame.
+"""
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from scipy.interpolate import CubicSpline, PPoly, splprep
+from scipy.spatial import ConvexHull, cKDTree
+
+from .errors import InputError
+
+DEFAULT_EDGE_OFFSETS_MM = (0.5, 1.0, 2.0)
+# Edge zone of the LE/TE circle fit: profile points seen from the end of the inscribed-circle
+# locus within this angle of the mean camber line's outward direction (docs/airfoil.md).
+DEFAULT_EDGE_ZONE_DEG = 45.0
+# An inscribed circle belongs to the camber line only while its two contacts are at least this
+# far apart as seen from its centre; closer, the circle sits in an edge and its centre is
+# ill-conditioned (the bisector of two nearly parallel normals).
+MIN_CONTACT_ANGLE_DEG = 60.0
+# Contour zones: a point is at an edge when its foot on the nominal lies within this fraction
+# of the chord from that end along the chord (as inspect/sections.py).
+CONTOUR_EDGE_FRACTION = 0.03
+CHORD_METHODS = ("nose-tail", "caliper", "tangent")
+ZONES = ("LE", "TE", "suction", "pressure")
+
+_NEWTON_ITERATIONS = 12
+_FEET = 300                 # feet on one side seeding the inscribed circles
+_END_FEET = 17              # finer feet closing in on each end of the camber line
+_END_ROUNDS = 3
+_SEED_STRIDE = 4
+# Consecutive input segments turning by more than this make a corner (not a rounded edge).
+_CORNER_DEG = 20.0
+_CORNER_RUN = 5
+_ZONE_ROUNDS = 20
+_ZONE_SAMPLES = 400
+_ZONE_MIN_POINTS = 12
+_END_WINDOW_MM = 0.5
+_END_SKIP = 0.5
+_BEND_WARN_DEG = 1.0
+_EDGE_CORE = 1e-3
+_MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
+# A camber-line circle clears the profile round the edge by this fraction of its radius; the
+# camber line thus stops within 1e-4 r of an exact circular edge's centre.
+_EDGE_GAP = 1e-4
+_DENSE_SPACING_MM = 0.02
+_DENSE_MIN, _DENSE_MAX = 2000, 8000
+
+
+# ---------------------------------------------------------------- the profile curve
+
+class Profile:
+    """A closed section profile as a periodic cubic spline, counter-clockwise."""
+
+    def __init__(self, points, noise_mm=0.0):
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 8:
+            raise InputError("airfoil profile: need an (N, 2) array of at least 8 points, got "
+                             "shape %s" % (pts.shape,))
+        if not np.all(np.isfinite(pts)):
+            raise InputError("airfoil profile: points must be finite")
+        step = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+        pts = np.vstack([pts[:1], pts[1:][step > 1e-12]])
+        if np.linalg.norm(pts[-1] - pts[0]) < 1e-12:
+            pts = pts[:-1]
+        if _signed_area(pts) < 0:
+            pts = pts[::-1].copy()
+        self.points = pts
+        self.corners = _corners(pts) if noise_mm == 0 else np.zeros(0, int)
+        closed = np.vstack([pts, pts[:1]])
+        u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+        self.length = float(u[-1])
+        self.point_params = u[:-1]
+        smoothing = len(pts) * float(noise_mm) ** 2
+        self._tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)
+        pieces = [PPoly.from_spline((self._tck[0], cx, 3)) for cx in self._tck[1]]
+        keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
+        keep &= np.diff(pieces[0].x) > 0
+        self._breaks = pieces[0].x[:-1][keep]
+        self._coef = np.stack([pp.c[:, keep] for pp in pieces], axis=-1).transpose(1, 0, 2)
+        n_dense = int(np.clip(self.length / _DENSE_SPACING_MM, _DENSE_MIN, _DENSE_MAX))
+        self.dense_u = np.linspace(0.0, self.length, n_dense, endpoint=False)
+        self.dense = self.eval(self.dense_u)
+        self._tree = cKDTree(self.dense)
+
+    def eval(self, u, der=0):
+        return self.eval3(u)[der]
+
+    def eval3(self, u):
+        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+        u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
+        i = np.searchsorted(self._breaks, u, side="right") - 1
+        i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
+        t = (u - self._breaks[i])[:, None]
+        c = self._coef[i]
+        c0, c1, c2, c3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
+        p = ((c0 * t + c1) * t + c2) * t + c3
+        d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
+        d2 = 6.0 * c0 * t + 2.0 * c1
+        return p, d1, d2
+
+    def outward_normal(self, u):
+        d = self.eval(u, 1)
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        return np.column_stack([d[:, 1], -d[:, 0]])
+
+    def nearest_param(self, xy):
+        _, i = self._tree.query(np.atleast_2d(xy))
+        return self.dense_u[i]
+
+    def closest(self, xy, u0=None, lo=None, hi=None):
+        """Feet of ``xy`` on the curve by Newton from ``u0`` (default the nearest dense sample),
+        parameters kept in [lo, hi] (unwrapped) when given. Returns (u, foot points)."""
+        xy = np.atleast_2d(xy)
+        u = self.nearest_param(xy) if u0 is None else np.array(u0, dtype=float)
+        for _ in range(_NEWTON_ITERATIONS):
+            new = self._newton_stationary(u, xy)
+            if lo is not None:
+                new = np.minimum(np.maximum(new, lo), hi)
+            done = np.max(np.abs(new - u), initial=0.0) < 1e-13 * self.length
+            u = new
+            if done:
+                break
+        return u, self.eval(u)
+
+    def _newton_stationary(self, u, xy):
+        # Stationary points of |S(u) - xy|^2: the closest point when started next to it.
+        s, s1, s2 = self.eval3(u)
+        d = s - xy
+        g = np.einsum("ij,ij->i", d, s1)
+        h = np.einsum("ij,ij->i", s1, s1) + np.einsum("ij,ij->i", d, s2)
+        h = np.where(np.abs(h) > 1e-12, h, np.einsum("ij,ij->i", s1, s1))
+        return u - g / h
+
+    def knot_quadrature(self, order=5):
+        """Gauss-Legendre nodes and weights over every knot span: exact for polynomials of
+        degree 2*order-1 in the spline's parameter."""
+        knots = np.unique(self._tck[0][(self._tck[0] >= 0) & (self._tck[0] <= self.length)])
+        x, w = np.polynomial.legendre.leggauss(order)
+        a, b = knots[:-1, None], knots[1:, None]
+        return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
+
+
+def _corners(pts):
+    """Indices of input points where the polyline turns by more than _CORNER_DEG: a corner no
+    smooth curve through the points has (a sharp edge, a kink between faces)."""
+    d = np.diff(np.vstack([pts[-1:], pts, pts[:1]]), axis=0)
+    a = np.arctan2(d[:, 1], d[:, 0])
+    turn = np.abs(np.degrees(np.angle(np.exp(1j * np.diff(a)))))
+    sharp = np.flatnonzero(turn > _CORNER_DEG)
+    # A corner may bend over a few points: one index (the sharpest) per run of them.
+    if not len(sharp):
+        return sharp
+    groups = np.split(sharp, np.flatnonzero(np.diff(sharp) > _CORNER_RUN) + 1)
+    if len(groups) > 1 and groups[0][0] + len(pts) - groups[-1][-1] <= _CORNER_RUN:
+        groups = [np.concatenate([groups[-1], groups[0]])] + groups[1:-1]
+    return np.array([g[np.argmax(turn[g])] for g in groups], dtype=int)
+
+
+def _signed_area(pts):
+    x, y = pts[:, 0], pts[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _unit(v):
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _angle_deg(direction, axis):
+    cross = axis[0] * direction[1] - axis[1] * direction[0]
+    return float(np.degrees(np.arctan2(cross, np.dot(axis, direction))))
+
+
+def _cross2(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+# ---------------------------------------------------------------- inscribed circles
+
+@dataclass
+class _Side:
+    lo: float     # unwrapped parameter range of the side, lo < hi
+    hi: float
+    u: np.ndarray
+    xy: np.ndarray
+    tree: cKDTree
+
+
+def _side(profile, lo, hi):
+    if hi <= lo:
+        hi += profile.length
+    u = profile.dense_u.copy()
+    u = np.where(u < lo, u + profile.length, u)
+    keep = (u >= lo) & (u <= hi)
+    u = np.sort(u[keep])
+    xy = profile.eval(u)
+    return _Side(lo, hi, u, xy, cKDTree(xy))
+
+
+def _foot(profile, side, xy, u0=None):
+    if u0 is None:
+        _, i = side.tree.query(xy)
+        u0 = side.u[i]
+    return profile.closest(xy, u0, side.lo, side.hi)
+
+
+def _refine_centres(profile, a, b, centre):
+    """Centres equidistant from sides a and b (the medial axis between them), by Newton on
+    d_a - d_b along its gradient (the difference of the unit vectors from the feet). The feet
+    are global nearest points at the start and the end, Newton-tracked in between."""
+    c = centre.copy()
+    ua, ub = None, None
+    for _ in range(30):
+        ua, fa = _foot(profile, a, c, ua)
+        ub, fb = _foot(profile, b, c, ub)
+        va, vb = c - fa, c - fb
+        da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
+        g = va / da[:, None] - vb / db[:, None]
+        g2 = np.einsum("ij,ij->i", g, g)
+        f = da - db
+        ok = g2 > 1e-12
+        c[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
+        if np.all(np.abs(f) < 1e-11):
+            break
+    ua, fa = _foot(profile, a, c)
+    ub, fb = _foot(profile, b, c)
+    return c, ua, ub, fa, fb
+
+
+def _circles_from_feet(profile, a, b, ua0):
+    """Inscribed circles seeded at feet ua0 on side a: the largest circle tangent there that no
+    point of b enters, refined to be exactly equidistant from both sides. Returns centres,
+    radii, feet parameters on a, and whether each is a circle of the camber line."""
+    fa = profile.eval(ua0)
+    inward = -profile.outward_normal(ua0)
+    # Seeds need only be near: every _SEED_STRIDE-th point of b.
+    q = b.xy[::_SEED_STRIDE]
+    dx = q[None, :, 0] - fa[:, None, 0]
+    dy = q[None, :, 1] - fa[:, None, 1]
+    num = dx * dx + dy * dy
+    den = 2.0 * (dx * inward[:, None, 0] + dy * inward[:, None, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = np.where(den > 1e-12, num / den, np.inf)
+    r0 = radius.min(axis=1)
+    r0 = np.where(np.isfinite(r0), r0, 0.0)
+    centre = fa + r0[:, None] * inward
+    c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
+    r = np.linalg.norm(fa - c, axis=1)
+    va, vb = _unit(fa - c), _unit(fb - c)
+    contact = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", va, vb), -1, 1)))
+    tol = 1e-9 * profile.length
+    interior = (ua > a.lo + tol) & (ua < a.hi - tol) & (ub > b.lo + tol) & (ub < b.hi - tol)
+    # A circle of the camber line leaves the profile between its two contacts, round the
+    # nearer edge; the edge circle itself (an exact circular edge) runs along it there.
+    via_lo = (ua - a.lo) + (b.hi - ub) < (a.hi - ua) + (ub - b.lo)
+    mid = np.where(via_lo, (ua + ub - profile.length) / 2.0, (ua + ub) / 2.0)
+    gap = np.linalg.norm(profile.eval(mid) - c, axis=1) - r
+    # Inscribed: no point of the profile nearer than the contacts (a foot stuck at a local
+    # stationary point next to a closer edge would make a circle that crosses the profile).
+    nearest = np.linalg.norm(profile.closest(c)[1] - c, axis=1)
+    inscribed = nearest > r - 1e-9 * np.maximum(r, 1.0)
+    ok = ((r0 > 0) & interior & inscribed & (contact >= MIN_CONTACT_ANGLE_DEG)
+          & (gap > _EDGE_GAP * r))
+    return c, r, ua, ok
+
+
+def _medial_axis(profile, a, b):
+    """Inscribed circles between sides a and b, ordered from a's start to its end, from feet
+    clustered towards a's ends; each end of the run of camber-line circles is then closed in
+    on by rounds of finer feet, so the run reaches the edges to a small fraction of a step."""
+    t = (1.0 - np.cos(np.linspace(0.0, np.pi, _FEET))) / 2.0
+    feet = a.lo + (a.hi - a.lo) * t[1:-1]
+    c, r, ua, ok = _circles_from_feet(profile, a, b, feet)
+    # The camber line is the longest run of camber-line circles; a stray one seeded on an edge
+    # (a degenerate bisector that slid onto the axis) does not start it.
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+    starts, stops = edges[::2], edges[1::2]
+    longest = int(np.argmax(stops - starts)) if len(starts) else 0
+    if not len(starts) or stops[longest] - starts[longest] < 4:
+        raise InputError("airfoil profile: fewer than 4 inscribed circles between its sides; "
+                         "not an airfoil-like closed profile")
+    run = np.arange(starts[longest], stops[longest])
+    found = [(c[run], r[run], ua[run])]
+    for inner, outer in ((run[0], run[0] - 1), (run[-1], run[-1] + 1)):
+        u_in = feet[inner]
+        u_out = feet[outer] if 0 <= outer < len(feet) else (a.lo if outer < 0 else a.hi)
+        for _ in range(_END_ROUNDS):
+            sub = np.linspace(u_in, u_out, _END_FEET)
+            cs, rs, uas, oks = _circles_from_feet(profile, a, b, sub)
+            found.append((cs[oks], rs[oks], uas[oks]))
+            n_run = len(oks) if oks.all() else int(np.argmin(oks))
+            if n_run == 0 or n_run == len(oks):
+                break
+            u_in, u_out = sub[n_run - 1], sub[n_run]
+    c = np.vstack([f[0] for f in found])
+    r = np.concatenate([f[1] for f in found])
+    order = np.argsort(np.concatenate([f[2] for f in found]))
+    c, r = c[order], r[order]
+    # Near a circular edge the feet crowd at the edge's tangency points and their order may
+    # differ from the centres' by far below a micrometre: walking out from the middle, keep
+    # the centres that go on in the direction of the axis.
+    mid = len(c) // 2
+    keep = [mid, mid + 1]
+    for step in (1, -1):
+        chain = keep if step == 1 else keep[::-1]
+        i = chain[-1] + step
+        while 0 <= i < len(c):
+            last, before = c[chain[-1]], c[chain[-2]]
+            if np.dot(c[i] - last, last - before) > 0 and np.linalg.norm(c[i] - last) > 1e-9:
+                chain.append(i)
+            i += step
+        keep = chain if step == 1 else chain[::-1]
+    keep = np.array(keep)
+    return _thin(c[keep], r[keep])
+
+
+def _thin(c, r):
+    """Centres at least _MCL_SPACING_MM apart, both end centres kept: the closing-in rounds
+    pack centres far closer than their sub-nanometre scatter allows a tangent to be taken."""
+    keep = [0]
+    for i in range(1, len(c)):
+        if np.linalg.norm(c[i] - c[keep[-1]]) >= _MCL_SPACING_MM:
+            keep.append(i)
+    if keep[-1] != len(c) - 1:
+        if len(keep) > 1 and np.linalg.norm(c[-1] - c[keep[-1]]) < _MCL_SPACING_MM:
+            keep[-1] = len(c) - 1
+        else:
+            keep.append(len(c) - 1)
+    return c[keep], r[keep]
+
+
+# ---------------------------------------------------------------- mean camber line
+
+class CamberLine:
+    """Inscribed-circle centres (a cubic spline in arc length) extended straight along the end
+    tangents to the profile: the LE point at s = 0, the TE point at s = length."""
+
+    def __init__(self, le, centres, te, le_tangent, te_tangent):
+        self.centres = centres
+        seg = np.linalg.norm(np.diff(centres, axis=0), axis=1)
+        s = np.concatenate([[0.0], np.cumsum(seg)])
+        self._spline = CubicSpline(s, centres, axis=0)
+        self.le, self.te = le, te
+        self.le_extension = float(np.linalg.norm(centres[0] - le))
+        self.inner_length = float(s[-1])
+        self.length = self.le_extension + self.inner_length + float(
+            np.linalg.norm(te - centres[-1]))
+        self.le_tangent, self.te_tangent = le_tangent, te_tangent
+
+    def at(self, s):
+        """Points and unit tangents (LE -> TE) at arc lengths s from the LE point."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        inner = np.clip(s - self.le_extension, 0.0, self.inner_length)
+        p = self._spline(inner)
+        t = _unit(self._spline(inner, 1))
+        before = s < self.le_extension
+        after = s > self.le_extension + self.inner_length
+        p[before] = self.centres[0] + (s[before] - self.le_extension)[:, None] * self.le_tangent
+        t[before] = self.le_tangent
+        p[after] = self.centres[-1] + (s[after] - self.le_extension
+                                       - self.inner_length)[:, None] * self.te_tangent
+        t[after] = self.te_tangent
+        return p, t
+
+    def sample(self, n=400):
+        return self.at(np.linspace(0.0, self.length, n))[0]
+
+
+def _line_end(centres, radii, end, edge=None):
+    """The camber line's centres and its unit tangent at its first (end=0) or last (end=-1)
+    centre, pointing out of that end: the slope of a least-squares parabola (in arc length)
+    through the centres within the end window (the end circle's radius, at least
+    _END_WINDOW_MM, at most a tenth of the line) -- a parabola over a window rather than an
+    interpolating spline's end slope, which the closely packed last centres of a circular edge
+    and noise would tilt.
+
+    With ``edge`` (the fitted edge circle): the centres nearer to its centre than _EDGE_CORE of
+    its radius are dropped (ill-conditioned bisectors on a circular edge), and when its centre
+    lies ahead of the line's end, the parabola is followed on (at most one edge radius) to the
+    point nearest to it, which becomes the line's end -- on a circular edge the inscribed
+    circles end as the edge circle, at its centre; on a varying-curvature nose the line ends
+    abreast of the fitted circle's centre. When that centre lies before the end (the nose's
+    curvature grows beyond it), the line is cut back to its point nearest the centre. Either
+    way the line ends abreast of the fitted edge circle's centre, a rule continuous in the
+    geometry and blind to the last, ill-conditioned centres."""
+    c = centres if end == -1 else centres[::-1]
+    r = radii if end == -1 else radii[::-1]
+    if edge is not None:
+        far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
+        c, r = c[far], r[far]
+        c, r = _cut_abreast(c, r, edge.center)
+    seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    s = s - s[-1]
+    # The last stretch of the locus bends towards the centre of curvature of the edge's
+    # tightest point when the edge is not a circle: it is left out of the fit.
+    skip = _END_SKIP * (r[-1] if edge is None else edge.radius)
+    window = min(max(r[-1], _END_WINDOW_MM), 0.1 * -s[0])
+    sel = (s >= -(skip + window)) & (s <= -skip)
+    if sel.sum() < 4:
+        sel = np.arange(len(s)) >= len(s) - 4
+    coef = np.polyfit(s[sel], c[sel], 2)
+    tangent = _unit(coef[1])
+    # How far the last stretch turns from that tangent: the metal angle's definition spread.
+    last = s >= -skip
+    bend = 0.0
+    if last.sum() >= 2 and np.linalg.norm(c[-1] - c[last][0]) > 0:
+        chord = _unit(c[-1] - c[last][0])
+        bend = float(np.degrees(np.arccos(np.clip(chord @ tangent, -1.0, 1.0))))
+    ahead = 0.0 if edge is None else float((edge.center - c[-1]) @ tangent)
+    if ahead > 0:
+        # Along the parabola, moved to pass through the last centre (where the locus bends
+        # the fitted parabola misses it), on to the point abreast of the edge circle's centre.
+        offset = c[-1] - coef[2]
+        reach = 0.0
+        for _ in range(5):
+            p = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
+            d = _unit(2 * coef[0] * reach + coef[1])
+            reach = min(reach + float((edge.center - p) @ d), edge.radius)
+        tip = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
+        tangent = _unit(2 * coef[0] * reach + coef[1])
+        c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
+    if end == 0:
+        return c[::-1], r[::-1], tangent, bend
+    return c, r, tangent, bend
+
+
+def _closed_end(profile, centres, radii, end, circle, notes):
+    """The line closed onto the fitted edge circle at one end (see _line_end) and its edge
+    point; when the closed end's tangent does not meet the profile (a corner, a clipped
+    section), the unclosed end, with a note saying so."""
+    c, r, out, bend = _line_end(centres, radii, end, circle)
+    try:
+        u, point = _ray_hit(profile, c[end], out)
+    except InputError:
+        c, r, out, bend = _line_end(centres, radii, end)
+        u, point = _ray_hit(profile, c[end], out)
+        notes.append("the camber line's end at (%.4f, %.4f) mm could not be brought abreast "
+                     "of its edge circle; it ends at its last inscribed circle"
+                     % tuple(c[end]))
+    if bend > _BEND_WARN_DEG:
+        notes.append("the camber line turns %.2f deg from its end tangent within its last "
+                     "half edge radius near (%.4f, %.4f) mm (the edge is not a circle): the "
+                     "metal angle there depends on the rule (docs/airfoil.md)"
+                     % (bend, c[end][0], c[end][1]))
+    return c, r, out, u, point
+
+
+def _cut_abreast(c, r, point):
+    """The polyline of centres c (radii r) cut at its point nearest ``point`` when that lies
+    before its last centre (a nose whose curvature still grows beyond the fitted circle)."""
+    a, b = c[:-1], c[1:]
+    e = b - a
+    t = np.clip(np.einsum("ij,ij->i", point - a, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
+    foot = a + t[:, None] * e
+    i = int(np.argmin(np.linalg.norm(foot - point, axis=1)))
+    if i == len(e) - 1 and t[i] >= 1.0:
+        return c, r
+    rr = r[i] + t[i] * (r[i + 1] - r[i])
+    return np.vstack([c[:i + 1], foot[i]]), np.concatenate([r[:i + 1], [rr]])
+
+
+def _ray_hit(profile, origin, direction):
+    """First crossing of the ray origin + tau * direction (tau > 0) with the profile."""
+    p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
+    e = q - p
+    den = _cross2(direction, e)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = _cross2(p - origin, e) / den
+        lam = _cross2(p - origin, direction) / den
+    ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau > 0)
+    if not np.any(ok):
+        raise InputError("airfoil profile: the camber line's end tangent leaves the profile "
+                         "without crossing it; the profile is not closed around it")
+    i = np.flatnonzero(ok)[np.argmin(tau[ok])]
+    return _line_hit(profile, origin, direction, profile.dense_u[i]
+                     + lam[i] * (profile.length / len(profile.dense)))
+
+
+def _line_hit(profile, origin, direction, u):
+    """Newton on cross(S(u) - origin, direction) = 0 from u: the crossing of a line."""
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    origin = np.atleast_2d(origin)
+    direction = np.atleast_2d(direction)
+    for _ in range(_NEWTON_ITERATIONS):
+        f = _cross2(profile.eval(u) - origin, direction)
+        df = _cross2(profile.eval(u, 1), direction)
+        u = u - f / np.where(np.abs(df) > 1e-15, df, 1e-15)
+    return u, profile.eval(u)
+
+
+def _thickness_normal(profile, mcl, s):
+    """Thickness normal to the camber line at arc lengths s: the chord of the profile cut by
+    the camber line's normal there (nearest crossing on each side)."""
+    m, t = mcl.at(s)
+    n = np.column_stack([-t[:, 1], t[:, 0]])
+    out = np.empty(len(s))
+    p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
+    e = q - p
+    h = profile.length / len(profile.dense)
+    for k in range(len(s)):
+        den = _cross2(n[k], e)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = _cross2(p - m[k], e) / den
+            lam = _cross2(p - m[k], n[k]) / den
+        ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
+        plus, minus = ok & (tau > 0), ok & (tau < 0)
+        if not plus.any() or not minus.any():
+            out[k] = np.nan
+            continue
+        ip = np.flatnonzero(plus)[np.argmin(tau[plus])]
+        im = np.flatnonzero(minus)[np.argmax(tau[minus])]
+        u0 = profile.dense_u[[ip, im]] + lam[[ip, im]] * h
+        _, xy = _line_hit(profile, np.tile(m[k], (2, 1)), np.tile(n[k], (2, 1)), u0)
+        out[k] = float(np.linalg.norm(xy[0] - xy[1]))
+    return out
+
+
+# ---------------------------------------------------------------- extents and chords
+
+def _support(profile, direction, sign):
+    """The profile point furthest along sign * direction (Newton on S'(u).d = 0)."""
+    proj = sign * (profile.dense @ direction)
+    u = np.array([profile.dense_u[np.argmax(proj)]])
+    for _ in range(_NEWTON_ITERATIONS):
+        g = profile.eval(u, 1) @ direction
+        h = profile.eval(u, 2) @ direction
+        u = u - g / np.where(np.abs(h) > 1e-15, h, 1e-15)
+    return profile.eval(u)[0]
+
+
+def extent(profile, direction):
+    """Length of the profile's projection on ``direction`` (its caliper width along it)."""
+    d = _unit(direction)
+    return float((_support(profile, d, 1) - _support(profile, d, -1)) @ d)
+
+
+def _farthest_pair(profile):
+    """Maximum Feret (caliper) diameter: the two profile points furthest apart. Each end is the
+    point of the curve furthest from the other: the furthest dense sample, then Newton steps
+    kept within one sample spacing (a step must not run off to the nearest point, which is
+    stationary too)."""
+    hull = profile.dense[ConvexHull(profile.dense).vertices]
+    hull = hull[::max(1, len(hull) // 400)]
+    d2 = np.sum((hull[:, None, :] - hull[None, :, :]) ** 2, axis=2)
+    i, j = np.unravel_index(np.argmax(d2), d2.shape)
+    spacing = profile.length / len(profile.dense)
+    uj = profile.nearest_param(hull[j])
+
+    def furthest_from(u_other):
+        p = profile.eval(u_other)[0]
+        u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
+        start = u.copy()
+        for _ in range(_NEWTON_ITERATIONS):
+            u = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+        return u
+
+    ui = furthest_from(uj)
+    for _ in range(6):
+        uj = furthest_from(ui)
+        ui = furthest_from(uj)
+    return ui[0], uj[0], profile.eval(ui)[0], profile.eval(uj)[0]
+
+
+def _tangent_from(profile, point, u):
+    """Newton on cross(S(u) - point, S'(u)) = 0: where a line from ``point`` touches."""
+    u = np.atleast_1d(float(u))
+    for _ in range(_NEWTON_ITERATIONS):
+        p, d1, d2 = profile.eval3(u)
+        d = p - point
+        step = _cross2(d, d1) / np.where(np.abs(_cross2(d, d2)) > 1e-15, _cross2(d, d2), 1e-15)
+        u = u - step
+        if abs(step[0]) < 1e-13 * profile.length:
+            break
+    return u[0]
+
+
+def _pressure_bitangent(profile, pressure, le_u, te_u):
+    """The line touching the profile at both edges across the pressure side, as (point near
+    the LE, point near the TE), or None when the pressure side is not concave."""
+    hull = np.sort(ConvexHull(profile.dense).vertices)
+    hu = profile.dense_u[hull]
+    gaps = np.diff(np.concatenate([hu, [hu[0] + profile.length]]))
+    k = int(np.argmax(np.where(_in_range(hu + gaps / 2, pressure, profile.length), gaps, 0)))
+    if gaps[k] < 0.2 * (pressure.hi - pressure.lo):
+        return None
+    u1, u2 = hu[k], hu[k] + gaps[k]
+    for _ in range(20):
+        before = (u1, u2)
+        u1 = _tangent_from(profile, profile.eval([u2])[0], u1)
+        u2 = _tangent_from(profile, profile.eval([u1])[0], u2)
+        if max(abs(u1 - before[0]), abs(u2 - before[1])) < 1e-12 * profile.length:
+            break
+    p1, p2 = profile.eval([u1])[0], profile.eval([u2])[0]
+    le = profile.eval([le_u])[0]
+    if np.linalg.norm(p1 - le) > np.linalg.norm(p2 - le):
+        p1, p2 = p2, p1
+    return p1, p2
+
+
+def _in_range(u, side, length):
+    u = np.mod(u - side.lo, length)
+    return u <= side.hi - side.lo
+
+
+# ---------------------------------------------------------------- edge circles
+
+@dataclass
+class CircleFit2D:
+    center: np.ndarray
+    radius: float
+    rms: float
+    n_points: int
+    zone_deg: float
+
+
+def fit_circle_2d(xy):
+    """Geometric least-squares circle (Gauss-Newton from Kasa's algebraic circle)."""
+    xy = np.asarray(xy, dtype=float)
+    if len(xy) < 3:
+        raise InputError("edge circle fit: fewer than 3 points in the edge zone")
+    A = np.column_stack([2.0 * xy, np.ones(len(xy))])
+    sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
+    c = sol[:2]
+    r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
+    for _ in range(50):
+        v = xy - c
+        rho = np.linalg.norm(v, axis=1)
+        J = np.column_stack([-v / rho[:, None], -np.ones(len(xy))])
+        dx, *_ = np.linalg.lstsq(J, -(rho - r), rcond=None)
+        c, r = c + dx[:2], r + dx[2]
+        if np.linalg.norm(dx) < 1e-14 * max(1.0, r):
+            break
+    res = np.linalg.norm(xy - c, axis=1) - r
+    return c, float(r), float(np.sqrt(np.mean(res ** 2)))
+
+
+def _edge_circle(profile, end_centre, outward, edge_u, zone_deg):
+    """Circle fitted to the edge zone: the stretch of profile round the edge point (parameter
+    edge_u) seen within +-zone_deg of the camber line's outward direction from the fitted
+    circle's own centre (first from the last inscribed circle's centre; re-fitted until the
+    zone stops changing). The fit is to the profile curve resampled finely over the zone."""
+    centre = np.asarray(end_centre, dtype=float)
+    zone = None
+    for _ in range(_ZONE_ROUNDS):
+        lo, hi = _zone_range(profile, centre, outward, edge_u, zone_deg)
+        if zone is not None and abs(lo - zone[0]) < 1e-9 and abs(hi - zone[1]) < 1e-9:
+            break
+        zone = (lo, hi)
+        xy = _zone_points(profile, lo, hi)
+        centre, radius, rms = fit_circle_2d(xy)
+    return CircleFit2D(centre, radius, rms, len(xy), zone_deg)
+
+
+def _zone_points(profile, lo, hi):
+    """The input points in the parameter range [lo, hi] (unwrapped) when there are at least
+    _ZONE_MIN_POINTS of them -- measured points fit without any smoothing's bias -- else the
+    profile curve resampled finely over it."""
+    u = np.mod(profile.point_params - lo, profile.length)
+    inside = u <= hi - lo
+    if inside.sum() >= _ZONE_MIN_POINTS:
+        return profile.points[inside]
+    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES))
+
+
+def _zone_range(profile, centre, outward, edge_u, zone_deg):
+    """Unwrapped parameter range round edge_u where the profile is seen from ``centre``
+    within zone_deg of ``outward`` (to the exact crossing of the zone's bounding rays)."""
+    cos_zone = np.cos(np.radians(zone_deg))
+
+    def inside(u):
+        return _unit(profile.eval(u) - centre) @ outward >= cos_zone
+
+    n = len(profile.dense)
+    h = profile.length / n
+    i0 = int(np.round(np.mod(edge_u, profile.length) / h)) % n
+    seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
+    if seen.all():
+        raise InputError("edge zone: the whole profile is within the edge zone")
+    ahead = int(np.argmin(seen))                 # first sample outside, going forwards
+    behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
+    base = profile.dense_u[i0]
+    a = np.array([base - behind * h, base + (ahead - 1) * h])
+    b = a + np.array([-h, h])
+    for _ in range(32):          # h / 2**32: far below a nanometre
+        m = 0.5 * (a + b)
+        ok = inside(m)
+        a, b = np.where(ok, m, a), np.where(ok, b, m)
+    return float(a[0]), float(a[1])
+
+
+# ---------------------------------------------------------------- the characteristics
+
+@dataclass
+class Characteristics:
+    """One section's characteristics (field names as result.json's ``airfoil`` block)."""
+    chord_mm: float
+    chord_method: str
+    nose_tail_chord_mm: float
+    caliper_chord_mm: float
+    tangent_chord_mm: Optional[float]
+    axial_chord_mm: float
+    stagger_deg: float
+    max_thickness_mm: float
+    max_thickness_pos_pct: float
+    max_thickness_center: np.ndarray
+    thickness_stations_pct: list
+    thickness_mm: list
+    le_radius_mm: float
+    te_radius_mm: float
+    le_circle: CircleFit2D
+    te_circle: CircleFit2D
+    edge_offsets_mm: list
+    le_thickness_mm: list
+    te_thickness_mm: list
+    inlet_angle_deg: float
+    outlet_angle_deg: float
+    area_mm2: float
+    centroid_mm: np.ndarray
+    le_point: np.ndarray
+    te_point: np.ndarray
+    chord_dir: np.ndarray
+    engine_axis: np.ndarray
+    le_rule: str
+    mcl: CamberLine
+    inscribed_centres: np.ndarray
+    inscribed_radii: np.ndarray
+    profile: Profile = field(repr=False)
+    suction_range: tuple = ()     # unwrapped parameter ranges of the two sides
+    pressure_range: tuple = ()
+    warnings: list = field(default_factory=list)
+
+    def as_dict(self):
+        return {
+            "chord_mm": self.chord_mm, "chord_method": self.chord_method,
+            "nose_tail_chord_mm": self.nose_tail_chord_mm,
+            "caliper_chord_mm": self.caliper_chord_mm,
+            "tangent_chord_mm": self.tangent_chord_mm,
+            "axial_chord_mm": self.axial_chord_mm, "stagger_deg": self.stagger_deg,
+            "max_thickness_mm": self.max_thickness_mm,
+            "max_thickness_pos_pct": self.max_thickness_pos_pct,
+            "thickness_stations_pct": list(self.thickness_stations_pct),
+            "thickness_mm": list(self.thickness_mm),
+            "le_radius_mm": self.le_radius_mm, "te_radius_mm": self.te_radius_mm,
+            "edge_zone_deg": self.le_circle.zone_deg,
+            "edge_offsets_mm": list(self.edge_offsets_mm),
+            "le_thickness_mm": list(self.le_thickness_mm),
+            "te_thickness_mm": list(self.te_thickness_mm),
+            "inlet_angle_deg": self.inlet_angle_deg, "outlet_angle_deg": self.outlet_angle_deg,
+            "area_mm2": self.area_mm2, "centroid_mm": self.centroid_mm.tolist(),
+            "le_point_mm": self.le_point.tolist(), "te_point_mm": self.te_point.tolist(),
+            "le_rule": self.le_rule, "warnings": list(self.warnings),
+        }
+
+
+def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
+                    stations_pct=(), edge_offsets_mm=DEFAULT_EDGE_OFFSETS_MM,
+                    edge_zone_deg=DEFAULT_EDGE_ZONE_DEG, le_hint=None, noise_mm=0.0):
+    """All characteristics of one section. ``profile``: a Profile or an ordered (N, 2) array;
+    ``engine_axis``: a 2D direction in the section plane; ``le_hint``: a point near the
+    leading edge (e.g. on the CAD's named LE face), else the LE is the blunter end."""
+    if not isinstance(profile, Profile):
+        profile = Profile(profile, noise_mm)
+    if chord_method not in CHORD_METHODS:
+        raise InputError("chord method: %r is not one of %s" % (chord_method,
+                                                                 ", ".join(CHORD_METHODS)))
+    axis = np.asarray(engine_axis, dtype=float).reshape(2)
+    if not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
+        raise InputError("engine axis: %s must be a finite non-zero 2D direction" % axis)
+    axis = _unit(axis)
+    L = profile.length
+
+    # Sides split at the caliper diameter's ends (the edges of an airfoil), then the circles.
+    cal_u1, cal_u2, cal_p1, cal_p2 = _farthest_pair(profile)
+    caliper = float(np.linalg.norm(cal_p2 - cal_p1))
+    u1, u2 = sorted([cal_u1 % L, cal_u2 % L])
+    side_a, side_b = _side(profile, u1, u2), _side(profile, u2, u1 + L)
+    centres, radii = _medial_axis(profile, side_a, side_b)
+
+    # Camber line end tangents, extended to the profile: the two edge points.
+    # First the edge circles about the locus's ends, then the ends closed onto circular edges.
+    out_a = _line_end(centres, radii, 0)[2]
+    out_b = _line_end(centres, radii, -1)[2]
+    circle_a = _edge_circle(profile, centres[0], out_a, _ray_hit(profile, centres[0], out_a)[0][0],
+                            edge_zone_deg)
+    circle_b = _edge_circle(profile, centres[-1], out_b,
+                            _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
+    notes = []
+    centres, radii, out_a, ua_end, end_a = _closed_end(profile, centres, radii, 0, circle_a,
+                                                       notes)
+    centres, radii, out_b, ub_end, end_b = _closed_end(profile, centres, radii, -1, circle_b,
+                                                       notes)
+    circle_a = _edge_circle(profile, circle_a.center, out_a, ua_end[0], edge_zone_deg)
+    circle_b = _edge_circle(profile, circle_b.center, out_b, ub_end[0], edge_zone_deg)
+    t0, t1 = -out_a, out_b
+    if le_hint is not None:
+        hint = np.asarray(le_hint, dtype=float).reshape(2)
+        a_is_le = np.linalg.norm(end_a[0] - hint) <= np.linalg.norm(end_b[0] - hint)
+        le_rule = "given"
+    else:
+        a_is_le = circle_a.radius >= circle_b.radius
+        le_rule = "larger edge radius"
+    if a_is_le:
+        le, te, le_u, te_u = end_a[0], end_b[0], ua_end[0], ub_end[0]
+        le_circle, te_circle = circle_a, circle_b
+    else:
+        centres, radii = centres[::-1], radii[::-1]
+        le, te, le_u, te_u = end_b[0], end_a[0], ub_end[0], ua_end[0]
+        le_circle, te_circle = circle_b, circle_a
+    mcl = CamberLine(le, centres, te, t0 if a_is_le else -t1, t1 if a_is_le else -t0)
+
+    nose_tail = float(np.linalg.norm(te - le))
+    chord_dir = (te - le) / nose_tail
+    # The two sides between the edge points; the suction side is the longer one (convex).
+    s1, s2 = _side(profile, le_u % L, te_u % L), _side(profile, te_u % L, le_u % L + L)
+    suction, pressure = (s1, s2) if (s1.hi - s1.lo) >= (s2.hi - s2.lo) else (s2, s1)
+
+    bitangent = _pressure_bitangent(profile, pressure, le_u, te_u)
+    tangent_chord = None if bitangent is None else extent(profile, bitangent[1] - bitangent[0])
+    chord = {"nose-tail": nose_tail, "caliper": caliper, "tangent": tangent_chord}[chord_method]
+    if chord is None:
+        raise InputError("chord method tangent: the pressure side is not concave, no line "
+                         "touches the profile at both edges across it")
+
+    # Largest inscribed circle: the radius along the camber line is flat at its maximum, so
+    # it is zoomed in on twice by exact circles at 9 arc lengths and a parabola through them.
+    k = int(np.clip(np.argmax(radii), 1, len(radii) - 2))
+    s_c = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(centres, axis=0), axis=1))])
+    lo_s, hi_s = s_c[k - 1], s_c[k + 1]
+    for _ in range(2):
+        s_try = np.linspace(lo_s, hi_s, 9)
+        seeds, _ = mcl.at(mcl.le_extension + s_try)
+        cs, _, _, fs, _ = _refine_centres(profile, side_a, side_b, seeds)
+        r_try = np.linalg.norm(fs - cs, axis=1)
+        a2, a1, _ = np.polyfit(s_try - s_try[4], r_try, 2)
+        s_max = s_try[4] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
+        s_max = float(np.clip(s_max, lo_s, hi_s))
+        half = (hi_s - lo_s) / 8.0
+        lo_s, hi_s = s_max - half, s_max + half
+    seed, _ = mcl.at(mcl.le_extension + s_max)
+    c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed)
+    max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
+    max_pos = 100.0 * float((c_max[0] - le) @ chord_dir) / nose_tail
+
+    stations = [float(p) for p in stations_pct]
+    thickness = _thickness_normal(profile, mcl, _stations_to_arc(mcl, le, chord_dir,
+                                                                 nose_tail, stations)).tolist()
+    offsets = [float(d) for d in edge_offsets_mm]
+    le_thk = _thickness_normal(profile, mcl, np.array(offsets)).tolist()
+    te_thk = _thickness_normal(profile, mcl, mcl.length - np.array(offsets)).tolist()
+
+    area, centroid = area_centroid(profile)
+    warnings = _corner_warnings(profile, le, te, nose_tail) + notes
+    return Characteristics(
+        chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
+        caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
+        axial_chord_mm=extent(profile, axis), stagger_deg=_angle_deg(chord_dir, axis),
+        max_thickness_mm=max_thickness, max_thickness_pos_pct=max_pos,
+        max_thickness_center=c_max[0], thickness_stations_pct=stations, thickness_mm=thickness,
+        le_radius_mm=le_circle.radius, te_radius_mm=te_circle.radius, le_circle=le_circle,
+        te_circle=te_circle, edge_offsets_mm=offsets, le_thickness_mm=le_thk,
+        te_thickness_mm=te_thk, inlet_angle_deg=_angle_deg(mcl.le_tangent, axis),
+        outlet_angle_deg=_angle_deg(mcl.te_tangent, axis), area_mm2=area,
+        centroid_mm=centroid, le_point=le, te_point=te, chord_dir=chord_dir, engine_axis=axis,
+        le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
+        profile=profile, suction_range=(suction.lo, suction.hi),
+        pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
+
+
+def _corner_warnings(profile, le, te, chord):
+    """One line per corner of the input points: the spline rounds a corner off over a point
+    spacing, so an edge radius, edge point and chord read there are not the part's."""
+    out = []
+    for i in profile.corners:
+        p = profile.points[i]
+        where = ("at the LE" if np.linalg.norm(p - le) < 0.02 * chord else
+                 "at the TE" if np.linalg.norm(p - te) < 0.02 * chord else "on a side")
+        out.append("corner %s at (%.4f, %.4f) mm: the profile is not smooth there; "
+                   "characteristics near it (edge radius, edge point, chords, metal angle) "
+                   "are not trustworthy" % (where, p[0], p[1]))
+    return out
+
+
+def _stations_to_arc(mcl, le, chord_dir, chord, stations_pct):
+    """Camber-line arc lengths whose points project on the chord at the given % of it."""
+    if not stations_pct:
+        return np.zeros(0)
+    s = np.linspace(0.0, mcl.length, 2001)
+    x = (mcl.at(s)[0] - le) @ chord_dir
+    out = []
+    for pct in stations_pct:
+        target = pct / 100.0 * chord
+        if not (x.min() <= target <= x.max()):
+            raise InputError("thickness station %g %% lies outside the chord" % pct)
+        si = float(np.interp(target, x, s))
+        for _ in range(8):
+            p, t = mcl.at([si])
+            si -= float((p[0] - le) @ chord_dir - target) / float(t[0] @ chord_dir)
+        out.append(si)
+    return np.array(out)
+
+
+def area_centroid(profile):
+    """Area and centroid of the spline-bounded region (Green's theorem, exact quadrature of
+    the piecewise-polynomial integrands)."""
+    u, w = profile.knot_quadrature(5)
+    p, d = profile.eval(u), profile.eval(u, 1)
+    x, y, dx, dy = p[:, 0], p[:, 1], d[:, 0], d[:, 1]
+    area = 0.5 * np.sum(w * (x * dy - y * dx))
+    cx = np.sum(w * x * x * dy) / (2.0 * area)
+    cy = -np.sum(w * y * y * dx) / (2.0 * area)
+    return float(area), np.array([cx, cy])
+
+
+# ---------------------------------------------------------------- measured against nominal
+
+def order_by_nominal(points, nominal):
+    """Unordered measured points of a section, ordered by their foot on the nominal."""
+    pts = np.asarray(points, dtype=float)
+    u, _ = nominal.closest(pts)
+    return pts[np.argsort(np.mod(u, nominal.length))]
+
+
+def signed_deviation(points, nominal):
+    """Signed normal distance of each point from the nominal profile (+ outside, material
+    excess) and the feet's parameters."""
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    u, foot = nominal.closest(pts)
+    return np.einsum("ij,ij->i", pts - foot, nominal.outward_normal(u)), u
+
+
+@dataclass
+class SectionFit:
+    """The measured section's position against the nominal: measured = R(twist) (nominal -
+    pivot) + pivot + shift."""
+    shift_mm: np.ndarray
+    twist_deg: float
+    pivot: np.ndarray
+    rms_before_mm: float
+    rms_after_mm: float
+    iterations: int
+
+
+def _rot(theta):
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def fit_section(points, nominal, pivot=None):
+    """2D least-squares fit (shift 2 + twist) of measured points onto the nominal profile by
+    point-to-curve Gauss-Newton; twist about ``pivot`` (default the nominal's centroid)."""
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
+        raise InputError("section fit: need an (N, 2) array of at least 3 points")
+    pivot = area_centroid(nominal)[1] if pivot is None else np.asarray(pivot, float).reshape(2)
+    theta, t = 0.0, np.zeros(2)
+    before = signed_deviation(pts, nominal)[0]
+    it = 0
+    for it in range(1, 60):
+        moved = (pts - pivot) @ _rot(theta).T + pivot + t
+        dev, u = signed_deviation(moved, nominal)
+        n = nominal.outward_normal(u)
+        arm = moved - pivot - t
+        # d(moved)/d(theta) is arm turned by +90 degrees.
+        J = np.column_stack([n, n[:, 1] * arm[:, 0] - n[:, 0] * arm[:, 1]])
+        step, *_ = np.linalg.lstsq(J, -dev, rcond=None)
+        t, theta = t + step[:2], theta + step[2]
+        if np.linalg.norm(step) < 1e-13:
+            break
+    after = signed_deviation((pts - pivot) @ _rot(theta).T + pivot + t, nominal)[0]
+    # The fit maps measured onto nominal; the section's own pose is its inverse.
+    twist = -theta
+    shift = -_rot(twist) @ t
+    return SectionFit(shift, float(np.degrees(twist)), pivot, float(np.sqrt(np.mean(before ** 2))),
+                      float(np.sqrt(np.mean(after ** 2))), it)
+
+
+def contour(points, nominal_chars, fit=None):
+    """Contour error per zone (LE, TE, suction, pressure, all). form_location_mm: twice the
+    largest |deviation| before any fit (the width of a zone centred on the nominal that holds
+    the points); form_mm: max - min deviation after the section's own 2D fit (least squares,
+    not minimum zone)."""
+    nominal = nominal_chars.profile
+    pts = np.asarray(points, dtype=float)
+    if fit is None:
+        fit = fit_section(pts, nominal)
+    before, u = signed_deviation(pts, nominal)
+    theta = -np.radians(fit.twist_deg)
+    t = -_rot(theta) @ fit.shift_mm
+    after = signed_deviation((pts - fit.pivot) @ _rot(theta).T + fit.pivot + t, nominal)[0]
+    zone = contour_zones(nominal_chars, u)
+    out = {}
+    for name in ZONES + ("all",):
+        sel = np.ones(len(pts), bool) if name == "all" else zone == name
+        if not sel.any():
+            out[name] = {"n": 0, "form_mm": None, "form_location_mm": None}
+            continue
+        out[name] = {"n": int(sel.sum()),
+                     "form_mm": float(after[sel].max() - after[sel].min()),
+                     "form_location_mm": float(2.0 * np.abs(before[sel]).max()),
+                     "min_mm": float(before[sel].min()), "max_mm": float(before[sel].max())}
+    return out
+
+
+def contour_zones(chars, u):
+    """'LE', 'TE', 'suction' or 'pressure' for feet at parameters u on the nominal."""
+    p = chars.profile.eval(u)
+    x = (p - chars.le_point) @ chars.chord_dir / chars.nose_tail_chord_mm
+    on_suction = _in_range(u, _Range(*chars.suction_range), chars.profile.length)
+    zone = np.where(on_suction, "suction", "pressure").astype(object)
+    zone[x <= CONTOUR_EDGE_FRACTION] = "LE"
+    zone[x >= 1.0 - CONTOUR_EDGE_FRACTION] = "TE"
+    return zone
+
+
+@dataclass
+class _Range:
+    lo: float
+    hi: float
+
+
+def lean_bow(heights_mm, shifts_mm):
+    """Per blade: lean is the line through the innermost and outermost sections' shifts
+    (its slope per mm of span and its angle), bow each section's shift from that line."""
+    h = np.asarray(heights_mm, dtype=float).reshape(-1)
+    s = np.asarray(shifts_mm, dtype=float).reshape(len(h), 2)
+    if len(h) < 2 or np.ptp(h) <= 0:
+        raise InputError("lean/bow: need at least two sections at different heights")
+    i, o = int(np.argmin(h)), int(np.argmax(h))
+    slope = (s[o] - s[i]) / (h[o] - h[i])
+    line = s[i] + (h - h[i])[:, None] * slope
+    bow = s - line
+    mag = np.linalg.norm(bow, axis=1)
+    return {"lean_mm_per_mm": slope.tolist(),
+            "lean_deg": float(np.degrees(np.arctan(np.linalg.norm(slope)))),
+            "bow_mm": bow.tolist(), "bow_magnitude_mm": mag.tolist(),
+            "largest_bow_section": int(np.argmax(mag))}
