@@ -85,10 +85,8 @@ def compare(loss_best, loss_rival):
     n = len(delta)
     difference = float(delta.sum())
     se = float(np.sqrt(n) * np.std(delta, ddof=1)) if n > 1 else 0.0
-    if se > 0:
-        z = difference / se
-    else:
-        z = np.inf if difference > 0 else 0.0
+    # Identical per-point differences (no spread) are no evidence either way.
+    z = difference / se if se > 0 else 0.0
     return Comparison(difference, se, float(z), bool(z >= DECIDED_Z))
 
 

@@ -162,12 +162,15 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     way pipeline.register builds its own."""
     from ..core import icp as icp_mod
     from ..core import stats as stats_mod
+    from .pipeline import uncertainty_with_rival
     from .result import RegistrationResult
     points_cad = tf.apply_transform(fit.transform, pointset.xyz)
     dist = nominal.signed_distance(points_cad)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
-    uncertainty = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
+    statistical = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
+    uncertainty, includes_rival = uncertainty_with_rival(statistical, fit.transform, coarse,
+                                                         nominal.bbox_corners)
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face,
@@ -175,7 +178,9 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         pose_covariance=fit.covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
-        timing_s=timing, warnings=warnings, source=pointset.source)
+        timing_s=timing, warnings=warnings, source=pointset.source,
+        pose_uncertainty_statistical_mm=float(statistical),
+        pose_uncertainty_includes_rival=includes_rival)
 
 
 def _sections_json(table, plan):

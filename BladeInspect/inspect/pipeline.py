@@ -374,10 +374,8 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
-    uncertainty = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
+    statistical = icp_mod.pose_uncertainty(fit.covariance, fit.center, nominal.bbox_corners)
     timing["deviations"] = time.perf_counter() - t0
-    progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
-             % (rms, uncertainty * 1000.0))
 
     coarse_out = {
         "measured_to_cad": np.asarray(coarse["pca_measured_to_cad"]).tolist(),
@@ -392,13 +390,38 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True):
         "pca_source": "reconstruction" if pca_points is not None else "points",
         "warning": coarse["warning"],
     }
+    uncertainty, includes_rival = uncertainty_with_rival(statistical, fit.transform, coarse_out,
+                                                         nominal.bbox_corners)
+    progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
+             % (rms, uncertainty * 1000.0))
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
         columns=dict(pointset.columns), n_rows_skipped=int(pointset.n_rows_skipped),
         rms_mm=rms, pose_covariance=fit.covariance, center=fit.center,
-        pose_uncertainty_mm=float(uncertainty), deviation_stats=stats, coarse=coarse_out,
-        timing_s=timing, warnings=warnings, source=pointset.source)
+        pose_uncertainty_mm=uncertainty, deviation_stats=stats, coarse=coarse_out,
+        timing_s=timing, warnings=warnings, source=pointset.source,
+        pose_uncertainty_statistical_mm=float(statistical),
+        pose_uncertainty_includes_rival=includes_rival)
+
+
+def uncertainty_with_rival(statistical_mm, measured_to_cad, coarse, corners):
+    """The pose uncertainty to state, and whether it covers the coarse stage's rival.
+
+    The statistical bound is the spread of the pose about the optimum the fine stage reached;
+    when the coarse stage could not tell that optimum from a distinct rival (coarse["rival"]
+    not decided), the pose is one of two places and the bound alone would state a confidence
+    the data do not give. The stated uncertainty is then raised to the distance between the
+    final pose and the rival at the worst corner of the CAD's bounding box, so the rival lies
+    within it (the statistical bound stays in pose_uncertainty_statistical_mm); that distance
+    is written into the rival's record as distance_from_final_mm."""
+    rival = coarse.get("rival")
+    if not rival or rival.get("decided", True):
+        return float(statistical_mm), False
+    distance = pose_distance(np.asarray(measured_to_cad),
+                             np.asarray(rival["measured_to_cad"]), corners)
+    rival["distance_from_final_mm"] = distance
+    return float(max(statistical_mm, distance)), True
 
 
 # ---------------------------------------------------------------- outputs
@@ -424,6 +447,8 @@ def result_json(result, extra=None):
         "pose_covariance": np.asarray(result.pose_covariance).tolist(),
         "pose_covariance_center": np.asarray(result.center).tolist(),
         "pose_uncertainty_mm": result.pose_uncertainty_mm,
+        "pose_uncertainty_statistical_mm": result.pose_uncertainty_statistical_mm,
+        "pose_uncertainty_includes_rival": result.pose_uncertainty_includes_rival,
         "timing_s": result.timing_s,
         "software": {"name": NAME, "version": __version__, "FreeCAD version": freecad_version()},
         "coarse": result.coarse,
