@@ -185,7 +185,13 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
         else:
             same_as[i] = twin
 
-    progress(0.75, "coarse registration: ranking %d distinct poses" % len(distinct))
+    # A pose with more than half of its points beyond that rejection distance (median above
+    # it) cannot be the best nor a credible rival of a pose within the noise: it loses on at
+    # least half of the points by the largest loss there is. Only the others cost an exact
+    # distance evaluation (those of far-off poses are the slowest, OCC decides many).
+    screened = {i for i in distinct if refined[i][0] > same_pose_mm}
+    ranked = [i for i in distinct if i not in screened]
+    progress(0.75, "coarse registration: ranking %d distinct poses" % len(ranked))
     rank_idx = _subsample(len(measured_xyz), RANKING_POINTS, rng)
     rank_xyz = measured_xyz[rank_idx]
     rank_snr = None if weights is None else weights[rank_idx]
@@ -194,8 +200,8 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
         dist = nominal.signed_distance(tf.apply_transform(T, rank_xyz)).distance
         return ranking.standardised(dist, rank_snr)
 
-    poses = {i: refined[i][1] for i in distinct}
-    residuals = {i: standardised(poses[i]) for i in distinct}
+    poses = {i: refined[i][1] for i in ranked}
+    residuals = {i: standardised(poses[i]) for i in ranked}
     best_i = _best_ranked(residuals)[0]
 
     score = refined[best_i][0]
@@ -222,7 +228,7 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
 
     best_i, scale, losses, objectives = _best_ranked(residuals)
     rival = None
-    others = [i for i in distinct if i != best_i
+    others = [i for i in ranked if i != best_i
               and pose_distance(poses[i], poses[best_i], corners) >= same_pose_mm]
     if others:
         rival_i = min(others, key=lambda i: objectives[i])
@@ -255,7 +261,8 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
                         "refined_to_cad": poses.get(i, refined[i][1]).tolist(),
                         "residual_mm": refined[i][0],
                         "objective": objectives.get(i),
-                        "same_pose_as": same_as.get(i)}
+                        "same_pose_as": same_as.get(i),
+                        "screened": i in screened}
                        for i, T in enumerate(candidates)],
         "chosen": int(best_i),
         "ranking": {"objective": "sum over the points of the fine ICP's robust loss at one "
