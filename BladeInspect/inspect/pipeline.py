@@ -156,9 +156,10 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
     capture = icp_mod.ICPOptions(max_iter=CAPTURE_ITERATIONS, defect_neighbours=0,
                                  min_scale=max(capture_mm / options.k_full, options.min_scale))
 
-    def refine(T):
-        fit = icp_mod.icp(pts, w, closest, T, capture)
-        fit = icp_mod.icp(pts, w, closest, fit.transform, options)
+    def refine(T, capture_first=True):
+        if capture_first:
+            T = icp_mod.icp(pts, w, closest, T, capture).transform
+        fit = icp_mod.icp(pts, w, closest, T, options)
         # The median |residual| over the subsample only steers the local search below; the
         # candidates are ranked by the common objective.
         return float(np.median(np.abs(fit.distances))), fit.transform
@@ -214,7 +215,8 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
             progress(0.8 + 0.2 * round_ / SEARCH_ROUNDS, "coarse registration: local search")
             improved = False
             for step in _search_steps(axes_n):
-                s, T = refine(step @ best_pose)
+                # Steps from a pose already drawn in: the robust refinement alone.
+                s, T = refine(step @ best_pose, capture_first=False)
                 search["tried"] += 1
                 if s < 0.8 * score:
                     score, best_pose, improved = s, T, True
