@@ -2,7 +2,7 @@
 stated bound, and whether the result warns, over random poses.
 
     PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_symmetric_vane.py \
-        [--poses 6] [--points 5000] [--radii 0.8/0.4,0.6/0.4,0.5/0.4]
+        [--poses 6] [--points 5000] [--radii 0.8/0.4,0.6/0.4,0.5/0.4] [--demo 8]
 
 Two vanes (tests/symmetric_vane.py): the issue's (arcs through (0,6) and (0,2) over a 50 mm
 chord, edge radii 0.8 and 0.4, span 100) and another (60 mm chord, rises 8 and 3.5, radii 1.2
@@ -64,13 +64,33 @@ def summary(rows):
                sum(w for _, _, w in rows), vague, UNINFORMATIVE_MM))
 
 
+def demo(poses, seed0=30):
+    from BladeInspect.inspect.simulate import simulate_measurement
+    nominal = pipeline.load_nominal(None)
+    print("demo blade")
+    for seed in range(seed0, seed0 + poses):
+        ps, truth, info, good = simulate_measurement(
+            nominal, n_points=4000, outlier_fraction=0.02, seed=seed, section_heights=(),
+            max_translation=150.0)
+        result = pipeline.register(nominal, ps, seed=seed)
+        err = pose_error(result.measured_to_cad, truth, nominal.bbox_corners)
+        print("%5d error %.3f um bound %.3f um chosen candidate %d warning %s"
+              % (seed, 1e3 * err, 1e3 * result.pose_uncertainty_mm, result.coarse["chosen"],
+                 "yes" if result.coarse.get("warning") else "no"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--poses", type=int, default=6)
     ap.add_argument("--points", type=int, default=5000)
     ap.add_argument("--radii", default="",
                     help="comma-separated r_minus/r_plus pairs on the issue's arcs")
+    ap.add_argument("--demo", type=int, default=0,
+                    help="also N random poses of the demo blade (4,000 points, 2 %% outliers): "
+                         "error, bound and chosen candidate, to compare revisions")
     args = ap.parse_args()
+    if args.demo:
+        demo(args.demo)
     t0 = time.perf_counter()
     rows = run("issue vane", ISSUE_VANE, args.poses, args.points)
     rows += run("other vane", OTHER_VANE, args.poses, args.points)
