@@ -178,21 +178,27 @@ def build_parser():
 
 def _print_result(result, out_dir, stream=None):
     stream = stream or sys.stdout   # looked up at the call, so a redirected stdout gets it
+    from .inspect.result import rival_lines
     stats = result.deviation_stats
     stream.write("registered %d points (%d inliers, %d rows skipped)\n"
                  % (result.n_points, result.n_inliers, result.n_rows_skipped))
     stream.write("  residual RMS %.4f mm, deviations %.4f .. %.4f mm\n"
                  % (result.rms_mm, stats["min"], stats["max"]))
     unmeasured = getattr(result, "pose_unmeasured", None) or []
-    stream.write("  pose uncertainty (1 sigma, worst bounding-box corner) %.2f um%s\n"
+    stream.write("  pose uncertainty (1 sigma, worst bounding-box corner) %.2f um%s%s\n"
                  % (result.pose_uncertainty_mm * 1000.0,
-                    " in the measured directions" if unmeasured else ""))
+                    " in the measured directions" if unmeasured else "",
+                    " - raised to cover the rival pose (statistical bound %.2f um)"
+                    % (result.pose_uncertainty_statistical_mm * 1000.0)
+                    if result.pose_uncertainty_includes_rival else ""))
     for direction in unmeasured:
         stream.write("  %s\n" % direction["motion"])
     for warning in result.warnings:
         stream.write("  warning: %s\n" % warning)
     if result.coarse.get("warning") and result.coarse["warning"] not in result.warnings:
         stream.write("  warning: %s\n" % result.coarse["warning"])
+    for line in rival_lines(result.coarse):
+        stream.write("  %s\n" % line)
     stream.write("  timing: %s\n" % ", ".join("%s %.2f s" % kv for kv in result.timing_s.items()))
     stream.write("results in %s\n" % os.path.abspath(out_dir))
 

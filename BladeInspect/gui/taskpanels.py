@@ -1,12 +1,14 @@
 """Task panels: the parameters of a command before it runs, and what a result says after.
 Panels collect input and show output; the work is done by the commands' pipeline calls."""
 import dataclasses
+import json
 import math
 
 import FreeCADGui
 from PySide import QtGui
 
 from ..app import settings
+from ..inspect.result import rival_lines
 
 
 def _spin(value, minimum, maximum, decimals=3, suffix=""):
@@ -173,9 +175,10 @@ def registration_html(obj):
     ]
     html = "<table cellspacing='4'>" + "".join(
         "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
-    if obj.Warnings:
+    notes = list(obj.Warnings) + rival_lines(json.loads(obj.CoarseJson or "{}"))
+    if notes:
         html += "<p><b>Warnings</b><br>" + "<br>".join(
-            w.replace("&", "&amp;").replace("<", "&lt;") for w in obj.Warnings) + "</p>"
+            w.replace("&", "&amp;").replace("<", "&lt;") for w in notes) + "</p>"
     return html
 
 

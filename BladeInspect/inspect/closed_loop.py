@@ -167,6 +167,7 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     """A RegistrationResult for points registered by a fine ICP from a known start, built the
     way pipeline.register builds its own."""
     from ..core import stats as stats_mod
+    from .pipeline import uncertainty_with_rival
     from .result import RegistrationResult
     points_cad = tf.apply_transform(fit.transform, pointset.xyz)
     dist = nominal.signed_distance(points_cad)
@@ -174,10 +175,12 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
     from .pipeline import pose_summary
     from .checks import unmeasured_warning
-    covariance, uncertainty, unmeasured = pose_summary(fit, nominal)
+    covariance, statistical, unmeasured = pose_summary(fit, nominal)
     if unmeasured:
         warnings = [w for w in warnings if w != unmeasured_warning(unmeasured)]
         warnings.append(unmeasured_warning(unmeasured))
+    uncertainty, includes_rival = uncertainty_with_rival(statistical, fit.transform, coarse,
+                                                         nominal.bbox_corners)
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face,
@@ -186,7 +189,8 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         pose_uncertainty_mm=float(uncertainty),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
-        pose_unmeasured=unmeasured)
+        pose_unmeasured=unmeasured, pose_uncertainty_statistical_mm=float(statistical),
+        pose_uncertainty_includes_rival=includes_rival)
 
 
 def _sections_json(table, plan):

@@ -16,8 +16,10 @@ import numpy as np
 from .. import __version__, NAME
 from ..core import icp as icp_mod
 from ..core import pca as pca_mod
+from ..core import ranking
 from ..core import stats as stats_mod
 from ..core import transforms as tf
+from ..core.icp import MAD_TO_SIGMA
 from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
 from . import checks
@@ -28,6 +30,10 @@ from .verdict import DEFAULT_TOLERANCE
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
 # keeps a 269k-point registration within seconds without giving up the full cloud's accuracy.
 COARSE_SUBSAMPLE = 1500
+# Points on which the distinct candidates are ranked, by exact distance to the CAD (a random
+# subset beyond this): the ambiguity test's power grows with the number of points that tell
+# two poses apart, and every candidate costs one exact distance evaluation of these.
+RANKING_POINTS = 10000
 FINE_SUBSAMPLE = 30000
 FULL_CLOUD_STEPS = 3
 # The full cloud starts within a few tenths of a micrometre of its optimum (the subsample's),
@@ -36,6 +42,10 @@ FULL_CLOUD_STEPS = 3
 # bound, so the pose is final without another closest-point evaluation of every point.
 FULL_CLOUD_TOL_MM = 5e-4
 FULL_CLOUD_TOL_RAD = 1e-5
+# The coarse stage's capture phase (see coarse_register): full weight within this many standard
+# errors of the PCA centroid (3: the start is rarely farther off), for this many iterations.
+CAPTURE_STANDARD_ERRORS = 3.0
+CAPTURE_ITERATIONS = 15
 # The coarse stage searches around its best candidate when that candidate's median residual is
 # above this (several times a point sensor's noise, well below any misalignment worth keeping).
 SEARCH_MEDIAN_MM = 0.015
@@ -114,17 +124,21 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
                     progress=_no_progress):
     """PCA coarse registration (paper 3.1.3): principal axes of the measured surface (or of its
     B-spline reconstruction's samples, ``pca_points``) against the nominal's, every proper sign
-    combination refined by a short ICP on a subsample and ranked by its robust residual.
+    combination refined by a short ICP on a subsample, then ranked by one objective common to
+    all of them (core.ranking: the fine stage's robust loss at one noise scale, over all points
+    up to RANKING_POINTS, exact distances to the CAD), the best tested against its best distinct
+    rival.
 
     Returns a dict: measured_to_cad (chosen candidate, refined), pca_measured_to_cad (the raw
-    PCA pose of that candidate), eigenvalues, candidates, warning."""
+    PCA pose of that candidate), eigenvalues, candidates, chosen, ranking, rival (the best
+    distinct other pose, or None), local_search, warning."""
     rng = np.random.default_rng(0) if rng is None else rng
     pca_source = measured_xyz if pca_points is None else pca_points
     axes_m = pca_mod.principal_axes(pca_source)
     axes_n = pca_mod.principal_axes(nominal.samples.xyz, nominal.samples.weight)
-    warning = pca_mod.axes_warning(axes_m, axes_n)
+    axes_warning = pca_mod.axes_warning(axes_m, axes_n)
     candidates = list(pca_mod.candidate_poses(axes_m, axes_n))
-    if warning:
+    if axes_warning:
         # Two axes are interchangeable up to noise: their directions in that plane are
         # arbitrary, so try the candidates turned about the well-defined axis as well.
         extra = []
@@ -141,49 +155,153 @@ def coarse_register(measured_xyz, weights, nominal, pca_points=None, rng=None,
     pts, w = measured_xyz[sub], None if weights is None else weights[sub]
     closest = _sample_closest_fn(nominal)
     options = icp_mod.ICPOptions(max_iter=30)
+    # The PCA start's translation is off by the measured centroid's sampling error, which
+    # along the long axis is sqrt(lambda_1 / n) (0.4 mm on a 100 mm vane at 5,000 points). A
+    # surface that alone fixes a direction (a vane's end caps fix its span position) may hold
+    # a few per cent of the points: the robust weight, scaled by the noise of the many others,
+    # would reject it from the first iteration and leave that direction where PCA put it. So
+    # each candidate is first drawn in with full weight for every point within
+    # CAPTURE_STANDARD_ERRORS such errors (and without the defect test, which would reject
+    # that surface as one coherent deviation), then refined robustly.
+    capture_mm = CAPTURE_STANDARD_ERRORS * np.sqrt(axes_m.eigenvalues[0] / len(pca_source))
+    capture = icp_mod.ICPOptions(max_iter=CAPTURE_ITERATIONS, defect_neighbours=0,
+                                 min_scale=max(capture_mm / options.k_full, options.min_scale))
 
-    def refine(T):
+    def refine(T, capture_first=True):
+        if capture_first:
+            T = icp_mod.icp(pts, w, closest, T, capture).transform
         fit = icp_mod.icp(pts, w, closest, T, options)
-        # Median |residual| over all points: every measured point lies on the part, so a wrong
-        # pose cannot look good by trimming away what it does not explain.
+        # The median |residual| over the subsample only steers the local search below; the
+        # candidates are ranked by the common objective.
         return float(np.median(np.abs(fit.distances))), fit.transform
 
-    ranked = []
+    refined = []
     for i, T in enumerate(candidates):
-        progress(0.8 * i / len(candidates), "coarse registration: candidate %d of %d"
+        progress(0.7 * i / len(candidates), "coarse registration: candidate %d of %d"
                  % (i + 1, len(candidates)))
-        score, refined = refine(T)
-        ranked.append((score, i, T, refined))
-    best = min(ranked, key=lambda r: r[0])
-    score, refined = best[0], best[3]
+        refined.append(refine(T))
+
+    # Poses closer than the ICP's rejection distance at every corner explain every point
+    # alike and lead the fine stage to one optimum: rank one of them (the one of smallest
+    # median) and record the others as the same pose.
+    corners = nominal.bbox_corners
+    same_pose_mm = options.k_zero * max(min(r[0] for r in refined) * MAD_TO_SIGMA,
+                                        options.min_scale)
+    distinct, same_as = [], {}
+    for i in sorted(range(len(candidates)), key=lambda i: refined[i][0]):
+        twin = next((j for j in distinct
+                     if pose_distance(refined[i][1], refined[j][1], corners)
+                     < same_pose_mm), None)
+        if twin is None:
+            distinct.append(i)
+        else:
+            same_as[i] = twin
+
+    # A pose with more than half of its points beyond that rejection distance (median above
+    # it) cannot be the best nor a credible rival of a pose within the noise: it loses on at
+    # least half of the points by the largest loss there is. Only the others cost an exact
+    # distance evaluation (those of far-off poses are the slowest, OCC decides many).
+    screened = {i for i in distinct if refined[i][0] > same_pose_mm}
+    ranked = [i for i in distinct if i not in screened]
+    progress(0.75, "coarse registration: ranking %d distinct poses" % len(ranked))
+    rank_idx = _subsample(len(measured_xyz), RANKING_POINTS, rng)
+    rank_xyz = measured_xyz[rank_idx]
+    rank_snr = None if weights is None else weights[rank_idx]
+
+    def standardised(T):
+        dist = nominal.signed_distance(tf.apply_transform(T, rank_xyz)).distance
+        return ranking.standardised(dist, rank_snr)
+
+    poses = {i: refined[i][1] for i in ranked}
+    residuals = {i: standardised(poses[i]) for i in ranked}
+    best_i = _best_ranked(residuals)[0]
+
+    score = refined[best_i][0]
     search = {"start_median_mm": score, "tried": 0, "rounds": 0}
     if score > SEARCH_MEDIAN_MM:
         # A sparse scan (few sections on a nearly helical blade) can leave the right candidate
         # in a neighbouring minimum that is far above the sensor's noise: look around it.
+        best_pose = poses[best_i]
         for round_ in range(SEARCH_ROUNDS):
             progress(0.8 + 0.2 * round_ / SEARCH_ROUNDS, "coarse registration: local search")
             improved = False
             for step in _search_steps(axes_n):
-                s, T = refine(step @ refined)
+                # Steps from a pose already drawn in: the robust refinement alone.
+                s, T = refine(step @ best_pose, capture_first=False)
                 search["tried"] += 1
                 if s < 0.8 * score:
-                    score, refined, improved = s, T, True
+                    score, best_pose, improved = s, T, True
             search["rounds"] = round_ + 1
             if not improved or score <= SEARCH_MEDIAN_MM:
                 break
+        if search["tried"] and best_pose is not poses[best_i]:
+            poses[best_i] = best_pose
+            residuals[best_i] = standardised(best_pose)
     search["final_median_mm"] = score
+
+    best_i, scale, losses, objectives = _best_ranked(residuals)
+    rival = None
+    others = [i for i in ranked if i != best_i
+              and pose_distance(poses[i], poses[best_i], corners) >= same_pose_mm]
+    if others:
+        rival_i = min(others, key=lambda i: objectives[i])
+        test = ranking.compare(losses[best_i], losses[rival_i])
+        rival = {"candidate": int(rival_i),
+                 "measured_to_cad": poses[rival_i].tolist(),
+                 "pca_measured_to_cad": candidates[rival_i].tolist(),
+                 "objective": objectives[rival_i],
+                 "objective_difference": test.difference,
+                 "standard_error": test.standard_error,
+                 "z": test.z,
+                 "decided": test.decided,
+                 "distance_mm": pose_distance(poses[rival_i], poses[best_i], corners)}
+    ambiguity = None
+    if rival is not None and not rival["decided"]:
+        ambiguity = ("coarse pose ambiguous: candidate %d and candidate %d, %.3g mm apart at "
+                     "the worst corner, fit the points equally well (Vuong z = %.2f < %.1f: "
+                     "objective %.1f vs %.1f, difference %.1f +- %.1f); the part may be "
+                     "symmetric - check the pose before using the result"
+                     % (best_i, rival["candidate"], rival["distance_mm"], rival["z"],
+                        ranking.DECIDED_Z, objectives[best_i], rival["objective"],
+                        rival["objective_difference"], rival["standard_error"]))
+    warning = "; ".join(w for w in (ambiguity, axes_warning) if w) or None
     return {
-        "measured_to_cad": refined,
-        "pca_measured_to_cad": best[2],
+        "measured_to_cad": poses[best_i],
+        "pca_measured_to_cad": candidates[best_i],
         "eigenvalues": {"measured": axes_m.eigenvalues.tolist(),
                         "nominal": axes_n.eigenvalues.tolist()},
-        "candidates": [{"measured_to_cad": T.tolist(), "refined_to_cad": Tr.tolist(),
-                        "residual_mm": r}
-                       for r, _, T, Tr in ranked],
-        "chosen": int(best[1]),
+        "candidates": [{"measured_to_cad": T.tolist(),
+                        "refined_to_cad": poses.get(i, refined[i][1]).tolist(),
+                        "residual_mm": refined[i][0],
+                        "objective": objectives.get(i),
+                        "same_pose_as": same_as.get(i),
+                        "screened": i in screened}
+                       for i, T in enumerate(candidates)],
+        "chosen": int(best_i),
+        "ranking": {"objective": "sum over the points of the fine ICP's robust loss at one "
+                                 "noise scale for every candidate (core.ranking)",
+                    "scale_mm": scale, "n_points": int(len(rank_idx)),
+                    "decided_z": ranking.DECIDED_Z, "same_pose_mm": same_pose_mm},
+        "rival": rival,
+        "ambiguous": ambiguity is not None,
         "local_search": search,
         "warning": warning,
     }
+
+
+def pose_distance(a_to_cad, b_to_cad, corners):
+    """How far apart two measured -> CAD poses put the part: the largest displacement of a
+    corner of the CAD's bounding box between them (mm)."""
+    return tf.corner_displacement(a_to_cad @ tf.invert_transform(b_to_cad), np.eye(4), corners)
+
+
+def _best_ranked(residuals):
+    """(best candidate, common scale, per-point losses, objectives) of candidates' standardised
+    residuals {index: (n,)}, all on the same points."""
+    keys = list(residuals)
+    scale, losses, objectives = ranking.rank([residuals[k] for k in keys])
+    losses, objectives = dict(zip(keys, losses)), dict(zip(keys, objectives))
+    return min(keys, key=lambda k: objectives[k]), scale, losses, objectives
 
 
 def _search_steps(axes):
@@ -335,12 +453,10 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
             raise InputError(message)
         fit_record["warning"] = message
         warnings.append(message)
-    covariance, uncertainty, unmeasured = pose_summary(fit, nominal)
+    covariance, statistical, unmeasured = pose_summary(fit, nominal)
     if unmeasured:
         warnings.append(checks.unmeasured_warning(unmeasured))
     timing["deviations"] = time.perf_counter() - t0
-    progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
-             % (rms, uncertainty * 1000.0))
 
     coarse_out = {
         "measured_to_cad": np.asarray(coarse["pca_measured_to_cad"]).tolist(),
@@ -348,10 +464,17 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         "eigenvalues": coarse["eigenvalues"],
         "candidates": coarse["candidates"],
         "chosen": coarse["chosen"],
+        "ranking": coarse["ranking"],
+        "rival": coarse["rival"],
+        "ambiguous": coarse["ambiguous"],
         "local_search": coarse["local_search"],
         "pca_source": "reconstruction" if pca_points is not None else "points",
         "warning": coarse["warning"],
     }
+    uncertainty, includes_rival = uncertainty_with_rival(statistical, fit.transform, coarse_out,
+                                                         nominal.bbox_corners)
+    progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
+             % (rms, uncertainty * 1000.0))
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
@@ -359,7 +482,9 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         rms_mm=rms, pose_covariance=covariance, center=fit.center,
         pose_uncertainty_mm=float(uncertainty), deviation_stats=stats, coarse=coarse_out,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
-        pose_unmeasured=unmeasured, surface_fit=fit_record)
+        pose_unmeasured=unmeasured, surface_fit=fit_record,
+        pose_uncertainty_statistical_mm=float(statistical),
+        pose_uncertainty_includes_rival=includes_rival)
 
 
 def pose_summary(fit, nominal):
@@ -371,6 +496,25 @@ def pose_summary(fit, nominal):
         return fit.covariance, float("inf"), []
     uncertainty = icp_mod.pose_uncertainty(split.covariance, fit.center, nominal.bbox_corners)
     return split.covariance, float(uncertainty), checks.describe_unmeasured(split, nominal)
+
+
+def uncertainty_with_rival(statistical_mm, measured_to_cad, coarse, corners):
+    """The pose uncertainty to state, and whether it covers the coarse stage's rival.
+
+    The statistical bound is the spread of the pose about the optimum the fine stage reached;
+    when the coarse stage could not tell that optimum from a distinct rival (coarse["rival"]
+    not decided), the pose is one of two places and the bound alone would state a confidence
+    the data do not give. The stated uncertainty is then raised to the distance between the
+    final pose and the rival at the worst corner of the CAD's bounding box, so the rival lies
+    within it (the statistical bound stays in pose_uncertainty_statistical_mm); that distance
+    is written into the rival's record as distance_from_final_mm."""
+    rival = coarse.get("rival")
+    if not rival or rival.get("decided", True):
+        return float(statistical_mm), False
+    distance = pose_distance(np.asarray(measured_to_cad),
+                             np.asarray(rival["measured_to_cad"]), corners)
+    rival["distance_from_final_mm"] = distance
+    return float(max(statistical_mm, distance)), True
 
 
 # ---------------------------------------------------------------- outputs
@@ -396,6 +540,8 @@ def result_json(result, extra=None):
         "pose_covariance": np.asarray(result.pose_covariance).tolist(),
         "pose_covariance_center": np.asarray(result.center).tolist(),
         "pose_uncertainty_mm": result.pose_uncertainty_mm,
+        "pose_uncertainty_statistical_mm": result.pose_uncertainty_statistical_mm,
+        "pose_uncertainty_includes_rival": result.pose_uncertainty_includes_rival,
         "timing_s": result.timing_s,
         "software": {"name": NAME, "version": __version__, "FreeCAD version": freecad_version()},
         "coarse": result.coarse,

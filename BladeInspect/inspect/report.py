@@ -23,6 +23,7 @@ from ..core import colormap
 from ..core.errors import InputError
 from . import sections as sections_mod
 from . import verdict as verdict_mod
+from .result import rival_lines
 
 # Enough points for a faithful picture; more only costs time and PDF size.
 MAX_VIEW_POINTS = 120000
@@ -338,13 +339,16 @@ def pose_rows(result):
         ["Rows skipped", "%d" % result.n_rows_skipped],
         ["Residual RMS of inliers", "%.4f mm" % result.rms_mm],
         ["Pose uncertainty (1 sigma, worst bounding-box corner)",
-         "%.2f um" % (1000.0 * result.pose_uncertainty_mm)],
+         "%.2f um" % (1000.0 * result.pose_uncertainty_mm)
+         + (" (covers the rival pose; statistical bound %.2f um)"
+            % (1000.0 * result.pose_uncertainty_statistical_mm)
+            if result.pose_uncertainty_includes_rival else "")],
         ["Translation 1 sigma (x, y, z)", "%.2f, %.2f, %.2f um" % tuple(1000.0 * sd[:3])],
         ["Rotation 1 sigma (x, y, z)", "%.2f, %.2f, %.2f urad" % tuple(1e6 * sd[3:])],
         ["measured_to_cad row 1", "  ".join("%.6f" % v for v in T[0])],
         ["measured_to_cad row 2", "  ".join("%.6f" % v for v in T[1])],
         ["measured_to_cad row 3", "  ".join("%.6f" % v for v in T[2])],
-    ]
+    ] + [["Coarse pose ambiguous", line] for line in rival_lines(result.coarse)]
 
 
 # ---------------------------------------------------------------- HTML

@@ -32,6 +32,11 @@ class RegistrationResult:
     cad_faces: list = field(default_factory=list)   # how each CAD face's outside was decided
     pose_unmeasured: list = field(default_factory=list)   # inspect.checks.describe_unmeasured
     surface_fit: Optional[dict] = None                     # inspect.checks.surface_fit
+    # The Cramer-Rao bound of the fine pose alone (pose_uncertainty_mm when the coarse stage
+    # was decided), and whether pose_uncertainty_mm was raised to cover an undecided rival
+    # pose (pipeline.uncertainty_with_rival).
+    pose_uncertainty_statistical_mm: Optional[float] = None
+    pose_uncertainty_includes_rival: bool = False
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
@@ -54,3 +59,23 @@ class RegistrationResult:
     @property
     def n_inliers(self):
         return int(np.count_nonzero(self.inlier))
+
+
+def rival_lines(coarse):
+    """Plain-text lines on the coarse stage's rival pose, for the terminal, the report and the
+    GUI; empty when there is none or the coarse stage told it apart from the chosen pose."""
+    rival = (coarse or {}).get("rival")
+    if not rival or rival.get("decided", True):
+        return []
+    ranking = coarse.get("ranking", {})
+    distance = rival.get("distance_from_final_mm", rival["distance_mm"])
+    T = np.asarray(rival["measured_to_cad"])
+    return ["rival pose (coarse candidate %d) %.4g mm from the result at the worst corner of "
+            "the CAD's bounding box; objective %.1f against the chosen pose's %.1f, Vuong "
+            "z = %.2f (decided from z >= %.1f); the pose uncertainty covers it"
+            % (rival["candidate"], distance, rival["objective"],
+               rival["objective"] - rival["objective_difference"], rival["z"],
+               ranking.get("decided_z", float("nan")))] + \
+        ["rival measured_to_cad row %d: %s" % (k + 1, "  ".join("%.6f" % v for v in T[k]))
+         for k in range(3)]
+
