@@ -178,7 +178,7 @@ def build_parser():
 
 def _print_result(result, out_dir, stream=None):
     stream = stream or sys.stdout   # looked up at the call, so a redirected stdout gets it
-    from .inspect.result import rival_lines
+    from .inspection.result import rival_lines
     stats = result.deviation_stats
     stream.write("registered %d points (%d inliers, %d rows skipped)\n"
                  % (result.n_points, result.n_inliers, result.n_rows_skipped))
@@ -204,15 +204,15 @@ def _print_result(result, out_dir, stream=None):
 
 
 def cmd_register(args):
-    from .inspect.pipeline import run_register
+    from .inspection.pipeline import run_register
     result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress(),
                           flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch)
     _print_result(result, args.out)
 
 
 def cmd_simulate(args, cad=None):
-    from .inspect.pipeline import load_nominal
-    from .inspect.simulate import run_simulation, write_simulation
+    from .inspection.pipeline import load_nominal
+    from .inspection.simulate import run_simulation, write_simulation
     nominal = load_nominal(args.cad if cad is None else cad)
     result, report, pointset = run_simulation(
         nominal, seed=args.seed, progress=Progress(), n_points=args.points, sides=args.sides,
@@ -234,7 +234,7 @@ def cmd_demo(args):
     """The paper's whole workflow on the built-in blade and the simulated rig: blind section
     scan, reconstruction, PCA, SNR-weighted ICP, CAD-planned scan of the nominal sections,
     report; then the pose judged against the simulator's truth."""
-    from .inspect.closed_loop import run_inspect
+    from .inspection.closed_loop import run_inspect
     summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress())
     result = summary["result"]
     _print_result(result, args.out)
@@ -252,9 +252,9 @@ def cmd_demo(args):
 
 
 def cmd_scan(args):
-    from .inspect.pipeline import load_nominal
+    from .inspection.pipeline import load_nominal
     from .rig.kinematics import RigKinematics
-    from .rig.scan import open_rig, scan_to_dir
+    from .measurement.scan import open_rig, scan_to_dir
     kinematics = RigKinematics.from_json(args.rig_file) if args.rig_file else None
     nominal = load_nominal(args.cad) if args.rig == "sim" else None
     rig = open_rig(args.rig, nominal=nominal, seed=args.seed, kinematics=kinematics)
@@ -271,12 +271,12 @@ def cmd_scan(args):
 
 def cmd_simrig(args):
     from .rig.simrig_device import run_simrig
-    from .inspect.pipeline import load_nominal
+    from .inspection.pipeline import load_nominal
     run_simrig(load_nominal(args.cad), seed=args.seed)
 
 
 def cmd_report(args, cad=None, points=None):
-    from .inspect.report import run_report
+    from .inspection.report import run_report
     options = {}
     if args.section_heights:
         options["heights_pct"] = args.section_heights
@@ -289,7 +289,7 @@ def cmd_report(args, cad=None, points=None):
 
 
 def cmd_batch(args):
-    from .inspect.batch import run_batch
+    from .inspection.batch import run_batch
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
                         allow_mismatch=args.allow_mismatch)
@@ -297,7 +297,7 @@ def cmd_batch(args):
 
 
 def cmd_inspect(args):
-    from .inspect.closed_loop import run_inspect
+    from .inspection.closed_loop import run_inspect
     summary = run_inspect(args.cad, args.out, rig_spec=args.rig,
                           section_heights=args.section_heights, complete=args.complete,
                           pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
@@ -309,7 +309,7 @@ def cmd_inspect(args):
 
 
 def cmd_calibrate(args):
-    from .rig.calibration import run_calibration
+    from .measurement.calibration import run_calibration
     errors = {}
     if args.rig == "sim":
         errors = {"axis_offset_mm": args.sim_axis_offset, "axis_tilt_deg": args.sim_axis_tilt}
@@ -345,7 +345,7 @@ def main(argv=None):
     try:
         args = build_parser().parse_args(argv)
         if args.command in OUT_FOLDER_COMMANDS:
-            from .inspect.checks import check_out_dir
+            from .inspection.checks import check_out_dir
             check_out_dir(args.out)
         COMMANDS[args.command](args)
     except (InputError, DeviceError) as exc:

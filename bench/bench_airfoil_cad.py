@@ -23,8 +23,8 @@ import Part  # noqa: E402
 
 from BladeInspect.cad.airfoil_sections import airfoil_section  # noqa: E402
 from BladeInspect.core import airfoil  # noqa: E402
-from BladeInspect.inspect.pipeline import load_nominal  # noqa: E402
-from BladeInspect.inspect.sections import span_axis_of  # noqa: E402
+from BladeInspect.inspection.pipeline import load_nominal  # noqa: E402
+from BladeInspect.inspection.sections import span_axis_of  # noqa: E402
 from tests.helpers import ROTOR67_SECTIONS, have_rotor67  # noqa: E402
 
 HEIGHTS_PCT = (10, 30, 50, 70, 90)

@@ -16,8 +16,8 @@ import FreeCAD  # noqa: F401  (before Part)
 from BladeInspect.cad.demo_blade import BladeParams, make_demo_blade
 from BladeInspect.cad.nominal import nominal_from_shape
 from BladeInspect.core.pointio import PointSet, write_points_csv
-from BladeInspect.inspect import pipeline
-from BladeInspect.inspect.simulate import simulate_measurement
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import simulate_measurement
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROTOR67 = os.path.join(REPO, "..", "shared", "data", "blades", "nasa_rotor67")

@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.dirname(HERE))
 
 def calibration_figures(trials):
     from BladeInspect.core import transforms as tf
-    from BladeInspect.rig import calibration as cal
+    from BladeInspect.measurement import calibration as cal
     from BladeInspect.rig.kinematics import RigKinematics
     from BladeInspect.rig.simulated import SimulatedRig
     print("== calibration: injected axis offset 0.2 mm, tilt 0.1 deg, random directions")
@@ -61,7 +61,7 @@ def calibration_figures(trials):
 def planning_figures(seeds):
     from BladeInspect.cad.demo_blade import make_demo_blade
     from BladeInspect.cad.nominal import nominal_from_shape
-    from BladeInspect.rig import planning
+    from BladeInspect.measurement import planning
     from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
     print("== planning: demo blade at random fixture poses, sections 10/30/50/70/90 %")
     model = make_demo_blade()
@@ -99,8 +99,8 @@ def planning_figures(seeds):
 def inspect_figures(seeds):
     import tempfile
     from BladeInspect.core import transforms as tf
-    from BladeInspect.inspect.closed_loop import run_inspect
-    from BladeInspect.inspect.pipeline import load_nominal
+    from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.pipeline import load_nominal
     from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
     print("== inspect loop: demo blade, random fixture pose, 30 um bump, sections 10..90 %")
     nominal = load_nominal(None)

@@ -27,7 +27,7 @@ def main():
     from BladeInspect.cad.demo_blade import make_demo_blade
     from BladeInspect.cad.nominal import nominal_from_shape
     from BladeInspect.core import transforms as tf
-    from BladeInspect.rig.complete import plan_complete, scan_complete
+    from BladeInspect.measurement.complete import plan_complete, scan_complete
     from BladeInspect.rig.simulated import simulated_rig_for
 
     t0 = time.perf_counter()
@@ -62,7 +62,7 @@ def main():
 
     if args.skip_inspect:
         return
-    from BladeInspect.inspect.closed_loop import run_inspect
+    from BladeInspect.inspection.closed_loop import run_inspect
     rig = simulated_rig_for(nominal, seed=args.seed)
     out = tempfile.mkdtemp(prefix="bench-complete-")
     try:

@@ -86,8 +86,8 @@ def synthetic(n_points, trials):
 
 
 def demo(n_points, trials):
-    from BladeInspect.inspect import pipeline
-    from BladeInspect.inspect.simulate import simulate_measurement
+    from BladeInspect.inspection import pipeline
+    from BladeInspect.inspection.simulate import simulate_measurement
     nominal = pipeline.load_nominal(None)
     closest = pipeline.exact_closest_fn(nominal)
     print("demo blade, simulated scan of %d points (+-6 um uniform, 2 %% outliers), ICP "

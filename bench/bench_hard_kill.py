@@ -31,9 +31,9 @@ from bench.bench_inspect_resume import pose, read, start_simrig, stop  # noqa: E
 
 
 def in_process(out, seed, heights, journal=True):
-    from BladeInspect.inspect.closed_loop import run_inspect
-    from BladeInspect.inspect.pipeline import load_nominal
-    from BladeInspect.rig import journal as journal_mod
+    from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.pipeline import load_nominal
+    from BladeInspect.measurement import journal as journal_mod
     from BladeInspect.rig.simulated import simulated_rig_for
     nominal = load_nominal(None)
     rig = simulated_rig_for(nominal, seed=seed)
@@ -101,7 +101,7 @@ def main():
     stop(simrig)
     live = os.path.join(out, ".checkpoint")
     state = json.loads(read(os.path.join(live, "scan.json")))["inspection"]
-    from BladeInspect.rig.journal import read_journal
+    from BladeInspect.measurement.journal import read_journal
     journal = read_journal(os.path.join(live, "readings.journal"))[0]
     rows = read(os.path.join(live, "points.csv")).count("\n") - 1
     print("inspect --rig serial, SIGKILL at the 2nd path of the 2nd planned section: exit %d "

@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspect import pipeline
-from BladeInspect.inspect.simulate import pose_error, simulate_measurement
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import pose_error, simulate_measurement
 
 
 def trials(nominal, n_trials, n_points, seed0=1000):

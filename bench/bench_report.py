@@ -19,8 +19,8 @@ import numpy as np
 
 from BladeInspect.cad.demo_blade import BladeParams, section_points
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspect.pipeline import load_nominal
-from BladeInspect.inspect.report import run_report
+from BladeInspect.inspection.pipeline import load_nominal
+from BladeInspect.inspection.report import run_report
 
 N_POINTS = 269158
 

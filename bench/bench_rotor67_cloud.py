@@ -13,7 +13,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.pointio import PointSet
-from BladeInspect.inspect import pipeline
+from BladeInspect.inspection import pipeline
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data",
                     "blades", "nasa_rotor67")

@@ -22,7 +22,7 @@ from tests.test_rotor67_loop import (BLIND_SECTIONS, HEIGHTS, STANDOFF, _bump_at
 
 def one_loop(nominal, seed, n_sections):
     from BladeInspect.core.pointio import read_points
-    from BladeInspect.inspect.closed_loop import run_inspect
+    from BladeInspect.inspection.closed_loop import run_inspect
     from BladeInspect.rig.sensor import SensorModel
     from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
     axis, bump = _bump_at_section(nominal, HEIGHTS[0])

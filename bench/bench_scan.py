@@ -18,9 +18,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from BladeInspect.core import transforms as tf  # noqa: E402
-from BladeInspect.rig.calibration import SpherePart  # noqa: E402
-from BladeInspect.rig.complete import plan_complete  # noqa: E402
-from BladeInspect.rig.scan import demo_nominal, open_rig, scan_to_dir  # noqa: E402
+from BladeInspect.measurement.calibration import SpherePart  # noqa: E402
+from BladeInspect.measurement.complete import plan_complete  # noqa: E402
+from BladeInspect.measurement.scan import demo_nominal, open_rig, scan_to_dir  # noqa: E402
 from BladeInspect.rig.simulated import SimulatedRig  # noqa: E402
 
 SENSOR_RATE = 9000.0

@@ -15,8 +15,8 @@ import numpy as np
 
 from BladeInspect.cad.load import load_nominal
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspect.pipeline import load_points, register
-from BladeInspect.rig.scan import open_rig, scan_to_dir
+from BladeInspect.inspection.pipeline import load_points, register
+from BladeInspect.measurement.scan import open_rig, scan_to_dir
 
 
 def main():

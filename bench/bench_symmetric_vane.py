@@ -19,8 +19,8 @@ import time
 
 import numpy as np
 
-from BladeInspect.inspect import pipeline
-from BladeInspect.inspect.simulate import pose_error
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import pose_error
 from tests.symmetric_vane import ISSUE_VANE, OTHER_VANE, scan_vane, vane_nominal
 
 # A stated 1 sigma this large (a tenth of the bench parts' span) says the pose is not known: it
@@ -65,7 +65,7 @@ def summary(rows):
 
 
 def demo(poses, seed0=30):
-    from BladeInspect.inspect.simulate import simulate_measurement
+    from BladeInspect.inspection.simulate import simulate_measurement
     nominal = pipeline.load_nominal(None)
     print("demo blade")
     for seed in range(seed0, seed0 + poses):

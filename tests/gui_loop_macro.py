@@ -247,7 +247,7 @@ def run():
     @step("inspect with the connected rig")
     def _():
         from BladeInspect.gui.session import RIG
-        from BladeInspect.rig.scan import open_rig
+        from BladeInspect.measurement.scan import open_rig
         blade = state["blade"]
         RIG.connect(open_rig("sim", objects.nominal_of(blade), seed=4), "sim")
         try:
@@ -346,7 +346,7 @@ def run():
         check("the inspect panel offers the new RIG.json",
               loop_commands.LAST_RIG_FILE[0] == rig_json, written)
         # The simulator's true axis for the panel's seed and injected errors.
-        from BladeInspect.rig.calibration import simulated_calibration_rig
+        from BladeInspect.measurement.calibration import simulated_calibration_rig
         rig, truth = simulated_calibration_rig(panel_diameter, seed=panel_seed,
                                                axis_offset_mm=0.2, axis_tilt_deg=0.1)
         rig.close()

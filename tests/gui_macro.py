@@ -87,11 +87,11 @@ def run():
     @step("import simulated points, register, deviation map")
     def _():
         for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
-                       "BladeInspect.inspect.simulate"):
+                       "BladeInspect.inspection.simulate"):
             need(module)
         from BladeInspect.core.pointio import write_points_csv
         from BladeInspect.core import transforms as tf
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection.simulate import simulate_measurement
         blade = state["blade"]
         nominal = objects.nominal_of(blade)
         ps, truth, info, _ = simulate_measurement(nominal, n_points=2000, seed=3,
@@ -142,7 +142,7 @@ def run():
     @step("section analysis of the registration")
     def _():
         need("BladeInspect.cad.sections")
-        need("BladeInspect.inspect.report")
+        need("BladeInspect.inspection.report")
         if "reg" not in state:
             raise Skip("no registration made")
         reg = state["reg"]
@@ -156,8 +156,8 @@ def run():
 
     @step("report of the registration")
     def _():
-        need("BladeInspect.inspect.report")
-        need("BladeInspect.inspect.document")
+        need("BladeInspect.inspection.report")
+        need("BladeInspect.inspection.document")
         if "reg" not in state:
             raise Skip("no registration made")
         reg, nominal = state["reg"], state["nominal"]
@@ -185,7 +185,7 @@ def run():
     @step("simulated rig: connect, scan, reconstruct, register, deviation map, sections")
     def _():
         for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
-                       "BladeInspect.rig.scan", "BladeInspect.cad.loft"):
+                       "BladeInspect.measurement.scan", "BladeInspect.cad.loft"):
             need(module)
         blade = state["blade"]
         Gui.Selection.clearSelection()
@@ -333,7 +333,7 @@ def _known_result(shape):
     """Points on the blade's faces moved along their normals by a known deviation field
     (a smooth wave over the span, both signs, beyond the colour limit at its peaks)."""
     from BladeInspect.core.stats import deviation_statistics
-    from BladeInspect.inspect.result import RegistrationResult
+    from BladeInspect.inspection.result import RegistrationResult
     pts, nrm = [], []
     for face in shape.Faces:
         if "Plane" in type(face.Surface).__name__:

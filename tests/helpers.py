@@ -15,7 +15,7 @@ def demo_nominal():
     """The built-in demo blade's Nominal, built once per test run (about a second) and shared
     by the modules that only read it."""
     if not _DEMO_NOMINAL:
-        from BladeInspect.inspect.pipeline import load_nominal
+        from BladeInspect.inspection.pipeline import load_nominal
         _DEMO_NOMINAL.append(load_nominal(None))
     return _DEMO_NOMINAL[0]
 

@@ -8,7 +8,7 @@ independently of the code under test.
 import numpy as np
 
 from BladeInspect.core.stats import deviation_statistics
-from BladeInspect.inspect.result import RegistrationResult
+from BladeInspect.inspection.result import RegistrationResult
 from tests.helpers import demo_nominal  # noqa: F401 (the fixtures' users call fx.demo_nominal)
 
 def surface_points(nominal, levels_z, spacing=0.3, normal=(0.0, 0.0, 1.0)):

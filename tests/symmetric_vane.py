@@ -10,7 +10,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.pointio import PointSet
-from BladeInspect.inspect.simulate import GOOD_SNR, OUTLIER_SNR, sample_faces
+from BladeInspect.inspection.simulate import GOOD_SNR, OUTLIER_SNR, sample_faces
 
 # The vane: suction arc through (-25,0),(0,6),(25,0), pressure arc through
 # (-25,0),(0,2),(25,0), edge radii 0.8 (x = -25) and 0.4 (x = +25), span 100 mm.

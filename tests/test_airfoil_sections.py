@@ -10,7 +10,7 @@ import Part
 from BladeInspect.cad.airfoil_sections import airfoil_section, plane_frame
 from BladeInspect.core import airfoil
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspect.sections import span_axis_of
+from BladeInspect.inspection.sections import span_axis_of
 from tests.helpers import demo_nominal
 
 

@@ -49,7 +49,7 @@ def random_rotation(rng):
 def synthetic_result(rng, n=300, deviation=None):
     """A RegistrationResult with a random pose and known deviations, as the pipeline makes."""
     from BladeInspect.core.stats import deviation_statistics
-    from BladeInspect.inspect.result import RegistrationResult
+    from BladeInspect.inspection.result import RegistrationResult
     T = np.eye(4)
     T[:3, :3] = random_rotation(rng)
     T[:3, 3] = rng.uniform(-50, 50, 3)
@@ -121,7 +121,7 @@ class TestMeasurement(DocumentCase):
 
     @unittest.skipUnless(_have("BladeInspect.cad.load"), "cad.load (point reader) not landed")
     def test_recompute_rereads_the_source_file_when_it_changes(self):
-        from BladeInspect.inspect.pipeline import load_points
+        from BladeInspect.inspection.pipeline import load_points
         path = os.path.join(self.tmp, "pts.csv")
         rng = np.random.default_rng(2)
         first = np.column_stack([rng.uniform(-10, 10, (50, 3)), rng.uniform(0, 100, 50)])
@@ -253,7 +253,7 @@ class TestRegistration(DocumentCase):
     def test_re_registers_only_when_an_input_changes(self):
         """The pipeline is replaced by a stand-in whose answer is known (identity pose,
         deviation = z), to check when the object recomputes and what it then stores."""
-        import BladeInspect.inspect.pipeline as pipeline
+        import BladeInspect.inspection.pipeline as pipeline
         rng = np.random.default_rng(4)
         calls = []
         _, template = synthetic_result(rng, n=40)

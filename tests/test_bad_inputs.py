@@ -55,7 +55,7 @@ class BadInputCase(unittest.TestCase):
     def setUpClass(cls):
         import FreeCAD  # noqa: F401  (FreeCAD before Part)
         from BladeInspect.cad.demo_blade import make_demo_blade
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection.simulate import simulate_measurement
         cls.tmp = tempfile.mkdtemp(prefix="bladeinspect-bad-")
         cls.cad = os.path.join(cls.tmp, "blade.step")
         make_demo_blade().shape.exportStep(cls.cad)
@@ -174,7 +174,7 @@ class TestAnotherBlade(BadInputCase):
         super().setUpClass()
         from BladeInspect.cad.demo_blade import BladeParams, make_demo_blade
         from BladeInspect.cad.nominal import nominal_from_shape
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection.simulate import simulate_measurement
         other = make_demo_blade(BladeParams(twist_deg=40.0, camber_root=0.11, chord_root=46.0))
         cls.other_nominal = nominal_from_shape(other.shape, roles=other.roles)
         scan, _, _, _ = simulate_measurement(cls.other_nominal, n_points=300, seed=4,
@@ -222,8 +222,8 @@ class TestAnotherBlade(BadInputCase):
 class TestTimeLimit(unittest.TestCase):
     def test_a_spent_budget_ends_the_fine_stage_with_a_message(self):
         from BladeInspect.core.errors import InputError
-        from BladeInspect.inspect import pipeline
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection import pipeline
+        from BladeInspect.inspection.simulate import simulate_measurement
         scan, truth, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
                                                  section_heights=())
         with self.assertRaises(InputError) as ctx:
@@ -235,8 +235,8 @@ class TestTimeLimit(unittest.TestCase):
     def test_a_spent_budget_ends_the_coarse_stage_with_a_message(self):
         from unittest import mock
         from BladeInspect.core.errors import InputError
-        from BladeInspect.inspect import pipeline
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection import pipeline
+        from BladeInspect.inspection.simulate import simulate_measurement
         scan, _, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
                                              section_heights=())
         with mock.patch.object(pipeline, "COARSE_TIME_LIMIT_S", 0.0), \
@@ -246,8 +246,8 @@ class TestTimeLimit(unittest.TestCase):
 
     def test_icp_stops_at_its_time_limit(self):
         from BladeInspect.core import icp
-        from BladeInspect.inspect.pipeline import exact_closest_fn
-        from BladeInspect.inspect.simulate import simulate_measurement
+        from BladeInspect.inspection.pipeline import exact_closest_fn
+        from BladeInspect.inspection.simulate import simulate_measurement
         scan, truth, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
                                                  section_heights=())
         fit = icp.icp(scan.xyz, scan.snr, exact_closest_fn(demo_nominal()), truth,
@@ -317,7 +317,7 @@ class TestUnmeasuredDirections(unittest.TestCase):
         np.testing.assert_allclose(split.covariance, 2e-5 * np.linalg.inv(H), rtol=1e-9)
 
     def test_words_for_a_prism(self):
-        from BladeInspect.inspect.checks import describe_unmeasured
+        from BladeInspect.inspection.checks import describe_unmeasured
         points, normals = self.cylinder(20.0, 9.0)
         H, icp = self.information(points, normals, points.mean(axis=0))
         split = icp.split_information(H, 1e-5, 80.0, len(points))

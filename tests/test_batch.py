@@ -10,7 +10,7 @@ import numpy as np
 from BladeInspect.cad.demo_blade import BladeParams
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspect import batch as B
+from BladeInspect.inspection import batch as B
 from tests import inspection_fixtures as fx
 
 SPAN = BladeParams().span

@@ -9,7 +9,7 @@ import unittest
 import numpy as np
 
 from BladeInspect.core.errors import InputError
-from BladeInspect.rig import calibration as cal
+from BladeInspect.measurement import calibration as cal
 
 
 def rodrigues(points, angle_deg, point, direction):

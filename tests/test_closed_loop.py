@@ -25,7 +25,7 @@ BUMP_RADIUS = 6.0
 class TestInspectLoop(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.sensor import SensorModel
         from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
         nominal = demo_nominal()
@@ -43,7 +43,7 @@ class TestInspectLoop(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="bi-inspect-")
         cls.out = os.path.join(cls.tmp, "out")
         # A CMM's points of the same sections (CAD frame, the same bump, 1 um noise).
-        from BladeInspect.rig.planning import nominal_section
+        from BladeInspect.measurement.planning import nominal_section
         rng = np.random.default_rng(5)
         cmm = []
         for h in HEIGHTS:
@@ -130,7 +130,7 @@ class TestInspectLoop(unittest.TestCase):
 
 class TestInspectErrors(unittest.TestCase):
     def test_bad_heights_leave_nothing(self):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "out")
             for bad in ((10, 120), (-1,), ("x",)):

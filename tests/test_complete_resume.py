@@ -22,7 +22,7 @@ PASSES_BEFORE_FAULT = 3
 
 
 def inspect_complete(nominal, out, rig, progress=None, resume=False):
-    from BladeInspect.inspect.closed_loop import run_inspect
+    from BladeInspect.inspection.closed_loop import run_inspect
     return run_inspect(None, out, rig=rig, nominal=nominal, seed=SEED, complete=True,
                        pitch=PITCH, section_heights=HEIGHTS, document=False,
                        scan_options=dict(SCAN_OPTIONS), progress=progress, resume=resume)

@@ -1,4 +1,4 @@
-"""The complete scan (rig.complete, `inspect --complete`) of the demo blade at a coarse pitch,
+"""The complete scan (measurement.complete, `inspect --complete`) of the demo blade at a coarse pitch,
 judged by the simulator's truth pose and by OCC's own distance and normals, not by the ray
 cast the plan itself is made from."""
 import json
@@ -36,7 +36,7 @@ class TestCompleteRaster(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.rig.complete import plan_complete, scan_complete
+        from BladeInspect.measurement.complete import plan_complete, scan_complete
         from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
         cls.nominal = demo_nominal()
         cls.truth = random_fixture_pose(np.random.default_rng(SEED))
@@ -116,7 +116,7 @@ class TestCompleteRaster(unittest.TestCase):
         self.assertTrue(np.all(chosen >= np.cos(np.radians(40.0)) - 1e-6))
 
     def test_bad_pitch(self):
-        from BladeInspect.rig.complete import plan_complete
+        from BladeInspect.measurement.complete import plan_complete
         for bad in (0.0, -1.0, float("nan"), "abc"):
             with self.assertRaises(InputError):
                 plan_complete(self.nominal, self.truth, self.rig.sensor, self.rig.limits,
@@ -125,7 +125,7 @@ class TestCompleteRaster(unittest.TestCase):
 
 class TestPasses(unittest.TestCase):
     def test_whole_lines_up_to_the_limit(self):
-        from BladeInspect.rig.complete import _passes
+        from BladeInspect.measurement.complete import _passes
         rng = np.random.default_rng(3)
         for _ in range(20):
             sizes = rng.integers(1, 9, rng.integers(1, 30))
@@ -154,7 +154,7 @@ class TestInspectComplete(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.sensor import SensorModel
         from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
         cls.nominal = demo_nominal()
@@ -232,7 +232,7 @@ class TestInspectComplete(unittest.TestCase):
         self.assertLess(self.result_json["sections"][1]["optical"]["max_abs_mm"], 0.005)
 
     def test_bad_pitch_is_input_error(self):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         with self.assertRaises(InputError):
             run_inspect(None, os.path.join(self.tmp, "bad"), rig=self.rig, nominal=self.nominal,
                         complete=True, pitch=0.0, document=False)

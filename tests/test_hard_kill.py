@@ -22,7 +22,7 @@ import numpy as np
 
 from BladeInspect.core.errors import InputError
 from BladeInspect.core.pointio import read_points
-from BladeInspect.rig.journal import JOURNAL_FILE, read_journal
+from BladeInspect.measurement.journal import JOURNAL_FILE, read_journal
 from tests.helpers import demo_nominal
 from tests.serial_support import FakeSimulatedRig, section_path
 
@@ -140,7 +140,7 @@ def finish(proc, log):
 class TestInspectKilled(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         cls.nominal = demo_nominal()
         cls.tmp = tempfile.mkdtemp(prefix="bi-kill-")
         ref_out = os.path.join(cls.tmp, "reference")
@@ -239,7 +239,7 @@ class TestInspectKilled(unittest.TestCase):
 
 class TestScanKilled(unittest.TestCase):
     def test_killed_scan_resumes_to_the_uninterrupted_rows(self):
-        from BladeInspect.rig.scan import scan_to_dir
+        from BladeInspect.measurement.scan import scan_to_dir
         from BladeInspect.rig.simrig_device import SimRigDevice
         from BladeInspect.rig.serial_rig import SerialRig
         nominal = demo_nominal()
@@ -298,12 +298,12 @@ class TestJournal(unittest.TestCase):
 
     def journaled_run(self, n):
         """n passes through a journaled fake rig; returns the readings."""
-        from BladeInspect.rig.journal import JournaledRig
+        from BladeInspect.measurement.journal import JournaledRig
         rig = JournaledRig(FakeSimulatedRig(seed=3), self.path)
         return [rig.scan_path(p, 15.0 * i) for i, p in enumerate(self.paths[:n])]
 
     def resumed(self, committed):
-        from BladeInspect.rig.journal import JournaledRig
+        from BladeInspect.measurement.journal import JournaledRig
         inner = FakeSimulatedRig(seed=3)
         inner.set_pass_index = lambda i: setattr(inner, "pass_index", i)
         rig = JournaledRig(inner, self.path, keep=True)

@@ -67,7 +67,7 @@ class Reference:
     each planned path (per plan attempt): where to make the device fail."""
 
     def __init__(self, nominal, out):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         rig = simulated_rig(nominal)
         self.blind_section_pass = []
         self.path_pass = []         # per attempt: pass index at the start of each path
@@ -135,7 +135,7 @@ class TestInspectResume(unittest.TestCase):
 
     @classmethod
     def run_serial(cls, kind=None, fault_at=None, resume=False):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.serial_rig import SerialRig
         from BladeInspect.rig.simrig_device import Fault, SimRigDevice
         fault = None if kind is None else Fault(kind, after_passes=fault_at)
@@ -309,7 +309,7 @@ class TestResumeRefusals(unittest.TestCase):
     def setUpClass(cls):
         from BladeInspect.rig.serial_rig import SerialRig
         from BladeInspect.rig.simrig_device import Fault, SimRigDevice
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         cls.nominal = demo_nominal()
         cls.tmp = tempfile.mkdtemp(prefix="bi-refuse-")
         cls.out = os.path.join(cls.tmp, "out")
@@ -341,7 +341,7 @@ class TestResumeRefusals(unittest.TestCase):
         return out
 
     def refused(self, pattern, **options):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         kwargs = dict(rig=simulated_rig(self.nominal), nominal=self.nominal, seed=SEED,
                       section_heights=HEIGHTS, document=False, resume=True)
         kwargs.update(options)
@@ -385,7 +385,7 @@ class TestResumeRefusals(unittest.TestCase):
         self.refused("holds an interrupted inspection", resume=False)
 
     def test_nothing_to_resume(self):
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         empty = os.path.join(self.tmp, "empty")
         with self.assertRaisesRegex(InputError, "holds no interrupted inspection"):
             run_inspect(None, empty, rig=simulated_rig(self.nominal), nominal=self.nominal,
@@ -395,7 +395,7 @@ class TestResumeRefusals(unittest.TestCase):
     def test_failure_over_an_earlier_result_leaves_no_result(self):
         """A run into a folder holding a finished inspection fails on the rig: the folder is
         then a checkpoint, and none of the earlier result files stands beside it."""
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.serial_rig import SerialRig
         from BladeInspect.rig.simrig_device import Fault, SimRigDevice
         out = os.path.join(self.tmp, "over-a-result")
@@ -459,7 +459,7 @@ class TestCancelledInspectionResumes(unittest.TestCase):
 
     def test_cancel_in_the_planned_phase_then_resume(self):
         from BladeInspect.core.errors import Cancelled
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         nominal = demo_nominal()
         tmp = tempfile.mkdtemp(prefix="bi-cancel-")
         self.addCleanup(shutil.rmtree, tmp, True)

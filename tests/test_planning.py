@@ -8,7 +8,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
-from BladeInspect.rig import planning
+from BladeInspect.measurement import planning
 from BladeInspect.rig.base import AxisLimits
 from tests.helpers import demo_nominal
 

@@ -5,8 +5,8 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspect import pipeline
-from BladeInspect.inspect.simulate import pose_error, simulate_measurement
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import pose_error, simulate_measurement
 from tests.helpers import demo_nominal
 
 class TestRegistrationFromAnyPose(unittest.TestCase):
@@ -101,7 +101,7 @@ class TestBlindScanRegistration(unittest.TestCase):
         import json
         import shutil
         import tempfile
-        from BladeInspect.rig.scan import open_rig, scan_to_dir
+        from BladeInspect.measurement.scan import open_rig, scan_to_dir
         nominal = demo_nominal()
         tmp = tempfile.mkdtemp(prefix="bladeinspect-blind-")
         try:

@@ -15,9 +15,9 @@ import numpy as np
 from BladeInspect.cad.demo_blade import BladeParams
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspect import report as R
-from BladeInspect.inspect import sections as S
-from BladeInspect.inspect import verdict as V
+from BladeInspect.inspection import report as R
+from BladeInspect.inspection import sections as S
+from BladeInspect.inspection import verdict as V
 from tests import inspection_fixtures as fx
 
 SPAN = BladeParams().span

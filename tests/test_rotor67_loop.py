@@ -76,8 +76,8 @@ class TestBlindScanRegisters(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.inspect.pipeline import load_points, register
-        from BladeInspect.rig.scan import open_rig, scan_to_dir
+        from BladeInspect.inspection.pipeline import load_points, register
+        from BladeInspect.measurement.scan import open_rig, scan_to_dir
         cls.nominal = rotor67_nominal()
         cls.tmp = tempfile.mkdtemp(prefix="bi-r67-scan-")
         rig = open_rig("sim", cls.nominal, SEED_BLIND)
@@ -137,7 +137,7 @@ class TestBlindScanRegisters(unittest.TestCase):
 def _bump_at_section(nominal, height_pct):
     """A bump centred on the suction side where the loop's plane at ``height_pct`` crosses it,
     halfway along the chord."""
-    from BladeInspect.inspect.sections import span_axis_of
+    from BladeInspect.inspection.sections import span_axis_of
     from BladeInspect.rig.simulated import make_bump
     axis, (lo, hi) = span_axis_of(nominal)
     s = nominal.samples
@@ -156,7 +156,7 @@ class TestInspectLoop(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         from BladeInspect.core.pointio import read_points
-        from BladeInspect.inspect.closed_loop import run_inspect
+        from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.sensor import SensorModel
         from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
         nominal = cls.nominal = rotor67_nominal()

@@ -12,7 +12,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
-from BladeInspect.rig.scan import open_rig, scan_to_dir
+from BladeInspect.measurement.scan import open_rig, scan_to_dir
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
 from tests.rig_parts import TwistedEllipse
 
@@ -151,7 +151,7 @@ class TestDemoBlade(unittest.TestCase):
 
     def test_section_of_the_demo_blade_lies_on_its_cad(self):
         try:
-            from BladeInspect.rig.scan import demo_nominal
+            from BladeInspect.measurement.scan import demo_nominal
             nominal = demo_nominal()
         except ImportError as exc:          # the CAD layer needs FreeCAD
             self.skipTest("no CAD layer: %s" % exc)

@@ -9,8 +9,8 @@ import numpy as np
 
 from BladeInspect.cad.demo_blade import BladeParams, section_points
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspect import sections as S
-from BladeInspect.inspect import verdict as V
+from BladeInspect.inspection import sections as S
+from BladeInspect.inspection import verdict as V
 from tests import inspection_fixtures as fx
 
 SPAN = BladeParams().span

@@ -173,7 +173,7 @@ class ScanResumeTest(unittest.TestCase):
         import json
         import os
         import tempfile
-        from BladeInspect.rig.scan import scan_to_dir
+        from BladeInspect.measurement.scan import scan_to_dir
         folder = tempfile.TemporaryDirectory()
         self.addCleanup(folder.cleanup)
         reference_dir = os.path.join(folder.name, "reference")

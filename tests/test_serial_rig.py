@@ -149,7 +149,7 @@ class SerialScanToDirTest(unittest.TestCase):
         # The whole blind scan (probing, levelling, rescans, final passes) over two ports.
         import os
         import tempfile
-        from BladeInspect.rig.scan import scan_to_dir
+        from BladeInspect.measurement.scan import scan_to_dir
         from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
         from tests.rig_parts import TwistedEllipse
 

@@ -150,8 +150,8 @@ class TestDemoBladeSpeed(unittest.TestCase):
         9000 points/s, exact ray cast on the demo blade's CAD and sensor model included. The
         setpoints are a complete-scan raster at one angle, so every point reads the blade.
         The best of up to five runs: other jobs share the machine."""
-        from BladeInspect.rig.complete import plan_complete
-        from BladeInspect.rig.scan import demo_nominal
+        from BladeInspect.measurement.complete import plan_complete
+        from BladeInspect.measurement.scan import demo_nominal
         from BladeInspect.rig.simulated import simulated_rig_for
         nominal = demo_nominal()
         rig = simulated_rig_for(nominal, seed=0)

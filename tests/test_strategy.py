@@ -10,7 +10,7 @@ from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
 from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
-from BladeInspect.rig.strategy import ScanStrategy, ViewResult, fit_section_curve
+from BladeInspect.measurement.strategy import ScanStrategy, ViewResult, fit_section_curve
 from tests.rig_parts import Sphere, TwistedEllipse
 
 TWIST = 25.0

@@ -15,8 +15,8 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import icp, ranking
-from BladeInspect.inspect import pipeline
-from BladeInspect.inspect.simulate import pose_error
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import pose_error
 from tests.symmetric_vane import ISSUE_VANE, scan_vane, vane_nominal
 
 DECIDABLE_SEEDS = (1, 2, 3, 4)
@@ -79,7 +79,7 @@ class TestNearSymmetricVane(unittest.TestCase):
 
     def test_equal_edge_radii_give_the_warning_and_both_poses(self):
         from BladeInspect import cli
-        from BladeInspect.inspect.report import pose_rows
+        from BladeInspect.inspection.report import pose_rows
         nominal = self.symmetric
         for seed in SYMMETRIC_SEEDS:
             with self.subTest(seed=seed):

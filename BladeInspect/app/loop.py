@@ -79,7 +79,7 @@ def cmm_section_table(registration, cmm_path):
     """Table 2 of a Registration with the CMM file's columns beside the optical ones. For an
     inspection, at its nominal sections from the planned points only; for any other
     registration, the sections the section analysis would choose."""
-    from ..inspect.sections import read_cmm, section_table
+    from ..inspection.sections import read_cmm, section_table
     if registration.Nominal is None:
         raise InputError("%s: no nominal linked" % registration.Label)
     cmm = read_cmm(cmm_path)

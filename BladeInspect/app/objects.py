@@ -303,7 +303,7 @@ class Measurement(_Proxy):
         if obj.SourceFile and os.path.exists(obj.SourceFile):
             signature = _file_signature(obj.SourceFile)
             if signature != obj.LoadedSignature:
-                from ..inspect.pipeline import load_points
+                from ..inspection.pipeline import load_points
                 store_pointset(obj, load_points(obj.SourceFile))
                 obj.LoadedSignature = signature
         elif obj.SourceFile:
@@ -510,7 +510,7 @@ class Registration(_Proxy):
         signature = self.signature(obj)
         if not signature or signature == obj.InputSignature:
             return
-        from ..inspect.pipeline import register
+        from ..inspection.pipeline import register
         result = register(nominal_of(obj.Nominal), pointset_of(obj.Measurement), seed=obj.Seed)
         store_registration(obj, result)
         obj.InputSignature = signature
@@ -634,7 +634,7 @@ def registration_result(obj, nominal):
     """The pipeline's RegistrationResult of a Registration object, for the stages after it
     (sections, reports). The closest points, normals and faces are not stored in the document;
     they are the nominal's exact signed distance of the stored points."""
-    from ..inspect.result import RegistrationResult
+    from ..inspection.result import RegistrationResult
     points, deviation, inlier = registration_points(obj)
     dist = nominal.signed_distance(points)
     columns = {}
@@ -657,7 +657,7 @@ def registration_result(obj, nominal):
 
 
 def make_section_profiles(doc, table, registration=None, name="SectionProfiles"):
-    """The nominal section profiles of a section table (inspect.sections) as Part polylines, one
+    """The nominal section profiles of a section table (inspection.sections) as Part polylines, one
     compound, for showing where the sections were cut. A snapshot: made again by the command."""
     import Part
     edges = []

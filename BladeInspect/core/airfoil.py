@@ -29,7 +29,7 @@ DEFAULT_EDGE_ZONE_DEG = 45.0
 # ill-conditioned (the bisector of two nearly parallel normals).
 MIN_CONTACT_ANGLE_DEG = 60.0
 # Contour zones: a point is at an edge when its foot on the nominal lies within this fraction
-# of the chord from that end along the chord (as inspect/sections.py).
+# of the chord from that end along the chord (as inspection/sections.py).
 CONTOUR_EDGE_FRACTION = 0.03
 CHORD_METHODS = ("nose-tail", "caliper", "tangent")
 ZONES = ("LE", "TE", "suction", "pressure")

@@ -148,7 +148,7 @@ def parse_free(text, axes=None, option="--free"):
 def parse_zone_weights(text, zones=None, option="--weights-by-zone"):
     """{zone: weight} of 'LE=2,TE=2,suction=1,pressure=1'. Weights are finite and >= 0 (0
     leaves a zone out of the fit); a zone not named keeps weight 1 (per_zone).
-    ``zones``: the labels allowed (e.g. inspect.sections.ZONES), or None for any."""
+    ``zones``: the labels allowed (e.g. inspection.sections.ZONES), or None for any."""
     weights = {}
     for entry in str(text).split(","):
         name, sep, value = (part.strip() for part in entry.partition("="))

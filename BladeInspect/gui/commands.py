@@ -149,7 +149,7 @@ class ConnectRig(_Command):
         FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
 
     def connect(self, spec, seed):
-        from ..rig.scan import open_rig
+        from ..measurement.scan import open_rig
 
         def job(p):
             nominal_obj = find_nominal()
@@ -177,8 +177,8 @@ class Scan(_Command):
         FreeCADGui.Control.showDialog(taskpanels.ScanPanel(self.scan))
 
     def scan(self, options):
-        from ..rig.scan import scan_to_dir
-        from ..inspect.pipeline import load_points
+        from ..measurement.scan import scan_to_dir
+        from ..inspection.pipeline import load_points
         doc = active_document()
         out_dir = scan_folder(doc)
         params = pyinspect.signature(scan_to_dir).parameters
@@ -218,7 +218,7 @@ class ImportPoints(_Command):
             self.load(path)
 
     def load(self, path):
-        from ..inspect.pipeline import load_points
+        from ..inspection.pipeline import load_points
         doc = active_document()
 
         def job(p):
@@ -274,7 +274,7 @@ class Register(_Command):
             self.show(obj)
 
     def register(self, measurement, nominal_obj, seed=None):
-        from ..inspect.pipeline import register
+        from ..inspection.pipeline import register
         doc = measurement.Document
         seed = settings.value("Seed") if seed is None else seed
 
@@ -342,9 +342,9 @@ class SectionAnalysis(_Command):
             self.show(table)
 
     def analyse(self, registration):
-        """The section table of a registration (inspect.sections), its nominal profiles added
+        """The section table of a registration (inspection.sections), its nominal profiles added
         to the document; None when it failed (reported)."""
-        from ..inspect.sections import section_table
+        from ..inspection.sections import section_table
         doc = registration.Document
 
         def job(p):
@@ -366,7 +366,7 @@ class SectionAnalysis(_Command):
 
     @staticmethod
     def show(table):
-        from ..inspect.report import section_rows
+        from ..inspection.report import section_rows
         header, rows = section_rows(table)
         FreeCADGui.Control.closeDialog()
         FreeCADGui.Control.showDialog(taskpanels.TablePanel(
@@ -391,7 +391,7 @@ class Report(_Command):
                 open_in_browser(html)
 
     def report(self, registration, out_dir):
-        from ..inspect.report import run_report
+        from ..inspection.report import run_report
         from ..core.pointio import write_points_csv
 
         def job(p):

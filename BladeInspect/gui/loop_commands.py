@@ -80,7 +80,7 @@ def _hide_measured_frame(measurement):
 
 
 def _show_table(title, table, note):
-    from ..inspect.report import section_rows
+    from ..inspection.report import section_rows
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
     FreeCADGui.Control.closeDialog()
@@ -96,7 +96,7 @@ class InspectPanel(taskpanels._Panel):
 
     def __init__(self, on_accept):
         super().__init__()
-        from ..inspect.closed_loop import DEFAULT_HEIGHTS
+        from ..inspection.closed_loop import DEFAULT_HEIGHTS
         self.on_accept = on_accept
         self.heights = QtGui.QLineEdit(", ".join("%g" % h for h in DEFAULT_HEIGHTS))
         self.heights.setToolTip("Nominal sections to measure, % of the span from hub to tip")
@@ -129,7 +129,7 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
     title = "Calibrate rig"
 
     def __init__(self, on_accept):
-        from ..rig.calibration import DEFAULT_DIAMETER
+        from ..measurement.calibration import DEFAULT_DIAMETER
         super().__init__(on_accept)
         self.diameter = taskpanels._spin(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
         self.offset = taskpanels._spin(0.0, 0.0, 10.0, 3, "mm")
@@ -156,7 +156,7 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
 
 
 class SimulatePanel(taskpanels._Panel):
-    """The simulation test bed's options (inspect.simulate.simulate_measurement)."""
+    """The simulation test bed's options (inspection.simulate.simulate_measurement)."""
     title = "Simulation test bed"
 
     def __init__(self, on_accept):
@@ -213,7 +213,7 @@ class Inspect(commands._Command):
         drawn as it is made; the points, registration, deviation map and section profiles
         added. Returns run_inspect's summary with the new objects under "objects", or None."""
         from ..core.pointio import read_points
-        from ..inspect.closed_loop import run_inspect
+        from ..inspection.closed_loop import run_inspect
         doc = nominal_obj.Document
         out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
 
@@ -303,7 +303,7 @@ class Calibrate(commands._Command):
 
     def calibrate(self, out_path, rig_spec="sim", sphere_diameter=None, seed=0,
                   **simulated_errors):
-        from ..rig.calibration import DEFAULT_DIAMETER, run_calibration
+        from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
         if rig_spec != "sim" and RIG.connected and RIG.spec == rig_spec:
             # The calibration opens the port itself; the scan session would hold it busy.
             RIG.disconnect()
@@ -374,7 +374,7 @@ class Simulate(commands._Command):
     def simulate(self, seed=0, **options):
         """run_simulation on the document's nominal, else a new demo blade; adds the simulated
         measurement, its registration and deviation map. Returns (report, registration)."""
-        from ..inspect.simulate import run_simulation
+        from ..inspection.simulate import run_simulation
         doc = commands.active_document()
 
         def job(p):

@@ -8,7 +8,7 @@ import FreeCADGui
 from PySide import QtGui
 
 from ..app import settings
-from ..inspect.result import rival_lines
+from ..inspection.result import rival_lines
 
 
 def _spin(value, minimum, maximum, decimals=3, suffix=""):

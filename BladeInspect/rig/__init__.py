@@ -1,1 +1,3 @@
-"""Measurement side: sensor model, four-axis kinematics, simulated rig, serial drivers, scan strategy."""
+"""The rig as hardware: the sensor model, four-axis kinematics, the simulated rig and the serial
+drivers with their protocols. What to measure and how (scan strategy, planning, calibration)
+lives in measurement/."""

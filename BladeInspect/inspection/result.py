@@ -30,8 +30,8 @@ class RegistrationResult:
     source: str = ""
     cad_source: str = ""
     cad_faces: list = field(default_factory=list)   # how each CAD face's outside was decided
-    pose_unmeasured: list = field(default_factory=list)   # inspect.checks.describe_unmeasured
-    surface_fit: Optional[dict] = None                     # inspect.checks.surface_fit
+    pose_unmeasured: list = field(default_factory=list)   # inspection.checks.describe_unmeasured
+    surface_fit: Optional[dict] = None                     # inspection.checks.surface_fit
     # The Cramer-Rao bound of the fine pose alone (pose_uncertainty_mm when the coarse stage
     # was decided), and whether pose_uncertainty_mm was raised to cover an undecided rival
     # pose (pipeline.uncertainty_with_rival).

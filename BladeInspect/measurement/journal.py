@@ -25,7 +25,7 @@ import os
 import numpy as np
 
 from ..core.errors import InputError
-from .base import Readings
+from ..rig.base import Readings
 
 JOURNAL_FILE = "readings.journal"
 

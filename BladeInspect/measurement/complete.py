@@ -18,7 +18,7 @@ from scipy.ndimage import binary_dilation
 
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
-from .kinematics import RigKinematics
+from ..rig.kinematics import RigKinematics
 from .planning import (ANGLES, COVERAGE_MARGIN_DEG, _blade_faces, _body_clear,
                        _expected_snr, _incidence_table, plan_json)
 

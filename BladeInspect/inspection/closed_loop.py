@@ -1,16 +1,16 @@
 """The `inspect` workflow (issue 8, item 1): the paper's whole automated loop on one blade.
 
-1. blind section scan (rig.scan.scan_to_dir: nothing about the pose is known yet);
+1. blind section scan (measurement.scan.scan_to_dir: nothing about the pose is known yet);
 2. registration of those points (reconstruction, PCA, SNR-weighted ICP) -> pose on the table;
 3. paths planned from the CAD at its nominal section planes, brought into the machine by
-   that pose (rig.planning), and scanned;
+   that pose (measurement.planning), and scanned;
 4. ICP on all points from that pose; when the pose moved enough to matter for the planned
    points, one re-plan and re-scan of the nominal sections with the better pose;
-5. Table 2 at the nominal sections (inspect.sections, with a CMM's columns when given), the
+5. Table 2 at the nominal sections (inspection.sections, with a CMM's columns when given), the
    verdict, and the report of the `report` command.
 
 With --complete (paper 4.3) steps 3-4 are the whole blade rastered every --pitch mm instead
-(rig.complete) and one ICP on all points; Table 2 takes the raster points within 0.25 mm of
+(measurement.complete) and one ICP on all points; Table 2 takes the raster points within 0.25 mm of
 each nominal plane, and the `phase` column reads blind or complete.
 
 Files in DIR: points.csv (table frame, with a `phase` column: blind or planned), plan.json,
@@ -22,7 +22,7 @@ points.csv up to the last completed blind section, planned section or raster pas
 and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in DIR/.checkpoint while the loop runs
-(_Checkpoint), every pass in between journaled (rig.journal), so a kill -9 or a power cut
+(_Checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
 depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
 checkpoint's fields.
@@ -38,8 +38,8 @@ import numpy as np
 from ..core import transforms as tf
 from ..core.errors import Cancelled, DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
-from ..rig.journal import JOURNAL_FILE, JournaledRig
-from ..rig.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
+from ..measurement.journal import JOURNAL_FILE, JournaledRig
+from ..measurement.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
 
 DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 EPSILON_MM = 2.0
@@ -219,7 +219,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
                 allow_mismatch=False):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
-    ``scan_options``: options of the blind scan (rig.scan.scan_to_dir, e.g. n_sections).
+    ``scan_options``: options of the blind scan (measurement.scan.scan_to_dir, e.g. n_sections).
     ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
     ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
     ``scan_options`` None takes the interrupted run's). ``flip_faces``: CAD faces whose
@@ -228,9 +228,9 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     Returns a summary dict. The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
-    from ..rig import scan as scan_mod
+    from ..measurement import scan as scan_mod
     from ..rig.kinematics import RigKinematics
-    from ..rig.planning import plan_sections
+    from ..measurement.planning import plan_sections
     if on_plan is not None:
         plan_only = plan_sections
 
@@ -250,7 +250,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
     if complete:
-        from ..rig.complete import _check_step
+        from ..measurement.complete import _check_step
         pitch = _check_step(pitch, "--pitch")
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
     if scan_options is not None or not resume:
@@ -546,10 +546,10 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
                    out, checkpoint, timing, progress, document, scan_options, cad_label,
                    register_options):
     """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
-    the whole blade rastered every ``pitch`` mm (rig.complete) from that pose, ICP on every
+    the whole blade rastered every ``pitch`` mm (measurement.complete) from that pose, ICP on every
     point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
-    from ..rig import scan as scan_mod
-    from ..rig.complete import plan_complete, scan_complete
+    from ..measurement import scan as scan_mod
+    from ..measurement.complete import plan_complete, scan_complete
     from . import pipeline
     from . import sections as sections_mod
     from . import verdict as verdict_mod
@@ -667,7 +667,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
 
 class _Checkpoint:
     """What an inspection has measured so far, kept in DIR/LIVE_FOLDER while it runs:
-    points.csv and scan.json grow one completed blind section at a time (rig.scan.scan_to_dir's
+    points.csv and scan.json grow one completed blind section at a time (measurement.scan.scan_to_dir's
     own checkpoint), then one completed planned section or raster pass at a time; plan.json is
     the plan being scanned; readings.journal holds every pass since (``rig``: the rig,
     journaled). scan.json's CHECKPOINT entry says where the loop stands from the first write

@@ -387,7 +387,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
 
     Refused (InputError) before any fitting when the points are too degenerate to fix a pose
     or do not match the CAD's size, and after it when they do not fit the CAD (see
-    inspect.checks; ``allow_mismatch`` keeps the result with a warning instead, and
+    inspection.checks; ``allow_mismatch`` keeps the result with a warning instead, and
     ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
     in those messages."""
     progress = progress or _no_progress
@@ -490,7 +490,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
 def pose_summary(fit, nominal):
     """(covariance, 1 sigma at the worst CAD corner, unmeasured directions) of an ICP fit: the
     covariance of the directions the points measure (core.icp.split_information) and the
-    others named (inspect.checks.describe_unmeasured); the full covariance when all are."""
+    others named (inspection.checks.describe_unmeasured); the full covariance when all are."""
     split = fit.split
     if split is None:
         return fit.covariance, float("inf"), []

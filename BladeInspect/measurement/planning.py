@@ -20,7 +20,7 @@ import numpy as np
 from ..core import pca
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
-from .kinematics import RigKinematics
+from ..rig.kinematics import RigKinematics
 
 # Planned incidence stays within this angle of the beam where any angle allows it: the SNR
 # falls with incidence, and the coverage's 85 deg limit is where readings stop, not where they

@@ -31,7 +31,7 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from ..core.errors import InputError
-from .kinematics import RigKinematics
+from ..rig.kinematics import RigKinematics
 
 # Views of one section as (name, angle offset from the section's base angle in deg).
 SIDE_VIEWS = (("side1", 0.0), ("side2", 180.0))

@@ -329,7 +329,7 @@ def pose_rows(result):
     T = np.asarray(result.measured_to_cad)
     cov = np.asarray(result.pose_covariance)
     sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-    # The 1 sigma figures cover the measured directions only (inspect.checks).
+    # The 1 sigma figures cover the measured directions only (inspection.checks).
     unmeasured = [["Not measured by the points (not in the 1 sigma figures)",
                    "; ".join(u["motion"].replace(" is not measured", "")
                              for u in result.pose_unmeasured)]] \

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core import fitting
 from ..core.errors import InputError
-from .kinematics import RigKinematics
+from ..rig.kinematics import RigKinematics
 
 DEFAULT_DIAMETER = 25.0
 # Twelve angles round the full turn: the centres then span the whole circle, which makes the
@@ -298,7 +298,7 @@ def simulated_calibration_rig(sphere_diameter=DEFAULT_DIAMETER, seed=0, axis_off
     what `calibrate --rig sim` measures, and what tests judge calibration against.
     Returns (rig, true kinematics)."""
     from ..core import transforms as tf
-    from .simulated import SimulatedRig
+    from ..rig.simulated import SimulatedRig
     rng = np.random.default_rng(seed)
     lean, shift = rng.uniform(0.0, 2.0 * np.pi, 2)
     tilt = np.radians(axis_tilt_deg)
@@ -323,7 +323,7 @@ def run_calibration(out_path, rig_spec="sim", sphere_diameter=DEFAULT_DIAMETER, 
     if rig_spec == "sim":
         rig, truth = simulated_calibration_rig(sphere_diameter, seed=seed, **simulated_errors)
     elif str(rig_spec).startswith("serial:"):
-        from .serial_rig import SerialRig
+        from ..rig.serial_rig import SerialRig
         rig = SerialRig(rig_spec[len("serial:"):])
     else:
         raise InputError("--rig: expected sim or serial:PORT, got %r" % (rig_spec,))

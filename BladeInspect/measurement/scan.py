@@ -4,7 +4,7 @@ DIR/scan.json (per-section record, times, the simulator's truth, the checkpoint)
 Both files grow one COMPLETED section at a time: the points are appended, then scan.json is
 replaced atomically (temporary file + os.replace) with a checkpoint holding the strategy's
 state, the rig's pass counter, the byte length of points.csv and the number of passes it
-holds. Within a section every pass goes to DIR/readings.journal as it ends (rig.journal), so a
+holds. Within a section every pass goes to DIR/readings.journal as it ends (measurement.journal), so a
 scan cut short - a DeviceError, a cancel, or a kill -9 / power cut mid-section - keeps its
 finished sections and the finished passes of the section in flight. ``resume=True`` continues
 after the last finished section: points.csv is cut back to the checkpoint (dropping a
@@ -38,12 +38,12 @@ def open_rig(spec, nominal=None, seed=0, kinematics=None, **rig_options):
     nominal); ``serial:PORT`` (or ``serial:MOTION,SENSOR``): the serial driver."""
     spec = str(spec)
     if spec == "sim":
-        from .simulated import simulated_rig_for
+        from ..rig.simulated import simulated_rig_for
         if nominal is None:
             nominal = demo_nominal()
         return simulated_rig_for(nominal, seed=seed, kinematics=kinematics, **rig_options)
     if spec.startswith("serial:") and len(spec) > len("serial:"):
-        from .serial_rig import SerialRig
+        from ..rig.serial_rig import SerialRig
         return SerialRig(spec[len("serial:"):], **rig_options)
     raise InputError("--rig %s: expected sim or serial:PORT" % spec)
 
@@ -58,12 +58,12 @@ def demo_nominal():
 
 def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None, phase=None,
                 on_record=None, **strategy_options):
-    """Run the blind scan (rig.strategy.ScanStrategy with ``strategy_options``) and write it
+    """Run the blind scan (measurement.strategy.ScanStrategy with ``strategy_options``) and write it
     to ``out_dir`` section by section. Returns the scan record (what scan.json holds, plus
     ``points``: the number of points). ``progress(fraction, message)`` is called per section.
     ``phase``: a value for a last ``phase`` column of points.csv (``inspect`` appends its
     planned rows to the same file). ``on_record(record)`` may add to each scan.json before it
-    is written. ``rig`` may be journaled already (rig.journal.JournaledRig: the caller keeps
+    is written. ``rig`` may be journaled already (measurement.journal.JournaledRig: the caller keeps
     the journal, as `inspect` does); else the journal is DIR/readings.journal, removed when the
     scan is complete.
 
@@ -161,7 +161,7 @@ def _strategy_kwargs(options):
         raise InputError("scan: unknown option %s" % ", ".join(unknown))
     kwargs = dict(options)
     if isinstance(kwargs.get("kinematics"), dict):
-        from .kinematics import RigKinematics
+        from ..rig.kinematics import RigKinematics
         kwargs["kinematics"] = RigKinematics.from_dict(kwargs["kinematics"], "scan.json options")
     return kwargs
 
@@ -288,7 +288,7 @@ def _section_record(section):
 def _real_time(rig, record):
     """A simulated rig's time plus the per-pass overhead a real one adds; a real rig's
     elapsed time is already real."""
-    from .simulated import SimulatedRig
+    from ..rig.simulated import SimulatedRig
     if isinstance(inner_rig(rig), SimulatedRig):
         return record["simulated_s"] + PASS_OVERHEAD_S * record["passes"]
     return record["simulated_s"]
