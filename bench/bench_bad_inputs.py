@@ -2,7 +2,7 @@
 command line: exit status, seconds, and the one line each ends with; then the surface-fit
 rule's margin, the fraction of points within its distance, on right and wrong scans.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_bad_inputs.py [DIR]
+    scripts/fcpython bench/bench_bad_inputs.py [DIR]
 """
 import os
 import subprocess

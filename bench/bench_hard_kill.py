@@ -7,7 +7,7 @@ journal costs:
    killed with SIGKILL as the 2nd path of the 2nd planned section begins; what DIR holds;
 3. `inspect --resume` on a new simrig: points.csv and pose against the in-process run's.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_hard_kill.py \
+    scripts/fcpython bench/bench_hard_kill.py \
         [--seed S] [--heights 30,70] [--keep]
 """
 import argparse

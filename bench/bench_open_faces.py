@@ -9,7 +9,7 @@ cad.rotor67 builds it): "before" signs each face by its file normal (what the co
 before faces were oriented; reproduced here by flipping back every face the rule flipped),
 "after" by the orientation rule of cad.orient.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_open_faces.py
+    scripts/fcpython bench/bench_open_faces.py
 """
 import os
 import sys

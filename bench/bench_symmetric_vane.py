@@ -1,7 +1,7 @@
 """Registration of near-symmetric vanes (issue 13, item 1): distance to the truth against the
 stated bound, and whether the result warns, over random poses.
 
-    PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_symmetric_vane.py \
+    scripts/fcpython bench/bench_symmetric_vane.py \
         [--poses 6] [--points 5000] [--radii 0.8/0.4,0.6/0.4,0.5/0.4] [--demo 8]
 
 Two vanes (tests/symmetric_vane.py): the issue's (arcs through (0,6) and (0,2) over a 50 mm

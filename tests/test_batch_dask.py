@@ -97,9 +97,9 @@ class TestLotOnDaskProcesses(unittest.TestCase):
 
     def start(self, args, name):
         log = os.path.join(self.tmp, name + ".log")
+        # Only the checkout on the path: a worker starts FreeCAD itself (batch.report_one).
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-            [HERE, "/usr/lib/freecad-python3/lib"] +
-            ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
+            [HERE] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
         with open(log, "w") as fh:
             proc = subprocess.Popen(args, stdout=fh, stderr=subprocess.STDOUT, cwd=self.tmp,
                                     env=env)

@@ -92,6 +92,11 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
                allow_mismatch=False):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
     ``attempt_log``: the file this run is recorded in before it begins."""
+    # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
+    # there as the command line starts it, with its module folders on the path (FreeCAD 1.0's
+    # Part needs them, or crashes).
+    from ..freecad_library import import_freecad
+    import_freecad()
     from .report import run_report
     name = os.path.basename(points_path)
     if attempt_log is not None:
