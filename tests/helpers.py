@@ -1,5 +1,11 @@
-"""Shared test helpers: paths to the shared real-blade data, temporary folders."""
+"""Shared test helpers: paths to the shared real-blade data, the demo blade, the GUI runner, a
+pose's bound computed from the truth, CPU timing."""
 import os
+import resource
+
+import numpy as np
+
+from BladeInspect.core import transforms as tf
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.normpath(os.path.join(REPO, "..", "shared"))
@@ -99,11 +105,11 @@ class GuiMacroChecks:
 def least_squares_pose_bound(points_cad, normals, sigma, corners):
     """1 sigma worst-corner displacement of the efficient (least-squares) pose estimate from
     readings with independent errors of standard deviation `sigma` along the surface normals at
-    the true points: the Cramér–Rao bound of point-to-surface registration, computed here from
-    first principles (information sum J^T J / sigma^2 with J = [n, p x n] for a small motion
-    (t, w) about the points' centroid), never from the code under test. Returns (bound mm, 6x6
-    covariance about the centroid, the centroid)."""
-    import numpy as np
+    the true points, computed here from first principles (information sum J^T J / sigma^2 with
+    J = [n, p x n] for a small motion (t, w) about the points' centroid), never from the code
+    under test. For normal errors it is the Cramér–Rao bound; for any errors of that variance
+    (the simulations' are uniform) it is the least a linear unbiased fit can reach
+    (Gauss–Markov). Returns (bound mm, 6x6 covariance about the centroid, the centroid)."""
     p = np.asarray(points_cad, dtype=float)
     n = np.asarray(normals, dtype=float)
     c = p.mean(axis=0)
@@ -126,8 +132,6 @@ def sensor_pose_bound(nominal, truth, xyz, snr, sensor, error_field=None):
     along the normal, which it meets at an angle: the bound returned is an upper limit of the
     true one. Gross errors (beyond the noise's half-width) and points on a known error field
     are left out, as an efficient estimator would leave them. Returns (bound mm, n points)."""
-    import numpy as np
-    from BladeInspect.core import transforms as tf
     if sensor.noise != "uniform":
         raise ValueError("sensor_pose_bound: uniform sensor noise only")
     snr = np.asarray(snr, dtype=float)
@@ -146,8 +150,6 @@ def best_cpu_seconds(run, tries=3, enough=None):
     first under `enough` seconds), and the last call's value. CPU time, not wall time: other
     jobs share the machine's cores; the thread's own, so that another thread of the test
     process does not count; the best of several, so that a first call's page faults do not."""
-    import resource
-
     def spent():
         usage = resource.getrusage(resource.RUSAGE_THREAD)
         return usage.ru_utime + usage.ru_stime
