@@ -8,7 +8,10 @@
    against the pose's own bound; residual RMS against the injected noise RMS. Three verdicts:
    every trial converges (within 10x the bound); the count beyond 3x is what an estimator
    exactly at the bound would leave (binomial test, p > 0.01); the RMS of error/bound is within
-   5 % of that estimator's own (about 1.2, not 1, since the error is the worst corner's).
+   5 % of that estimator's own (above 1: the error is the worst of eight corners'). An
+   overstated covariance fails the last (error/bound falls), an understated one the last two.
+   Beside them, plain least squares at the truth on each trial's own noise draw: the efficient
+   estimator's error for that very draw.
 2. The reported covariance against the scatter of the pose over repeated noisy trials at one
    pose (`--scatter N` trials).
 3. `--full`: a 269,158-point cloud: the whole registration's time and the exact deviations'
