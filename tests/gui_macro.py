@@ -13,7 +13,7 @@ import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
-from tests.gui_harness import (OUT, Skip, active_panel, check, need,  # noqa: E402
+from tests.gui_harness import (OUT, active_panel, check,  # noqa: E402
                                run_scenario, settle, start_workbench, step, view_shot,
                                window_shot)
 
@@ -38,7 +38,6 @@ def run():
 
     @step("demo blade through its task panel")
     def _():
-        need("BladeInspect.cad.demo_blade")
         Gui.runCommand("BladeInspect_DemoBlade")
         settle(0.5)
         panel = _active_panel()
@@ -86,9 +85,6 @@ def run():
 
     @step("import simulated points, register, deviation map")
     def _():
-        for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
-                       "BladeInspect.inspection.simulate"):
-            need(module)
         from BladeInspect.core.pointio import write_points_csv
         from BladeInspect.core import transforms as tf
         from BladeInspect.inspection.simulate import simulate_measurement
@@ -141,10 +137,6 @@ def run():
 
     @step("section analysis of the registration")
     def _():
-        need("BladeInspect.cad.sections")
-        need("BladeInspect.inspection.report")
-        if "reg" not in state:
-            raise Skip("no registration made")
         reg = state["reg"]
         table = commands.BY_NAME["BladeInspect_SectionAnalysis"].analyse(reg)
         check("section analysis made", table is not None and len(table.sections) > 0,
@@ -156,10 +148,6 @@ def run():
 
     @step("report of the registration")
     def _():
-        need("BladeInspect.inspection.report")
-        need("BladeInspect.inspection.document")
-        if "reg" not in state:
-            raise Skip("no registration made")
         reg, nominal = state["reg"], state["nominal"]
         from BladeInspect.core import transforms as tf
         out = os.path.join(OUT, "report")
@@ -184,9 +172,6 @@ def run():
 
     @step("simulated rig: connect, scan, reconstruct, register, deviation map, sections")
     def _():
-        for module in ("BladeInspect.cad.nominal", "BladeInspect.core.pointio",
-                       "BladeInspect.measurement.scan", "BladeInspect.cad.loft"):
-            need(module)
         blade = state["blade"]
         Gui.Selection.clearSelection()
         commands.BY_NAME["BladeInspect_ConnectRig"].connect("sim", 0)
@@ -236,9 +221,7 @@ def run():
 
     @step("deviation map of a known result, legend, save and reopen")
     def _():
-        blade = state.get("blade")
-        if blade is None:
-            raise Skip("no demo blade")
+        blade = state["blade"]
         from BladeInspect.core.colormap import deviation_colors
         result = _known_result(blade.Shape)
         reg = objects.make_registration(doc, result, name="KnownRegistration")

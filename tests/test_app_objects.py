@@ -21,14 +21,6 @@ COMMAND_VERBS = ("DemoBlade", "LoadCad", "ConnectRig", "Scan", "ImportPoints", "
                  "Register", "DeviationMap", "SectionAnalysis", "Report", "Preferences")
 
 
-def _have(module):
-    try:
-        __import__(module)
-        return True
-    except ImportError:
-        return False
-
-
 class FakePointSet:
     """The PointSet fields make_measurement reads, without depending on core.pointio."""
 
@@ -105,13 +97,8 @@ class TestMeasurement(DocumentCase):
         self.assertEqual(obj.NRowsSkipped, 3)
         self.assertEqual(obj.Points.CountPoints, 500)
         self.assertAlmostEqual(obj.MeanSNR, snr.mean(), places=9)
-        if _have("BladeInspect.core.pointio"):
-            ps = objects.pointset_of(obj)
-            xyz_back, snr_back, cols = ps.xyz, ps.snr, ps.columns
-        else:
-            xyz_back = np.asarray(obj.Coordinates).reshape(-1, 3)
-            snr_back = np.asarray(obj.SNR)
-            cols = {"section": np.asarray(obj.Column_section)}
+        ps = objects.pointset_of(obj)
+        xyz_back, snr_back, cols = ps.xyz, ps.snr, ps.columns
         np.testing.assert_array_equal(xyz_back, xyz)   # bit for bit: stored as doubles
         np.testing.assert_array_equal(snr_back, snr)
         np.testing.assert_array_equal(cols["section"], section)
@@ -119,7 +106,6 @@ class TestMeasurement(DocumentCase):
         shown = np.array([(v.x, v.y, v.z) for v in obj.Points.Points])
         np.testing.assert_allclose(shown, xyz, atol=1e-5)
 
-    @unittest.skipUnless(_have("BladeInspect.cad.load"), "cad.load (point reader) not landed")
     def test_recompute_rereads_the_source_file_when_it_changes(self):
         from BladeInspect.inspection.pipeline import load_points
         path = os.path.join(self.tmp, "pts.csv")
@@ -345,7 +331,6 @@ class TestDeviationMap(DocumentCase):
         self.assertEqual([o.Name for o in self.doc.Objects], before)
 
 
-@unittest.skipUnless(_have("BladeInspect.cad.demo_blade"), "cad.demo_blade not landed")
 class TestDemoBlade(DocumentCase):
     def test_parameters_rebuild_the_blade_and_roles_are_kept(self):
         from BladeInspect.cad.demo_blade import BladeParams

@@ -3,7 +3,6 @@ point: Shape.distToShape for the distance and closest point, Solid.isInside / Fa
 the sign, closed forms where they exist (sphere, box). Shapes cover every kind of face: planar
 trimmed faces and a cylinder (box with a hole), a surface of revolution, a sphere, open B-spline
 faces, a small interpolated twisted blade, and the demo / Rotor 67 blades when present."""
-import os
 import unittest
 
 import numpy as np
@@ -327,9 +326,6 @@ class RaycastClosedForm(unittest.TestCase):
 
 class Blades(DistanceCase, unittest.TestCase):
     def test_demo_blade(self):
-        path = os.path.join(helpers.REPO, "BladeInspect", "cad", "demo_blade.py")
-        if not os.path.exists(path):
-            self.skipTest("cad/demo_blade.py not there yet")
         from BladeInspect.cad.demo_blade import make_demo_blade
         model = make_demo_blade()
         nominal = nominal_from_shape(model.shape, roles=model.roles)
@@ -339,9 +335,8 @@ class Blades(DistanceCase, unittest.TestCase):
         self.check(nominal, corner_points(nominal.shape, rng, 1, 0.3)[:150], 0, 1.0)
 
     def test_rotor67(self):
-        path = os.path.join(helpers.REPO, "BladeInspect", "cad", "rotor67.py")
-        if not (os.path.exists(path) and helpers.have_rotor67()):
-            self.skipTest("cad/rotor67.py or the Rotor 67 data not there")
+        if not helpers.have_rotor67():
+            self.skipTest("the Rotor 67 data (../shared) is not there")
         from BladeInspect.cad.rotor67 import make_rotor67_blade
         model = make_rotor67_blade(helpers.ROTOR67_SECTIONS)
         nominal = nominal_from_shape(model.shape, roles=model.roles)

@@ -448,10 +448,6 @@ class TestResumeRefusals(unittest.TestCase):
                                             r"\(23, not 5\)[^\n]*\n$")
 
 
-if __name__ == "__main__":
-    unittest.main()
-
-
 class TestCancelledInspectionResumes(unittest.TestCase):
     """A cancel (the GUI's Cancel, raised from the progress callback) in the planned phase
     keeps what was measured as a checkpoint, as a rig failure does; --resume then ends as the
@@ -493,3 +489,7 @@ class TestCancelledInspectionResumes(unittest.TestCase):
                                            ref.points_lines))
         pose = np.asarray(read_json(os.path.join(out, "result.json"))["measured_to_cad"])
         np.testing.assert_allclose(pose, np.asarray(ref.result["measured_to_cad"]), atol=1e-9)
+
+
+if __name__ == "__main__":
+    unittest.main()

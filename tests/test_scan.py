@@ -150,11 +150,8 @@ class TestDemoBlade(unittest.TestCase):
     """The demo blade's CAD at a random fixture pose, judged by the CAD's own exact distance."""
 
     def test_section_of_the_demo_blade_lies_on_its_cad(self):
-        try:
-            from BladeInspect.measurement.scan import demo_nominal
-            nominal = demo_nominal()
-        except ImportError as exc:          # the CAD layer needs FreeCAD
-            self.skipTest("no CAD layer: %s" % exc)
+        from BladeInspect.measurement.scan import demo_nominal
+        nominal = demo_nominal()
         rig = open_rig("sim", nominal=nominal, seed=8)
         # The span is given (from the truth) to keep the test short; the probe is tested on
         # the analytic blade.

@@ -2,7 +2,6 @@
 angle, coverage, error fields, determinism per (seed, pass), time, limits, fixture poses and
 speed (at least 10x the real sensor's 9000 points/s, for the rig alone and on the demo
 blade's CAD)."""
-import time
 import unittest
 
 import numpy as np
@@ -12,6 +11,7 @@ from BladeInspect.core.errors import DeviceError
 from BladeInspect.rig.base import AxisLimits
 from BladeInspect.rig.simulated import (SimulatedRig, make_bump, make_thickening,
                                         random_fixture_pose)
+from tests.helpers import best_cpu_seconds
 from tests.rig_parts import Sphere
 
 
@@ -137,9 +137,8 @@ class TestRigInterface(unittest.TestCase):
         n = 100000
         path = np.column_stack([np.tile(np.linspace(-30, 30, 1000), 100),
                                 np.repeat(np.linspace(30, 90, 100), 1000), np.full(n, 80.0)])
-        start = time.perf_counter()
-        readings = rig.scan_path(path, 0.0)
-        spent = time.perf_counter() - start
+        spent, readings = best_cpu_seconds(lambda: rig.scan_path(path, 0.0),
+                                           enough=n / 90000.0)
         self.assertGreater(np.isfinite(readings.reading_mm).mean(), 0.3)
         self.assertLess(spent, n / 90000.0, "%.0f points/s" % (n / spent))
 
@@ -149,7 +148,7 @@ class TestDemoBladeSpeed(unittest.TestCase):
         """Issue 4: a scan of 100,000 points simulates at least 10x faster than the sensor's
         9000 points/s, exact ray cast on the demo blade's CAD and sensor model included. The
         setpoints are a complete-scan raster at one angle, so every point reads the blade.
-        The best of up to five runs: other jobs share the machine."""
+        CPU time, the best of up to five runs: other jobs share the machine."""
         from BladeInspect.measurement.complete import plan_complete
         from BladeInspect.measurement.scan import demo_nominal
         from BladeInspect.rig.simulated import simulated_rig_for
@@ -159,13 +158,8 @@ class TestDemoBladeSpeed(unittest.TestCase):
                              angles_deg=[0.0])
         path = plan.stage_xyz[:100000]
         self.assertEqual(len(path), 100000)
-        best = np.inf
-        for _ in range(5):
-            start = time.perf_counter()
-            readings = rig.scan_path(path, 0.0)
-            best = min(best, time.perf_counter() - start)
-            if best < len(path) / 90000.0:
-                break
+        best, readings = best_cpu_seconds(lambda: rig.scan_path(path, 0.0), tries=5,
+                                          enough=len(path) / 90000.0)
         self.assertGreater(np.isfinite(readings.reading_mm).mean(), 0.99)
         self.assertLess(best, len(path) / 90000.0, "%.0f points/s" % (len(path) / best))
 

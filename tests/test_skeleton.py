@@ -18,6 +18,20 @@ class TestSkeleton(unittest.TestCase):
                               text=True)
         self.assertEqual(proc.returncode, 0, proc.stderr)
 
+    def test_every_test_module_runs_all_its_tests_directly(self):
+        # A class defined below `unittest.main()` is never run by `python tests/test_x.py`.
+        import ast, glob, os
+        from tests.helpers import REPO
+        for path in sorted(glob.glob(os.path.join(REPO, "tests", "test_*.py"))):
+            with open(path) as fh:
+                body = ast.parse(fh.read()).body
+            last = body[-1]
+            with self.subTest(module=os.path.basename(path)):
+                self.assertIsInstance(last, ast.If)
+                self.assertEqual(ast.unparse(last.test), "__name__ == '__main__'")
+                self.assertFalse(any(isinstance(node, ast.If) and ast.unparse(node.test) ==
+                                     "__name__ == '__main__'" for node in body[:-1]))
+
 
 if __name__ == "__main__":
     unittest.main()
