@@ -12,6 +12,7 @@ import argparse
 import faulthandler
 import json
 import os
+import signal
 import sys
 import time
 
@@ -366,6 +367,7 @@ def run_program():
     the versions when it starts and its exit status when main() returns: a process that dies
     without the second line crashed, and the wrapper says so instead of ending silently."""
     status_file = os.environ.get("BLADEINSPECT_STATUS_FILE")
+    _die_with_wrapper(os.environ.get("BLADEINSPECT_WRAPPER_PID"))
     _record_status(status_file, "pid %d" % os.getpid())
     try:
         from . import freecad_library
@@ -385,6 +387,25 @@ def run_program():
     code = main()
     _record_status(status_file, "finished %d" % code)
     return code
+
+
+def _die_with_wrapper(wrapper_pid):
+    """The wrapper runs this process as its child (to report a crash), so a kill of the
+    wrapper, even SIGKILL, must end this process too, as it would if the wrapper had exec'd
+    it: the kernel sends SIGKILL here when the parent dies (Linux prctl PR_SET_PDEATHSIG). And
+    a child started in the background by a shell begins with SIGINT ignored: Ctrl-C must
+    still raise KeyboardInterrupt, which keeps a checkpoint."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    if not wrapper_pid:
+        return
+    try:
+        import ctypes
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL))
+    except (OSError, AttributeError):   # not Linux: the wrapper's traps still forward signals
+        return
+    if os.getppid() != int(wrapper_pid):   # the wrapper died before the request was made
+        os._exit(128 + int(signal.SIGKILL))
 
 
 def _record_status(path, line):

@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 from tests.helpers import REPO
@@ -34,6 +35,15 @@ def _python_child(wrapper_pid):
         except OSError:
             pass
     return None
+
+
+def _alive(pid):
+    """True while ``pid`` runs (a zombie waiting to be reaped counts as ended)."""
+    try:
+        with open("/proc/%d/stat" % pid) as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
 
 
 class CrashIsNeverSilent(unittest.TestCase):
@@ -78,6 +88,39 @@ class CrashIsNeverSilent(unittest.TestCase):
         beside = [n for n in os.listdir(os.path.dirname(out)) if n.startswith(".bladeinspect-")]
         self.assertEqual(beside, [], "a private output folder was left beside --out")
         return log
+
+    def test_killing_the_wrapper_ends_the_run(self):
+        # ./bladeinspect is what a user or a supervisor kills: its Python child must end with it,
+        # SIGKILL included, as it would if the wrapper had exec'd it; SIGTERM is passed on.
+        for sig in (signal.SIGKILL, signal.SIGTERM):
+            out = os.path.join(self.tmp, "wrapper-%d" % sig)
+            wrapper = subprocess.Popen(
+                [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
+                cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                env=dict(os.environ, TMPDIR=self.tmp))
+            child = None
+            try:
+                for line in wrapper.stderr:
+                    if re.match(r"\[\s*\d+%\]", line):
+                        child = _python_child(wrapper.pid)
+                        wrapper.send_signal(sig)
+                        break
+                rest = wrapper.stderr.read()
+                rc = wrapper.wait(timeout=60)
+            finally:
+                if wrapper.poll() is None:
+                    wrapper.kill()
+            self.assertIsNotNone(child)
+            self.assertNotEqual(rc, 0)
+            deadline = time.monotonic() + 10
+            while _alive(child) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            self.assertFalse(_alive(child), "the CLI's Python outlived its wrapper (signal %d)"
+                             % sig)
+            if sig == signal.SIGTERM:
+                self.assertRegex(rest.strip().splitlines()[-1],
+                                 r"^bladeinspect: crashed: 'simulate' was killed by signal TERM")
+            self.assertFalse(os.path.exists(os.path.join(out, "result.json")))
 
     def test_sigkill(self):
         self._check(signal.SIGKILL, "was killed by signal KILL")
