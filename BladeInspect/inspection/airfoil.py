@@ -33,7 +33,7 @@ SCALARS = ("chord_mm", "axial_chord_mm", "stagger_deg", "max_thickness_mm",
 LISTS = ("le_thickness_mm", "te_thickness_mm", "centroid_mm", "shift_mm")
 POSITION = ("twist_deg", "form_mm", "form_location_mm", "shift_mm")
 CHARACTERISTICS = SCALARS + LISTS
-DEFAULT_DRAWS = 16
+DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
 # both edges and both sides).
 MIN_SECTION_POINTS = 60
@@ -48,7 +48,7 @@ class Options:
     edge_offsets_mm: tuple = kernel.DEFAULT_EDGE_OFFSETS_MM
     tolerances: list = field(default_factory=list)     # of Tolerance
     characteristics_file: str = None
-    draws: int = DEFAULT_DRAWS
+    draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
     seed: int = 0
 
 
@@ -307,10 +307,18 @@ class SectionResult:
 
 def _section(nominal, plane, opts, result, rng):
     from ..cad.airfoil_sections import airfoil_section
-    xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
-    hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
-    nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
-                                 edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint)
+    try:
+        xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
+        hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
+        nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
+                                     chord_method=opts.chord_method,
+                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint)
+    except InputError as exc:
+        # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
+        sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
+        sr.block = {"label": plane.label, "height_pct": plane.height_pct, "le_rule": None,
+                    "nominal": None, "measured": None, "deviation": None, "uncertainty": None}
+        return sr
     sr = SectionResult(plane=plane, frame=frame, nominal=nom)
     sr.notes += ["nominal: %s" % w for w in nom.warnings]
     nominal_values = _char_values(nom, frame)
@@ -341,8 +349,9 @@ def _section(nominal, plane, opts, result, rng):
     measured_values["n_points"] = int(len(idx))
     measured_values["zones"] = cont
     block["measured"] = measured_values
-    block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
-                                        measured_values)
+    if opts.draws:
+        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
+                                            measured_values)
     return sr
 
 
@@ -402,9 +411,12 @@ def _tolerance_for(tolerances, label, key):
     return best
 
 
-def _judge(block, tolerances):
+def _judge(block, tolerances, measured_part=True):
     """Deviation, tolerance and verdict of each characteristic of one section block; returns
     the keys that failed."""
+    if block["nominal"] is None:
+        block.update(tolerance={}, verdicts={}, verdict="not measured")
+        return []
     nominal = _flat(block["nominal"])
     measured = _flat(block["measured"]) if block["measured"] else {}
     deviation, tol_out, verdicts, failed = {}, {}, {}, []
@@ -418,8 +430,13 @@ def _judge(block, tolerances):
             verdicts[key] = "not judged"
             continue
         tol_out[key] = {"lower": t.lower, "upper": t.upper, "row": t.row}
+        if not measured_part:
+            verdicts[key] = "not judged"
+            continue
         if key not in deviation:
+            # A toleranced characteristic that could not be measured cannot be signed off.
             verdicts[key] = "not measured"
+            failed.append(key + " (not measured)")
             continue
         ok = (t.lower is None or deviation[key] >= t.lower) and \
             (t.upper is None or deviation[key] <= t.upper)
@@ -431,7 +448,7 @@ def _judge(block, tolerances):
     block["deviation"] = _unflat(deviation, like) if measured else None
     block["tolerance"] = tol_out
     block["verdicts"] = verdicts
-    judged = [v for v in verdicts.values() if v in ("pass", "fail")]
+    judged = [v for v in verdicts.values() if v in ("pass", "fail", "not measured")]
     block["verdict"] = ("fail" if failed else "pass") if judged else "not judged"
     return failed
 
@@ -464,6 +481,16 @@ def _lean_bow(results, span_axis):
     return lb
 
 
+def check_sections(opts, planes):
+    """A tolerance row's section must be one of the planes' labels (or all)."""
+    labels = {p.label for p in planes}
+    for t in opts.tolerances:
+        if t.section.lower() != "all" and t.section not in labels:
+            raise InputError("%s: row %d: section %r is not one of the sections (%s)"
+                             % (opts.characteristics_file, t.row, t.section,
+                                ", ".join(sorted(labels))))
+
+
 def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     """The characteristics of every plane (measured too when ``result``, a
     RegistrationResult, is given), judged against ``opts.tolerances``."""
@@ -471,20 +498,16 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     opts = opts or Options()
     if span_axis is None:
         span_axis, _ = sections.span_axis_of(nominal)
-    labels = {p.label for p in planes}
-    for t in opts.tolerances:
-        if t.section.lower() != "all" and t.section not in labels:
-            raise InputError("%s: row %d: section %r is not one of the sections (%s)"
-                             % (opts.characteristics_file, t.row, t.section,
-                                ", ".join(sorted(labels))))
+    check_sections(opts, planes)
     rng = np.random.default_rng(opts.seed)
     results = [_section(nominal, p, opts, result, rng) for p in planes]
     failed = []
     for r in results:
-        failed += ["section %s: %s" % (r.plane.label, k) for k in _judge(r.block,
-                                                                          opts.tolerances)]
+        failed += ["section %s: %s" % (r.plane.label, k)
+                   for k in _judge(r.block, opts.tolerances, result is not None)]
         r.block["notes"] = list(r.notes)
-    n_judged = sum(v in ("pass", "fail") for r in results for v in r.block["verdicts"].values())
+    n_judged = sum(v in ("pass", "fail", "not measured")
+                   for r in results for v in r.block["verdicts"].values())
     verdict = {"pass": None if n_judged == 0 else not failed, "n_judged": n_judged,
                "failed": failed,
                "summary": ("airfoil: no characteristic toleranced" if n_judged == 0 else
@@ -530,6 +553,8 @@ def extras_of(table):
 def csv_rows(blocks):
     rows = []
     for b in blocks:
+        if b["nominal"] is None:
+            continue
         nom = _flat(b["nominal"])
         mea = _flat(b["measured"]) if b["measured"] else {}
         dev = _flat(b["deviation"]) if b.get("deviation") else {}
@@ -578,6 +603,7 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
                    pose_uncertainty_mm=result.pose_uncertainty_mm, rms_mm=result.rms_mm)
     else:
         planes, span_axis = nominal_planes(nominal, heights), None
+    check_sections(opts, planes)
     progress(0.7, "airfoil characteristics of %d sections" % len(planes))
     stage = run_stage(nominal, planes, opts, result, span_axis)
     doc.update(stage.extras())
