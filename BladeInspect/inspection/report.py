@@ -22,6 +22,7 @@ import numpy as np
 from ..core import colormap
 from ..core.errors import InputError
 from . import airfoil as airfoil_mod
+from . import airfoil_report
 from . import sections as sections_mod
 from . import verdict as verdict_mod
 from .result import rival_lines
@@ -521,6 +522,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
             pdf.savefig(fig, dpi=PDF_DPI)
             plt.close(fig)
             n_pages += 1
+        n_pages += airfoil_report.add_pages(pdf, parts, table)  # issue 15 hook
         meta = pdf.infodict()
         meta["Title"] = title
         meta["Creator"] = "BladeInspect"
