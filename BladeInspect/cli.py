@@ -173,7 +173,7 @@ def build_parser():
                    help="section planes in %% of span (default 10,30,50,70,90)")
     a.add_argument("--seed", type=_seed, default=0)
     _airfoil_arguments(a, always=True)
-    for parser in (rp, i):
+    for parser in (rp, i, b):
         _airfoil_arguments(parser, always=False)
 
     c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
@@ -342,7 +342,7 @@ def cmd_batch(args):
     from .inspection.batch import run_batch
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
-                        allow_mismatch=args.allow_mismatch)
+                        allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args))
     sys.stdout.write("%s\n" % summary["message"])
 
 

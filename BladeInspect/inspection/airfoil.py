@@ -613,3 +613,34 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
         write_csv(out.path("airfoil.csv"), stage.blocks)
     progress(1.0, stage.verdict["summary"])
     return {"stage": stage, "result": result, "sections": table, "doc": doc}
+
+
+LOT_CSV = "summary_airfoil.csv"
+
+
+def write_lot_csv(out_dir, files):
+    """A lot's DIR/summary_airfoil.csv: one row per blade, section and characteristic (the
+    blade's airfoil.csv rows with the file first), from each blade's result.json, so that a
+    lot can be charted; none when no blade has airfoil characteristics. ``files``: (stem,
+    path) of the lot in order."""
+    import json
+    rows = []
+    for stem, path in files:
+        try:
+            with open(os.path.join(out_dir, stem, "result.json")) as fh:
+                blocks = json.load(fh).get("airfoil")
+        except (OSError, ValueError):
+            continue
+        rows += [[os.path.basename(path)] + r for r in csv_rows(blocks or [])]
+    if not rows:
+        return None
+    target = os.path.join(out_dir, LOT_CSV)
+    tmp = target + ".tmp"
+    with open(tmp, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(("file",) + CSV_HEADER)
+        for row in rows:
+            w.writerow(["" if v is None else ("%.9g" % v if isinstance(v, float) else v)
+                        for v in row])
+    os.replace(tmp, target)
+    return target
