@@ -362,9 +362,9 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     # The measured profile's smooth fit at each point: the draws' noise-free points.
     prof = ch.profile
     pts = frame.to_2d(_into_plane(xyz0, n0, frame.origin, frame.normal))
-    _, smooth = prof.closest(pts)
+    u, smooth = prof.closest(pts)
     smooth3 = frame.to_3d(smooth)
-    out_normal = frame.vector_to_3d(prof.outward_normal(prof.closest(smooth)[0]))
+    out_normal = frame.vector_to_3d(prof.outward_normal(u))
     cov = np.asarray(result.pose_covariance, dtype=float)
     cov = np.where(np.isfinite(cov), cov, 0.0)
     try:
@@ -534,10 +534,11 @@ def attach(result, nominal, table, verdict, opts=None):
     stage = run_stage(nominal, planes_of_table(table), opts, result, table.span_axis)
     table.airfoil = stage
     if stage.verdict["pass"] is False:
+        verdict["summary"] = ("FAIL: %s; profile %s" % (stage.verdict["summary"],
+                                                         verdict["summary"])
+                              if verdict["pass"] else
+                              "%s; %s" % (verdict["summary"], stage.verdict["summary"]))
         verdict["pass"] = False
-        verdict["summary"] = verdict["summary"].replace("PASS", "FAIL", 1) \
-            if verdict["summary"].startswith("PASS") else verdict["summary"]
-        verdict["summary"] += "; " + stage.verdict["summary"]
     verdict["airfoil"] = stage.verdict
     return stage
 
