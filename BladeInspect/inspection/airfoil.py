@@ -37,6 +37,8 @@ DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
 # both edges and both sides).
 MIN_SECTION_POINTS = 60
+# A measured point is round an edge within this many edge radii of the edge circle's centre.
+EDGE_NEIGHBOURHOOD = 1.5
 CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
               "lower", "upper", "verdict")
 
@@ -239,6 +241,22 @@ def _point_noise(pts2d, nominal_profile):
     return float(1.4826 * mad / np.sqrt(2.0))
 
 
+def _sparse_edges(pts, nom):
+    """Notes for an edge with fewer measured points round it than the kernel fits a circle
+    to directly: the smoothing spline then rounds the edge off, a bias of the edge radius,
+    edge point, chord and metal angle that the stated uncertainty does not cover."""
+    notes = []
+    for name, circle in (("LE", nom.le_circle), ("TE", nom.te_circle)):
+        n = int(np.count_nonzero(np.linalg.norm(pts - circle.center, axis=1)
+                                 <= circle.radius * EDGE_NEIGHBOURHOOD))
+        if n < kernel._ZONE_MIN_POINTS:
+            notes.append("measured: %d points within %.1f edge radii of the %s circle's "
+                         "centre (%d wanted): the %s radius, edge point, chord and metal "
+                         "angle are biased by the smoothing, beyond the stated uncertainty"
+                         % (n, EDGE_NEIGHBOURHOOD, name, kernel._ZONE_MIN_POINTS, name))
+    return notes
+
+
 def _char_values(ch, frame, fit=None, contour=None):
     """The block's values of one Characteristics (nominal: fit None)."""
     v = {"chord_mm": ch.chord_mm, "chord_method": ch.chord_method,
@@ -344,6 +362,7 @@ def _section(nominal, plane, opts, result, rng):
         return sr
     sr.measured, sr.fit, sr.contour, sr.points_2d, sr.noise_mm = ch, fit, cont, ordered, noise
     sr.notes += ["measured: %s" % w for w in ch.warnings]
+    sr.notes += _sparse_edges(ordered, nom)
     measured_values = _char_values(ch, frame, fit, cont)
     measured_values["noise_mm"] = noise
     measured_values["n_points"] = int(len(idx))
