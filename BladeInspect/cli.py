@@ -164,6 +164,19 @@ def build_parser():
     i.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
     i.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
 
+    a = sub.add_parser("airfoil", help="airfoil characteristics per section (nominal, or "
+                       "measured against nominal with --points)")
+    a.add_argument("--cad", default=None, help="CAD file (default: the built-in demo blade)")
+    a.add_argument("--points", default=None,
+                   help="measured points in any frame (registered first, as `register`)")
+    a.add_argument("--out", required=True)
+    a.add_argument("--section-heights", type=_heights, default=None,
+                   help="section planes in %% of span (default 10,30,50,70,90)")
+    a.add_argument("--seed", type=_seed, default=0)
+    _airfoil_arguments(a, always=True)
+    for parser in (rp, i, b):
+        _airfoil_arguments(parser, always=False)
+
     c = sub.add_parser("calibrate", help="find the rotary axis from a reference sphere")
     c.add_argument("--out", required=True, help="RIG.json to write")
     c.add_argument("--rig", default="sim")
@@ -276,6 +289,43 @@ def cmd_simrig(args):
     run_simrig(load_nominal(args.cad), seed=args.seed)
 
 
+def _airfoil_arguments(parser, always):
+    # report and inspect add the airfoil characteristics on request (--airfoil or any of its
+    # options): they cost about 4 s a section with their uncertainty.
+    if not always:
+        parser.add_argument("--airfoil", action="store_true",
+                            help="add the airfoil characteristics per section (issue 15)")
+    parser.add_argument("--engine-axis", default=None,
+                        help="engine axis: x, y, z, -x, ... or \"1,0,0\" (default the CAD's +X)")
+    parser.add_argument("--characteristics", default=None, metavar="FILE",
+                        help="tolerances: CSV characteristic,section,lower,upper[,nominal]")
+    parser.add_argument("--chord-method", default=None,
+                        choices=("nose-tail", "caliper", "tangent"),
+                        help="chord definition (default nose-tail)")
+    parser.add_argument("--edge-offsets", default=None, metavar="MM,MM,...",
+                        help="edge thickness offsets from the LE/TE points (default 0.5,1,2)")
+
+
+def _airfoil_options(args):
+    """inspection.airfoil.Options from the command's arguments; None when report/inspect were
+    not asked for the airfoil characteristics."""
+    given = [args.engine_axis, args.characteristics, args.chord_method, args.edge_offsets]
+    if not getattr(args, "airfoil", True) and all(v is None for v in given):
+        return None
+    from .inspection.airfoil import options_from_args
+    return options_from_args(*given)
+
+
+def cmd_airfoil(args):
+    from .inspection.airfoil import run_airfoil
+    summary = run_airfoil(args.cad, args.out, points_path=args.points,
+                          heights_pct=args.section_heights, opts=_airfoil_options(args),
+                          seed=args.seed, progress=Progress())
+    sys.stdout.write("airfoil: %d sections -> %s\n%s\n"
+                     % (len(summary["stage"].blocks), args.out,
+                        summary["stage"].verdict["summary"]))
+
+
 def cmd_report(args, cad=None, points=None):
     from .inspection.report import run_report
     options = {}
@@ -284,7 +334,7 @@ def cmd_report(args, cad=None, points=None):
     summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
                          tolerance=args.tolerance, seed=args.seed, progress=Progress(),
                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
-                         **options)
+                         airfoil=_airfoil_options(args), **options)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -293,7 +343,7 @@ def cmd_batch(args):
     from .inspection.batch import run_batch
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
-                        allow_mismatch=args.allow_mismatch)
+                        allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args))
     sys.stdout.write("%s\n" % summary["message"])
 
 
@@ -304,7 +354,8 @@ def cmd_inspect(args):
                           pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
                           seed=args.seed, rig_file=args.rig_file, progress=Progress(),
                           resume=args.resume, flip_faces=args.flip_face,
-                          allow_mismatch=args.allow_mismatch)
+                          allow_mismatch=args.allow_mismatch,
+                          airfoil=_airfoil_options(args))
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -334,11 +385,12 @@ def cmd_calibrate(args):
 
 COMMANDS = {"demo": cmd_demo, "register": cmd_register, "simulate": cmd_simulate,
             "scan": cmd_scan, "simrig": cmd_simrig, "report": cmd_report, "batch": cmd_batch,
-            "inspect": cmd_inspect, "calibrate": cmd_calibrate}
+            "inspect": cmd_inspect, "calibrate": cmd_calibrate, "airfoil": cmd_airfoil}
 
 
 # Commands whose --out is a folder (calibrate's is the RIG.json file itself).
-OUT_FOLDER_COMMANDS = ("demo", "register", "simulate", "scan", "report", "batch", "inspect")
+OUT_FOLDER_COMMANDS = ("demo", "register", "simulate", "scan", "report", "batch", "inspect",
+                       "airfoil")
 
 
 def main(argv=None):

@@ -22,6 +22,7 @@ import threading
 import time
 
 from ..core.errors import InputError
+from . import airfoil as airfoil_mod
 from . import verdict as verdict_mod
 
 POINT_EXTENSIONS = (".csv", ".xyz", ".asc", ".txt", ".ply", ".pcd")
@@ -89,7 +90,7 @@ def _read_done(folder):
 
 
 def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
-               allow_mismatch=False):
+               allow_mismatch=False, airfoil=None):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
     ``attempt_log``: the file this run is recorded in before it begins."""
     # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
@@ -103,7 +104,8 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
         _record_attempt(attempt_log)
     try:
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
-                   nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch)
+                   nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch,
+                   airfoil=airfoil)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -165,12 +167,13 @@ def _csv_value(v):
 
 def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
               tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None,
-              allow_mismatch=False):
+              allow_mismatch=False, airfoil=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
-    'message': one line for the command line}. ``allow_mismatch``: as for `report`."""
+    'message': one line for the command line}. ``allow_mismatch``, ``airfoil``: as for
+    `report`; with ``airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil)."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
@@ -199,11 +202,14 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
 
     t0 = time.perf_counter()
     if todo and scheduler:
-        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch)
+        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
+                  airfoil)
     elif todo:
-        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch)
+        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
+                   airfoil)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
+    airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
     # Every file is reported: the attempt counts are in the summary.
     shutil.rmtree(os.path.join(out_dir, ATTEMPTS_FOLDER), ignore_errors=True)
     count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)
@@ -225,25 +231,29 @@ def _attempt_log(out_dir, stem):
     return os.path.join(os.path.abspath(out_dir), ATTEMPTS_FOLDER, stem)
 
 
-def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch):
+def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
+               airfoil=None):
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
     if workers == 1 or len(todo) == 1:
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
-                                      seed, _attempt_log(out_dir, stem), allow_mismatch))
+                                      seed, _attempt_log(out_dir, stem), allow_mismatch,
+                                      airfoil))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                               tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch):
+                               tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
+                               airfoil):
                    stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
-def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch):
+def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
+              airfoil=None):
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -261,7 +271,8 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, all
         for stem, path in todo:
             fut = client.submit(report_one, cad, os.path.abspath(path),
                                 os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
-                                _attempt_log(out_dir, stem), allow_mismatch, pure=False)
+                                _attempt_log(out_dir, stem), allow_mismatch, airfoil,
+                                pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):

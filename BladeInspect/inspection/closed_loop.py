@@ -40,6 +40,7 @@ from ..core.errors import Cancelled, DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
 from ..measurement.journal import JOURNAL_FILE, JournaledRig
 from ..measurement.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
+from . import airfoil as airfoil_mod
 
 DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 EPSILON_MM = 2.0
@@ -216,7 +217,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
                 complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
                 scan_options=None, on_plan=None, resume=False, flip_faces=(),
-                allow_mismatch=False):
+                allow_mismatch=False, airfoil=None):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (measurement.scan.scan_to_dir, e.g. n_sections).
@@ -224,7 +225,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
     ``scan_options`` None takes the interrupted run's). ``flip_faces``: CAD faces whose
     outward side is reversed (``--flip-face``, cad.orient). ``allow_mismatch``: go on with a
-    blind scan that does not fit the CAD, with the warning (pipeline.register).
+    blind scan that does not fit the CAD, with the warning (pipeline.register). ``airfoil``: an
+    inspection.airfoil.Options to add the airfoil characteristics (issue 15; None: none).
     Returns a summary dict. The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
@@ -280,13 +282,14 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
                                              seed, epsilon, cmm_data, tolerance, pitch, out,
                                              checkpoint, timing, progress, document,
                                              scan_options, cad_path or "built-in demo blade",
-                                             register_options)
+                                             register_options, airfoil=airfoil)
                 else:
                     summary = _loop(nominal, checkpoint.rig, kinematics, heights, seed, epsilon,
                                     cmm_data, tolerance, out, checkpoint, timing, progress,
                                     plan_sections, scan_mod, pipeline, sections_mod,
                                     verdict_mod, write_report, document, scan_options,
-                                    cad_path or "built-in demo blade", register_options)
+                                    cad_path or "built-in demo blade", register_options,
+                                    airfoil=airfoil)
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
@@ -347,7 +350,8 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
 
 def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out,
           checkpoint, timing, progress, plan_sections, scan_mod, pipeline, sections_mod,
-          verdict_mod, write_report, document, scan_options, cad_label, register_options):
+          verdict_mod, write_report, document, scan_options, cad_label, register_options,
+          airfoil=None):
     # 1-2. blind section scan and its registration
     resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "planned" else None
     scan_record, blind, blind_rig_s, first = _blind_stage(
@@ -435,6 +439,8 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_planned, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)
+    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
+        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
@@ -464,7 +470,7 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
              "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
              "replans": replans,
              "n_points_by_phase": {"blind": n_blind, "planned": n_planned},
-             "rig_time_s": rig_s}
+             "rig_time_s": rig_s, **airfoil_mod.extras_of(table)}  # issue 15 hook
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     return {"result": result, "blind_result": first, "plan": plan, "sections": table,
@@ -544,7 +550,7 @@ def _blind_column(pointset, name, n):
 
 def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
                    out, checkpoint, timing, progress, document, scan_options, cad_label,
-                   register_options):
+                   register_options, airfoil=None):
     """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
     the whole blade rastered every ``pitch`` mm (measurement.complete) from that pose, ICP on every
     point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
@@ -620,6 +626,8 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_read, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
                                         verdict_mod)
+    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
+        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
@@ -653,7 +661,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
              "n_points_by_phase": {"blind": n_blind, "complete": n_read},
              "complete": {"pitch_mm": plan.pitch_mm, "rig_s": complete_rig_s,
                           "simulated_s": timing["complete_scan"]},
-             "rig_time_s": checkpoint.rig_s()}
+             "rig_time_s": checkpoint.rig_s(), **airfoil_mod.extras_of(table)}  # issue 15 hook
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     return {"result": result, "blind_result": first, "plan": plan, "sections": table,

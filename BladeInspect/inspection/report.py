@@ -21,6 +21,8 @@ import numpy as np
 
 from ..core import colormap
 from ..core.errors import InputError
+from . import airfoil as airfoil_mod
+from . import airfoil_report
 from . import sections as sections_mod
 from . import verdict as verdict_mod
 from .result import rival_lines
@@ -520,6 +522,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
             pdf.savefig(fig, dpi=PDF_DPI)
             plt.close(fig)
             n_pages += 1
+        n_pages += airfoil_report.add_pages(pdf, parts, table)  # issue 15 hook
         meta = pdf.infodict()
         meta["Title"] = title
         meta["Creator"] = "BladeInspect"
@@ -534,13 +537,14 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
                seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
-               nominal=None, document=True, flip_faces=(), allow_mismatch=False):
+               nominal=None, document=True, flip_faces=(), allow_mismatch=False, airfoil=None):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
     made in a private folder beside out_dir and moved in only when every one is complete.
     ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
     ``--flip-face`` (cad.orient). ``allow_mismatch``: write the result of a scan that does not
-    fit the CAD, with the warning (pipeline.register). Returns a summary dict."""
+    fit the CAD, with the warning (pipeline.register). ``airfoil``: an inspection.airfoil.Options
+    to add the airfoil characteristics (issue 15; None: none). Returns a summary dict."""
     from . import pipeline
     from .checks import check_out_dir
     check_out_dir(out_dir)
@@ -568,6 +572,8 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     progress(0.82, "section table")
     table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
     verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
+        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0
     with pipeline.AtomicOutput(out_dir) as out:
         t0 = time.perf_counter()
@@ -582,7 +588,8 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
                                       tolerance=tolerance, verdict=verdict, cad_path=cad_path)
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
-            "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance},
+            "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance,
+            **airfoil_mod.extras_of(table)},  # issue 15 hook
             output=out)
     progress(1.0, verdict["summary"])
     return {"out_dir": os.path.abspath(out_dir), "result": result, "sections": table,

@@ -1,0 +1,666 @@
+"""Airfoil characteristics per section (issue 15): nominal from the CAD's exact cut, measured
+from that section's registered points, deviation, standard uncertainty, tolerance and verdict,
+and the blade's lean and bow. The numerics are core.airfoil's; the definitions docs/airfoil.md.
+
+Measured points are brought into their section plane by sliding each along the CAD surface
+(its tangent nearest the plane normal) rather than straight along the normal: a point of a
+raster band 0.25 mm off the plane moves along the part, not off it. A planned scan's points lie
+within ~1 um of the plane, where the two agree.
+
+Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
+draw moves the section's points by a pose drawn from the registration's covariance and lays
+fresh sensor noise (the section's own point-to-point scatter) on the measured profile's smooth
+fit at the same places; the standard deviation of each characteristic over the draws is its
+uncertainty (a parametric bootstrap; bench/bench_airfoil_uncertainty.py compares it with the
+scatter over repeated simulated scans).
+"""
+
+import csv
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import airfoil as kernel
+from ..core import transforms as tf
+from ..core.errors import InputError
+
+# Scalar characteristics, list-valued ones, and which of them have no CAD value (the section's
+# position and contour against the nominal: zero on the nominal by definition).
+SCALARS = ("chord_mm", "axial_chord_mm", "stagger_deg", "max_thickness_mm",
+           "max_thickness_pos_pct", "le_radius_mm", "te_radius_mm", "inlet_angle_deg",
+           "outlet_angle_deg", "area_mm2", "twist_deg", "form_mm", "form_location_mm")
+LISTS = ("le_thickness_mm", "te_thickness_mm", "centroid_mm", "shift_mm")
+POSITION = ("twist_deg", "form_mm", "form_location_mm", "shift_mm")
+CHARACTERISTICS = SCALARS + LISTS
+DEFAULT_DRAWS = 12
+# Fewer measured points than this in a section: no measured characteristics (a profile needs
+# both edges and both sides).
+MIN_SECTION_POINTS = 60
+# A measured point is round an edge within this many edge radii of the edge circle's centre.
+EDGE_NEIGHBOURHOOD = 1.5
+CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
+              "lower", "upper", "verdict")
+
+
+@dataclass
+class Options:
+    engine_axis: tuple = (1.0, 0.0, 0.0)
+    chord_method: str = "nose-tail"
+    edge_offsets_mm: tuple = kernel.DEFAULT_EDGE_OFFSETS_MM
+    tolerances: list = field(default_factory=list)     # of Tolerance
+    characteristics_file: str = None
+    draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
+    seed: int = 0
+
+
+@dataclass
+class Tolerance:
+    characteristic: str          # a field name, or name[i] for element i of a list field
+    section: str                 # a section label or "all"
+    lower: float                 # limits on the deviation (measured - nominal); None = open
+    upper: float
+    nominal: float = None        # overrides the CAD's value when given
+    row: int = 0
+
+
+# ---------------------------------------------------------------- options from the CLI
+
+_AXIS_LETTERS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def parse_engine_axis(text):
+    """--engine-axis: a letter x, y, z with an optional sign (-x), or a vector "1,0,0"."""
+    t = str(text).strip().lower()
+    sign = -1.0 if t.startswith("-") else 1.0
+    letter = t.lstrip("+-")
+    if letter in _AXIS_LETTERS:
+        return tuple(sign * v for v in _AXIS_LETTERS[letter])
+    try:
+        v = np.array([float(c) for c in t.split(",")])
+    except ValueError:
+        v = np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
+        raise InputError("--engine-axis: expected x, y, z, -x, ... or three numbers "
+                         "\"1,0,0\", got %r" % text)
+    return tuple((v / np.linalg.norm(v)).tolist())
+
+
+def parse_offsets(text):
+    try:
+        v = [float(c) for c in str(text).split(",") if c.strip()]
+    except ValueError:
+        v = []
+    if not v or not all(np.isfinite(x) and x > 0 for x in v):
+        raise InputError("--edge-offsets: expected positive distances in mm \"0.5,1,2\", got %r"
+                         % text)
+    return tuple(v)
+
+
+def _base_name(name):
+    return name.split("[", 1)[0]
+
+
+def read_characteristics(path):
+    """--characteristics FILE: CSV with header characteristic,section,lower,upper[,nominal].
+    ``section`` a label or ``all``; lower/upper limits on the deviation, empty for none; an
+    InputError naming the file and row otherwise."""
+    if not os.path.exists(path):
+        raise InputError("%s: no such characteristics file" % path)
+    try:
+        with open(path, newline="") as fh:
+            rows = [r for r in csv.reader(fh)]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError("%s: cannot read characteristics file (%s)" % (path, exc))
+    rows = [(k + 1, r) for k, r in enumerate(rows)
+            if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise InputError("%s: characteristics file is empty" % path)
+    header = [c.strip().lower() for c in rows[0][1]]
+    need = ("characteristic", "section", "lower", "upper")
+    if any(n not in header for n in need):
+        raise InputError("%s: row %d: header must be characteristic,section,lower,upper"
+                         "[,nominal], got %r" % (path, rows[0][0], ",".join(rows[0][1])))
+    col = {n: header.index(n) for n in need + ("nominal",) if n in header}
+    out = []
+    for line, r in rows[1:]:
+        cells = {n: (r[i].strip() if i < len(r) else "") for n, i in col.items()}
+        name = cells["characteristic"]
+        base = _base_name(name)
+        if base not in CHARACTERISTICS:
+            raise InputError("%s: row %d: unknown characteristic %r (one of %s)"
+                             % (path, line, name, ", ".join(CHARACTERISTICS)))
+        if "[" in name:
+            try:
+                idx = int(name[len(base) + 1:-1])
+            except ValueError:
+                idx = -1
+            if not name.endswith("]") or base not in LISTS or idx < 0:
+                raise InputError("%s: row %d: %r: an element is named name[i], i >= 0, of a "
+                                 "list characteristic" % (path, line, name))
+        if not cells["section"]:
+            raise InputError("%s: row %d: section is empty (a label or all)" % (path, line))
+        values = {}
+        for key in ("lower", "upper", "nominal"):
+            text = cells.get(key, "")
+            if text == "":
+                values[key] = None
+                continue
+            try:
+                values[key] = float(text)
+            except ValueError:
+                values[key] = float("nan")
+            if not np.isfinite(values[key]):
+                raise InputError("%s: row %d: %s must be a number, got %r"
+                                 % (path, line, key, text))
+        if values["lower"] is not None and values["upper"] is not None \
+                and values["lower"] > values["upper"]:
+            raise InputError("%s: row %d: lower %g is above upper %g"
+                             % (path, line, values["lower"], values["upper"]))
+        if values["nominal"] is not None and base in LISTS and "[" not in name:
+            raise InputError("%s: row %d: a nominal of %s needs one element, name[i]"
+                             % (path, line, name))
+        out.append(Tolerance(name, cells["section"], values["lower"], values["upper"],
+                             values["nominal"], line))
+    return out
+
+
+def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
+                      edge_offsets=None):
+    """Options from the command line's text values (None: the default)."""
+    opts = Options()
+    if engine_axis is not None:
+        opts.engine_axis = parse_engine_axis(engine_axis)
+    if characteristics is not None:
+        opts.tolerances = read_characteristics(characteristics)
+        opts.characteristics_file = characteristics
+    if chord_method is not None:
+        if chord_method not in kernel.CHORD_METHODS:
+            raise InputError("--chord-method: %r is not one of %s"
+                             % (chord_method, ", ".join(kernel.CHORD_METHODS)))
+        opts.chord_method = chord_method
+    if edge_offsets is not None:
+        opts.edge_offsets_mm = parse_offsets(edge_offsets)
+    return opts
+
+
+# ---------------------------------------------------------------- section planes
+
+@dataclass
+class Plane:
+    label: str
+    origin: np.ndarray
+    normal: np.ndarray
+    height_pct: float
+    le_hint_3d: np.ndarray = None     # the CAD's LE when its faces name it
+    point_index: np.ndarray = None
+
+
+def planes_of_table(table):
+    out = []
+    for s in table.sections:
+        hint = s.profile.le if (s.profile is not None
+                                and s.profile.le_rule == "CAD face roles") else None
+        out.append(Plane(s.label, s.origin, s.normal, s.height_pct, hint, s.point_index))
+    return out
+
+
+def nominal_planes(nominal, heights_pct):
+    """Planes at span heights of the CAD alone (the nominal-only `airfoil` command), placed as
+    inspection.sections places them."""
+    from . import sections
+    axis, (lo, hi) = sections.span_axis_of(nominal)
+    centre = nominal.samples.xyz.mean(axis=0)
+    out = []
+    for k, h in enumerate(heights_pct):
+        level = lo + float(h) / 100.0 * (hi - lo)
+        origin = centre + (level - centre @ axis) * axis
+        out.append(Plane(str(k + 1), origin, axis.copy(), float(h)))
+    return out
+
+
+# ---------------------------------------------------------------- per section
+
+def _into_plane(xyz, surface_normal, origin, plane_normal):
+    """Points slid along the CAD surface into the plane (see the module notes)."""
+    h = (xyz - origin) @ plane_normal
+    s = plane_normal - (surface_normal @ plane_normal)[:, None] * surface_normal
+    along = s @ plane_normal
+    ok = along > 0.2
+    step = np.where(ok, h / np.where(ok, along, 1.0), h)
+    direction = np.where(ok[:, None], s, plane_normal)
+    return xyz - step[:, None] * direction
+
+
+def _point_noise(pts2d, nominal_profile):
+    """Sensor noise of a section's ordered points: the scatter of consecutive points'
+    deviations (a smooth form error cancels in the difference), MAD-robust."""
+    dev, u = kernel.signed_deviation(pts2d, nominal_profile)
+    d = np.diff(dev[np.argsort(np.mod(u, nominal_profile.length))])
+    mad = np.median(np.abs(d - np.median(d)))
+    return float(1.4826 * mad / np.sqrt(2.0))
+
+
+def _sparse_edges(pts, nom):
+    """Notes for an edge with fewer measured points round it than the kernel fits a circle
+    to directly: the smoothing spline then rounds the edge off, a bias of the edge radius,
+    edge point, chord and metal angle that the stated uncertainty does not cover."""
+    notes = []
+    for name, circle in (("LE", nom.le_circle), ("TE", nom.te_circle)):
+        n = int(np.count_nonzero(np.linalg.norm(pts - circle.center, axis=1)
+                                 <= circle.radius * EDGE_NEIGHBOURHOOD))
+        if n < kernel._ZONE_MIN_POINTS:
+            notes.append("measured: %d points within %.1f edge radii of the %s circle's "
+                         "centre (%d wanted): the %s radius, edge point, chord and metal "
+                         "angle are biased by the smoothing, beyond the stated uncertainty"
+                         % (n, EDGE_NEIGHBOURHOOD, name, kernel._ZONE_MIN_POINTS, name))
+    return notes
+
+
+def _char_values(ch, frame, fit=None, contour=None):
+    """The block's values of one Characteristics (nominal: fit None)."""
+    v = {"chord_mm": ch.chord_mm, "chord_method": ch.chord_method,
+         "axial_chord_mm": ch.axial_chord_mm, "stagger_deg": ch.stagger_deg,
+         "max_thickness_mm": ch.max_thickness_mm,
+         "max_thickness_pos_pct": ch.max_thickness_pos_pct,
+         "le_radius_mm": ch.le_radius_mm, "te_radius_mm": ch.te_radius_mm,
+         "edge_offsets_mm": list(ch.edge_offsets_mm),
+         "le_thickness_mm": list(ch.le_thickness_mm),
+         "te_thickness_mm": list(ch.te_thickness_mm),
+         "inlet_angle_deg": ch.inlet_angle_deg, "outlet_angle_deg": ch.outlet_angle_deg,
+         "area_mm2": ch.area_mm2,
+         "centroid_mm": frame.to_3d(ch.centroid_mm)[0].tolist(),
+         "shift_mm": [0.0, 0.0] if fit is None else fit.shift_mm.tolist(),
+         "twist_deg": 0.0 if fit is None else fit.twist_deg,
+         "form_mm": 0.0 if contour is None else contour["all"]["form_mm"],
+         "form_location_mm": 0.0 if contour is None else contour["all"]["form_location_mm"]}
+    return v
+
+
+def _measure(pts2d, nominal_chars, opts, noise, le_hint):
+    ordered = kernel.order_by_nominal(pts2d, nominal_chars.profile)
+    ch = kernel.characteristics(ordered, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
+                                edge_offsets_mm=opts.edge_offsets_mm, le_hint=le_hint,
+                                noise_mm=noise)
+    fit = kernel.fit_section(ordered, nominal_chars.profile)
+    cont = kernel.contour(ordered, nominal_chars, fit)
+    return ch, fit, cont, ordered
+
+
+def _flat(values):
+    """{name or name[i]: number} of a block's numeric characteristics."""
+    out = {}
+    for name in SCALARS:
+        if values.get(name) is not None:
+            out[name] = float(values[name])
+    for name in LISTS:
+        for i, x in enumerate(values.get(name) or []):
+            if x is not None:
+                out["%s[%d]" % (name, i)] = float(x)
+    return out
+
+
+def _unflat(flat, like):
+    out = {}
+    for name in SCALARS:
+        out[name] = flat.get(name)
+    for name in LISTS:
+        out[name] = [flat.get("%s[%d]" % (name, i)) for i in range(len(like.get(name) or []))]
+    return out
+
+
+@dataclass
+class SectionResult:
+    plane: Plane
+    frame: object
+    nominal: object                  # core.airfoil.Characteristics
+    measured: object = None
+    fit: object = None
+    contour: dict = None
+    points_2d: np.ndarray = None
+    noise_mm: float = None
+    block: dict = None
+    notes: list = field(default_factory=list)
+
+
+def _section(nominal, plane, opts, result, rng):
+    from ..cad.airfoil_sections import airfoil_section
+    try:
+        xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
+        hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
+        nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
+                                     chord_method=opts.chord_method,
+                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint)
+    except InputError as exc:
+        # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
+        sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
+        sr.block = {"label": plane.label, "height_pct": plane.height_pct, "le_rule": None,
+                    "nominal": None, "measured": None, "deviation": None, "uncertainty": None}
+        return sr
+    sr = SectionResult(plane=plane, frame=frame, nominal=nom)
+    sr.notes += ["nominal: %s" % w for w in nom.warnings]
+    nominal_values = _char_values(nom, frame)
+    block = {"label": plane.label, "height_pct": plane.height_pct,
+             "le_rule": nom.le_rule, "nominal": nominal_values, "measured": None,
+             "deviation": None, "uncertainty": None}
+    sr.block = block
+    if result is None:
+        return sr
+    idx = np.asarray(plane.point_index if plane.point_index is not None else [], dtype=int)
+    idx = idx[result.inlier[idx]] if len(idx) else idx
+    if len(idx) < MIN_SECTION_POINTS:
+        sr.notes.append("measured: %d points in the section, %d needed"
+                        % (len(idx), MIN_SECTION_POINTS))
+        return sr
+    xyz = _into_plane(result.points_cad[idx], result.normal[idx], frame.origin, frame.normal)
+    pts = frame.to_2d(xyz)
+    noise = _point_noise(pts, nom.profile)
+    try:
+        ch, fit, cont, ordered = _measure(pts, nom, opts, noise, nom.le_point)
+    except InputError as exc:
+        sr.notes.append("measured: %s" % exc)
+        return sr
+    sr.measured, sr.fit, sr.contour, sr.points_2d, sr.noise_mm = ch, fit, cont, ordered, noise
+    sr.notes += ["measured: %s" % w for w in ch.warnings]
+    sr.notes += _sparse_edges(ordered, nom)
+    measured_values = _char_values(ch, frame, fit, cont)
+    measured_values["noise_mm"] = noise
+    measured_values["n_points"] = int(len(idx))
+    measured_values["zones"] = cont
+    block["measured"] = measured_values
+    if opts.draws:
+        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
+                                            measured_values)
+    return sr
+
+
+def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values):
+    """1 sigma of each measured characteristic by re-fitting perturbed points (module notes)."""
+    xyz0 = result.points_cad[idx]
+    n0 = result.normal[idx]
+    # The measured profile's smooth fit at each point: the draws' noise-free points.
+    prof = ch.profile
+    pts = frame.to_2d(_into_plane(xyz0, n0, frame.origin, frame.normal))
+    u, smooth = prof.closest(pts)
+    smooth3 = frame.to_3d(smooth)
+    out_normal = frame.vector_to_3d(prof.outward_normal(u))
+    cov = np.asarray(result.pose_covariance, dtype=float)
+    cov = np.where(np.isfinite(cov), cov, 0.0)
+    try:
+        chol = np.linalg.cholesky(cov + 1e-30 * np.eye(6))
+    except np.linalg.LinAlgError:
+        w, V = np.linalg.eigh(cov)
+        chol = V * np.sqrt(np.clip(w, 0, None))
+    centre = np.asarray(result.center, dtype=float)
+    draws = []
+    for _ in range(max(int(opts.draws), 2)):
+        d = chol @ rng.standard_normal(6)
+        R = tf.rotation_from_vector(d[3:])
+        moved = (smooth3 - centre) @ R.T + centre + d[:3]
+        moved = moved + out_normal * (noise * rng.standard_normal(len(moved)))[:, None]
+        p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
+        try:
+            c, f, k, _ = _measure(p2, nom, opts, noise, nom.le_point)
+        except InputError:
+            continue
+        draws.append(_flat(_char_values(c, frame, f, k)))
+    if len(draws) < 2:
+        return None
+    keys = _flat(measured_values).keys()
+    sd = {key: float(np.std([d[key] for d in draws if key in d], ddof=1))
+          for key in keys if sum(key in d for d in draws) >= 2}
+    return _unflat(sd, measured_values)
+
+
+# ---------------------------------------------------------------- tolerances and verdicts
+
+def _tolerance_for(tolerances, label, key):
+    """The most specific row for (section, characteristic): a named section before all, an
+    element name[i] before the whole list."""
+    base = _base_name(key)
+    best, rank = None, -1
+    for t in tolerances:
+        if t.section != label and t.section.lower() != "all":
+            continue
+        if t.characteristic != key and t.characteristic != base:
+            continue
+        r = (2 if t.section == label else 0) + (1 if t.characteristic == key else 0)
+        if r > rank:
+            best, rank = t, r
+    return best
+
+
+def _judge(block, tolerances, measured_part=True):
+    """Deviation, tolerance and verdict of each characteristic of one section block; returns
+    the keys that failed."""
+    if block["nominal"] is None:
+        block.update(tolerance={}, verdicts={}, verdict="not measured")
+        return []
+    nominal = _flat(block["nominal"])
+    measured = _flat(block["measured"]) if block["measured"] else {}
+    deviation, tol_out, verdicts, failed = {}, {}, {}, []
+    for key in nominal:
+        t = _tolerance_for(tolerances, block["label"], key)
+        if t is not None and t.nominal is not None:
+            nominal[key] = t.nominal
+        if key in measured:
+            deviation[key] = measured[key] - nominal[key]
+        if t is None or (t.lower is None and t.upper is None):
+            verdicts[key] = "not judged"
+            continue
+        tol_out[key] = {"lower": t.lower, "upper": t.upper, "row": t.row}
+        if not measured_part:
+            verdicts[key] = "not judged"
+            continue
+        if key not in deviation:
+            # A toleranced characteristic that could not be measured cannot be signed off.
+            verdicts[key] = "not measured"
+            failed.append(key + " (not measured)")
+            continue
+        ok = (t.lower is None or deviation[key] >= t.lower) and \
+            (t.upper is None or deviation[key] <= t.upper)
+        verdicts[key] = "pass" if ok else "fail"
+        if not ok:
+            failed.append(key)
+    like = block["nominal"]
+    block["nominal"] = dict(like, **{k: v for k, v in _unflat(nominal, like).items()})
+    block["deviation"] = _unflat(deviation, like) if measured else None
+    block["tolerance"] = tol_out
+    block["verdicts"] = verdicts
+    judged = [v for v in verdicts.values() if v in ("pass", "fail", "not measured")]
+    block["verdict"] = ("fail" if failed else "pass") if judged else "not judged"
+    return failed
+
+
+@dataclass
+class Stage:
+    sections: list                   # of SectionResult
+    blocks: list                     # result.json `airfoil`
+    lean_bow: dict
+    verdict: dict
+    settings: dict
+
+    def extras(self):
+        """result.json's fields of the stage."""
+        return {"airfoil": self.blocks, "lean_bow": self.lean_bow,
+                "airfoil_verdict": self.verdict, "airfoil_settings": self.settings}
+
+
+def _lean_bow(results, span_axis):
+    measured = [r for r in results if r.fit is not None]
+    if len(measured) < 2:
+        return None
+    heights = [float(r.plane.origin @ span_axis) for r in measured]
+    if np.ptp(heights) <= 0:
+        return None
+    lb = kernel.lean_bow(heights, [r.fit.shift_mm for r in measured])
+    lb["largest_bow_section"] = measured[lb["largest_bow_section"]].plane.label
+    lb["sections"] = [r.plane.label for r in measured]
+    lb["heights_mm"] = heights
+    return lb
+
+
+def check_sections(opts, planes):
+    """A tolerance row's section must be one of the planes' labels (or all)."""
+    labels = {p.label for p in planes}
+    for t in opts.tolerances:
+        if t.section.lower() != "all" and t.section not in labels:
+            raise InputError("%s: row %d: section %r is not one of the sections (%s)"
+                             % (opts.characteristics_file, t.row, t.section,
+                                ", ".join(sorted(labels))))
+
+
+def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
+    """The characteristics of every plane (measured too when ``result``, a
+    RegistrationResult, is given), judged against ``opts.tolerances``."""
+    from . import sections
+    opts = opts or Options()
+    if span_axis is None:
+        span_axis, _ = sections.span_axis_of(nominal)
+    check_sections(opts, planes)
+    rng = np.random.default_rng(opts.seed)
+    results = [_section(nominal, p, opts, result, rng) for p in planes]
+    failed = []
+    for r in results:
+        failed += ["section %s: %s" % (r.plane.label, k)
+                   for k in _judge(r.block, opts.tolerances, result is not None)]
+        r.block["notes"] = list(r.notes)
+    n_judged = sum(v in ("pass", "fail", "not measured")
+                   for r in results for v in r.block["verdicts"].values())
+    verdict = {"pass": None if n_judged == 0 else not failed, "n_judged": n_judged,
+               "failed": failed,
+               "summary": ("airfoil: no characteristic toleranced" if n_judged == 0 else
+                           "airfoil: PASS (%d characteristics)" % n_judged if not failed else
+                           "airfoil: FAIL %d of %d: %s" % (len(failed), n_judged,
+                                                           "; ".join(failed)))}
+    settings = {"engine_axis": list(map(float, opts.engine_axis)),
+                "chord_method": opts.chord_method,
+                "edge_offsets_mm": list(map(float, opts.edge_offsets_mm)),
+                "characteristics_file": opts.characteristics_file,
+                "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
+                "uncertainty_method": "re-fit of perturbed points: pose from the registration "
+                                      "covariance and sensor noise on the measured profile's "
+                                      "smooth fit, %d draws" % opts.draws,
+                "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1)"}
+    return Stage(results, [r.block for r in results], _lean_bow(results, span_axis), verdict,
+                 settings)
+
+
+def attach(result, nominal, table, verdict, opts=None):
+    """The stage for a report or an inspection: the section table's sections measured from
+    the result, the part's verdict taking in every judged characteristic (it fails, naming
+    them, when one does). The stage is kept on the table for the report's figures."""
+    stage = run_stage(nominal, planes_of_table(table), opts, result, table.span_axis)
+    table.airfoil = stage
+    if stage.verdict["pass"] is False:
+        verdict["summary"] = ("FAIL: %s; profile %s" % (stage.verdict["summary"],
+                                                         verdict["summary"])
+                              if verdict["pass"] else
+                              "%s; %s" % (verdict["summary"], stage.verdict["summary"]))
+        verdict["pass"] = False
+    verdict["airfoil"] = stage.verdict
+    return stage
+
+
+def extras_of(table):
+    """result.json's airfoil fields of a table the stage was attached to (none otherwise)."""
+    stage = getattr(table, "airfoil", None)
+    return {} if stage is None else stage.extras()
+
+
+# ---------------------------------------------------------------- files
+
+def csv_rows(blocks):
+    rows = []
+    for b in blocks:
+        if b["nominal"] is None:
+            continue
+        nom = _flat(b["nominal"])
+        mea = _flat(b["measured"]) if b["measured"] else {}
+        dev = _flat(b["deviation"]) if b.get("deviation") else {}
+        unc = _flat(b["uncertainty"]) if b.get("uncertainty") else {}
+        for key in nom:
+            t = b["tolerance"].get(key, {})
+            rows.append([b["label"], key, nom[key], mea.get(key), dev.get(key), unc.get(key),
+                         t.get("lower"), t.get("upper"), b["verdicts"][key]])
+    return rows
+
+
+def write_csv(path, blocks):
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(CSV_HEADER)
+        for row in csv_rows(blocks):
+            w.writerow(["" if v is None else ("%.9g" % v if isinstance(v, float) else v)
+                        for v in row])
+
+
+def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None, seed=0,
+                progress=None, nominal=None):
+    """The `airfoil` command: DIR/airfoil.json and DIR/airfoil.csv, atomically. Without
+    ``points_path`` the CAD's characteristics alone; with it the points are registered first
+    (their frame is unknown, as for `register`) and measured per section."""
+    import json
+    from . import pipeline
+    from . import sections as sections_mod
+    from .checks import check_out_dir
+    check_out_dir(out_dir)
+    progress = progress or (lambda f, m: None)
+    opts = opts or Options()
+    heights = list(sections_mod.DEFAULT_HEIGHTS_PCT if heights_pct is None else heights_pct)
+    if nominal is None:
+        nominal = pipeline.load_nominal(cad_path)
+    doc = {"cad_file": cad_path or "built-in demo blade", "points_file": points_path}
+    result = table = None
+    if points_path is not None:
+        points = pipeline.load_points(points_path)
+        result = pipeline.register(nominal, points, seed=seed,
+                                   progress=lambda f, m: progress(0.6 * f, m),
+                                   cad_source=cad_path or "the demo blade")
+        table = sections_mod.section_table(result, nominal, heights_pct=heights)
+        planes, span_axis = planes_of_table(table), table.span_axis
+        doc.update(measured_to_cad=np.asarray(result.measured_to_cad).tolist(),
+                   pose_uncertainty_mm=result.pose_uncertainty_mm, rms_mm=result.rms_mm)
+    else:
+        planes, span_axis = nominal_planes(nominal, heights), None
+    check_sections(opts, planes)
+    progress(0.7, "airfoil characteristics of %d sections" % len(planes))
+    stage = run_stage(nominal, planes, opts, result, span_axis)
+    doc.update(stage.extras())
+    with pipeline.AtomicOutput(out_dir) as out:
+        with open(out.path("airfoil.json"), "w") as fh:
+            json.dump(doc, fh, indent=1, default=pipeline._json_default)
+        write_csv(out.path("airfoil.csv"), stage.blocks)
+    progress(1.0, stage.verdict["summary"])
+    return {"stage": stage, "result": result, "sections": table, "doc": doc}
+
+
+LOT_CSV = "summary_airfoil.csv"
+
+
+def write_lot_csv(out_dir, files):
+    """A lot's DIR/summary_airfoil.csv: one row per blade, section and characteristic (the
+    blade's airfoil.csv rows with the file first), from each blade's result.json, so that a
+    lot can be charted; none when no blade has airfoil characteristics. ``files``: (stem,
+    path) of the lot in order."""
+    import json
+    rows = []
+    for stem, path in files:
+        try:
+            with open(os.path.join(out_dir, stem, "result.json")) as fh:
+                blocks = json.load(fh).get("airfoil")
+        except (OSError, ValueError):
+            continue
+        rows += [[os.path.basename(path)] + r for r in csv_rows(blocks or [])]
+    if not rows:
+        return None
+    target = os.path.join(out_dir, LOT_CSV)
+    tmp = target + ".tmp"
+    with open(tmp, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(("file",) + CSV_HEADER)
+        for row in rows:
+            w.writerow(["" if v is None else ("%.9g" % v if isinstance(v, float) else v)
+                        for v in row])
+    os.replace(tmp, target)
+    return target
