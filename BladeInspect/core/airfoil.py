@@ -927,6 +927,20 @@ def circle_radius_factor(half_angle_rad):
     return float(np.sqrt(m_cc / (m_cc - m_c ** 2)))
 
 
+def edge_points_needed(noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_ZONE_DEG):
+    """Points the edge zone (+-zone_deg) needs for the fitted radius's 1-sigma to be at most
+    radius_sigma_mm at the points' noise: n = (noise / sigma_R * f(alpha))^2 (issue 15 item 7)."""
+    f = circle_radius_factor(np.radians(zone_deg))
+    return int(np.ceil((float(noise_mm) / float(radius_sigma_mm) * f) ** 2))
+
+
+def edge_spacing_mm(radius_mm, noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_ZONE_DEG):
+    """Point spacing along an edge of radius radius_mm giving the zone those points: its arc
+    2 alpha r over edge_points_needed."""
+    arc = 2.0 * np.radians(zone_deg) * float(radius_mm)
+    return arc / edge_points_needed(noise_mm, radius_sigma_mm, zone_deg)
+
+
 def _corner_warnings(profile, le, te, chord):
     """One line per corner of the input points: the spline rounds a corner off over a point
     spacing, so an edge radius, edge point and chord read there are not the part's."""
