@@ -407,7 +407,6 @@ def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIN
     if edge is not None:
         far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
         c, r = c[far], r[far]
-        c, r = _cut_abreast(c, r, edge.center)
     seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     s = s - s[-1]
@@ -418,8 +417,9 @@ def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIN
     sel = (s >= -(skip + window)) & (s <= -skip)
     if sel.sum() < 2 * _END_DEGREE:
         sel = np.arange(len(s)) >= len(s) - 2 * _END_DEGREE
-    # The fit is about the end (s = 0): its Taylor terms up to s^2 continue the line ahead.
-    coef = np.polyfit(s[sel], c[sel], _END_DEGREE)[-3:]
+    full = np.polyfit(s[sel], c[sel], _END_DEGREE)
+    deriv = np.column_stack([np.polyder(full[:, k]) for k in range(2)])
+    coef = full[-3:]
     tangent = _unit(coef[1])
     # How far the last stretch turns from that tangent: the metal angle's definition spread.
     last = s >= -skip
@@ -427,19 +427,18 @@ def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIN
     if last.sum() >= 2 and np.linalg.norm(c[-1] - c[last][0]) > 0:
         chord = _unit(c[-1] - c[last][0])
         bend = float(np.degrees(np.arccos(np.clip(chord @ tangent, -1.0, 1.0))))
-    ahead = 0.0 if edge is None else float((edge.center - c[-1]) @ tangent)
-    if ahead > 0:
-        # Along the parabola, moved to pass through the last centre (where the locus bends
-        # the fitted parabola misses it), on to the point abreast of the edge circle's centre.
-        offset = c[-1] - coef[2]
+    if edge is not None:
+        # The line ends on the fitted quartic (not at the last, least conditioned centre),
+        # at its point abreast of the edge circle's centre, ahead of the last centre or behind.
         reach = 0.0
-        for _ in range(5):
-            p = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
-            d = _unit(2 * coef[0] * reach + coef[1])
-            reach = min(reach + float((edge.center - p) @ d), edge.radius)
-        tip = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
-        tangent = _unit(2 * coef[0] * reach + coef[1])
-        c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
+        for _ in range(8):
+            p = np.array([np.polyval(full[:, k], reach) for k in range(2)])
+            d = _unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+            reach = float(np.clip(reach + (edge.center - p) @ d, s[sel][0], edge.radius))
+        tip = np.array([np.polyval(full[:, k], reach) for k in range(2)])
+        tangent = _unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+        keep = s < reach - 1e-9
+        c, r = np.vstack([c[keep], tip]), np.concatenate([r[keep], [edge.radius]])
     if end == 0:
         return c[::-1], r[::-1], tangent, bend
     return c, r, tangent, bend
