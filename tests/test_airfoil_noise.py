@@ -42,16 +42,18 @@ class NoiseRepeatability(unittest.TestCase):
             self.assertLess(np.linalg.norm(ch.le_point - self.truth.le_point), 10 * UM)
             self.assertLess(np.linalg.norm(ch.te_point - self.truth.te_point), 10 * UM)
 
-    def test_edge_radii_within_5_um_at_the_item_7_density(self):
-        # At 0.02 mm spacing the +-45 deg zone holds ~70 points: sigma_R ~2.4 um, and 5 um is
-        # only 2 sigma. Points spaced by the item-7 rule (sigma_R <= 2 um) meet it.
-        h = airfoil.edge_spacing_mm(min(self.sec.r_le, self.sec.r_te), SIGMA, 2 * UM)
-        for pts in noisy_scans(self.sec, (21, 22, 23), spacing=h):
+    def test_edge_radii_within_5_um_at_three_sigma(self):
+        # Within 5 um at 3 sigma needs sigma_R <= 5/3 um: the item-7 rule for that target gives
+        # the spacing (0.018 mm here; at 0.02 mm sigma_R is 1.8 um and one seed of 11-15 read
+        # the TE radius 5.4 um off).
+        h = airfoil.edge_spacing_mm(min(self.sec.r_le, self.sec.r_te), SIGMA, 5 * UM / 3)
+        for pts in noisy_scans(self.sec, (11, 12, 13, 14, 15), spacing=h):
             ch = airfoil.characteristics(pts, noise_mm=SIGMA)
             self.assertAlmostEqual(ch.le_radius_mm, self.sec.r_le, delta=5 * UM)
             self.assertAlmostEqual(ch.te_radius_mm, self.sec.r_te, delta=5 * UM)
             # The stated sigma_R uses the fit's own rms, itself a noisy estimate of sigma.
-            self.assertLessEqual(airfoil.edge_radius_sigma(ch.le_circle, SIGMA), 1.15 * 2 * UM)
+            self.assertLessEqual(airfoil.edge_radius_sigma(ch.le_circle, SIGMA),
+                                 1.15 * 5 * UM / 3)
 
     def test_angles(self):
         for ch in self.scans:
