@@ -394,14 +394,12 @@ def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIN
     end slope, which the closely packed last centres of a circular edge and noise would tilt.
 
     With ``edge`` (the fitted edge circle): the centres nearer to its centre than _EDGE_CORE of
-    its radius are dropped (ill-conditioned bisectors on a circular edge), and when its centre
-    lies ahead of the line's end, the parabola is followed on (at most one edge radius) to the
-    point nearest to it, which becomes the line's end -- on a circular edge the inscribed
-    circles end as the edge circle, at its centre; on a varying-curvature nose the line ends
-    abreast of the fitted circle's centre. When that centre lies before the end (the nose's
-    curvature grows beyond it), the line is cut back to its point nearest the centre. Either
-    way the line ends abreast of the fitted edge circle's centre, a rule continuous in the
-    geometry and blind to the last, ill-conditioned centres."""
+    its radius are dropped (ill-conditioned bisectors on a circular edge), and the line ends on
+    the fitted quartic at its point abreast of the edge circle's centre (ahead of the last
+    centre, at most one edge radius, or behind it), the centres beyond dropped -- on a circular
+    edge the inscribed circles end as the edge circle, at its centre; on a varying-curvature
+    nose the line ends abreast of the fitted circle's centre. A rule continuous in the geometry
+    and blind to the last, ill-conditioned centres."""
     c = centres if end == -1 else centres[::-1]
     r = radii if end == -1 else radii[::-1]
     if edge is not None:
@@ -419,8 +417,7 @@ def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIN
         sel = np.arange(len(s)) >= len(s) - 2 * _END_DEGREE
     full = np.polyfit(s[sel], c[sel], _END_DEGREE)
     deriv = np.column_stack([np.polyder(full[:, k]) for k in range(2)])
-    coef = full[-3:]
-    tangent = _unit(coef[1])
+    tangent = _unit(full[-2])
     # How far the last stretch turns from that tangent: the metal angle's definition spread.
     last = s >= -skip
     bend = 0.0
@@ -463,20 +460,6 @@ def _closed_end(profile, centres, radii, end, circle, notes, window_pct):
                      "metal angle there depends on the rule (docs/airfoil.md)"
                      % (bend, c[end][0], c[end][1]))
     return c, r, out, u, point
-
-
-def _cut_abreast(c, r, point):
-    """The polyline of centres c (radii r) cut at its point nearest ``point`` when that lies
-    before its last centre (a nose whose curvature still grows beyond the fitted circle)."""
-    a, b = c[:-1], c[1:]
-    e = b - a
-    t = np.clip(np.einsum("ij,ij->i", point - a, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
-    foot = a + t[:, None] * e
-    i = int(np.argmin(np.linalg.norm(foot - point, axis=1)))
-    if i == len(e) - 1 and t[i] >= 1.0:
-        return c, r
-    rr = r[i] + t[i] * (r[i + 1] - r[i])
-    return np.vstack([c[:i + 1], foot[i]]), np.concatenate([r[:i + 1], [rr]])
 
 
 def _ray_hit(profile, origin, direction):
