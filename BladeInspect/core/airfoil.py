@@ -32,6 +32,9 @@ MIN_CONTACT_ANGLE_DEG = 60.0
 # of the chord from that end along the chord (as inspection/sections.py).
 CONTOUR_EDGE_FRACTION = 0.03
 CHORD_METHODS = ("nose-tail", "caliper", "tangent")
+# The blunter end is the LE only when the two edge radii differ by more than this many
+# standard deviations of their difference; else the engine axis decides (docs/airfoil.md).
+LE_RADIUS_SIGMAS = 3.0
 ZONES = ("LE", "TE", "suction", "pressure")
 
 _NEWTON_ITERATIONS = 12
@@ -45,8 +48,14 @@ _CORNER_RUN = 5
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_MIN_POINTS = 12
-_END_WINDOW_MM = 0.5
 _END_SKIP = 0.5
+# Metal angles: the camber line's end tangent is the slope at its end of a quartic in arc
+# length fitted to the inscribed-circle centres over this % of the locus back from the end
+# (the last half edge radius left out). A wide window is what conditions the tangent on
+# noisy points (the end centres are the least conditioned); a quartic keeps the window's
+# curvature change from biasing it (docs/airfoil.md gives the figures).
+DEFAULT_METAL_ANGLE_WINDOW_PCT = 50.0
+_END_DEGREE = 4
 _BEND_WARN_DEG = 1.0
 _EDGE_CORE = 1e-3
 _MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
@@ -377,74 +386,70 @@ class CamberLine:
         return self.at(np.linspace(0.0, self.length, n))[0]
 
 
-def _line_end(centres, radii, end, edge=None):
+def _line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WINDOW_PCT):
     """The camber line's centres and its unit tangent at its first (end=0) or last (end=-1)
-    centre, pointing out of that end: the slope of a least-squares parabola (in arc length)
-    through the centres within the end window (the end circle's radius, at least
-    _END_WINDOW_MM, at most a tenth of the line) -- a parabola over a window rather than an
-    interpolating spline's end slope, which the closely packed last centres of a circular edge
-    and noise would tilt.
+    centre, pointing out of that end: the slope at the end of a least-squares quartic (in arc
+    length) through the centres within the end window (``window_pct`` of the locus, after the
+    last half edge radius) -- a fit over a wide window rather than an interpolating spline's
+    end slope, which the closely packed last centres of a circular edge and noise would tilt.
 
     With ``edge`` (the fitted edge circle): the centres nearer to its centre than _EDGE_CORE of
-    its radius are dropped (ill-conditioned bisectors on a circular edge), and when its centre
-    lies ahead of the line's end, the parabola is followed on (at most one edge radius) to the
-    point nearest to it, which becomes the line's end -- on a circular edge the inscribed
-    circles end as the edge circle, at its centre; on a varying-curvature nose the line ends
-    abreast of the fitted circle's centre. When that centre lies before the end (the nose's
-    curvature grows beyond it), the line is cut back to its point nearest the centre. Either
-    way the line ends abreast of the fitted edge circle's centre, a rule continuous in the
-    geometry and blind to the last, ill-conditioned centres."""
+    its radius are dropped (ill-conditioned bisectors on a circular edge), and the line ends on
+    the fitted quartic at its point abreast of the edge circle's centre (ahead of the last
+    centre, at most one edge radius, or behind it), the centres beyond dropped -- on a circular
+    edge the inscribed circles end as the edge circle, at its centre; on a varying-curvature
+    nose the line ends abreast of the fitted circle's centre. A rule continuous in the geometry
+    and blind to the last, ill-conditioned centres."""
     c = centres if end == -1 else centres[::-1]
     r = radii if end == -1 else radii[::-1]
     if edge is not None:
         far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
         c, r = c[far], r[far]
-        c, r = _cut_abreast(c, r, edge.center)
     seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     s = s - s[-1]
     # The last stretch of the locus bends towards the centre of curvature of the edge's
     # tightest point when the edge is not a circle: it is left out of the fit.
     skip = _END_SKIP * (r[-1] if edge is None else edge.radius)
-    window = min(max(r[-1], _END_WINDOW_MM), 0.1 * -s[0])
+    window = window_pct / 100.0 * -s[0]
     sel = (s >= -(skip + window)) & (s <= -skip)
-    if sel.sum() < 4:
-        sel = np.arange(len(s)) >= len(s) - 4
-    coef = np.polyfit(s[sel], c[sel], 2)
-    tangent = _unit(coef[1])
+    if sel.sum() < 2 * _END_DEGREE:
+        sel = np.arange(len(s)) >= len(s) - 2 * _END_DEGREE
+    full = np.polyfit(s[sel], c[sel], _END_DEGREE)
+    deriv = np.column_stack([np.polyder(full[:, k]) for k in range(2)])
+    tangent = _unit(full[-2])
     # How far the last stretch turns from that tangent: the metal angle's definition spread.
     last = s >= -skip
     bend = 0.0
     if last.sum() >= 2 and np.linalg.norm(c[-1] - c[last][0]) > 0:
         chord = _unit(c[-1] - c[last][0])
         bend = float(np.degrees(np.arccos(np.clip(chord @ tangent, -1.0, 1.0))))
-    ahead = 0.0 if edge is None else float((edge.center - c[-1]) @ tangent)
-    if ahead > 0:
-        # Along the parabola, moved to pass through the last centre (where the locus bends
-        # the fitted parabola misses it), on to the point abreast of the edge circle's centre.
-        offset = c[-1] - coef[2]
+    if edge is not None:
+        # The line ends on the fitted quartic (not at the last, least conditioned centre),
+        # at its point abreast of the edge circle's centre, ahead of the last centre or behind.
         reach = 0.0
-        for _ in range(5):
-            p = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
-            d = _unit(2 * coef[0] * reach + coef[1])
-            reach = min(reach + float((edge.center - p) @ d), edge.radius)
-        tip = (coef[0] * reach + coef[1]) * reach + coef[2] + offset
-        tangent = _unit(2 * coef[0] * reach + coef[1])
-        c, r = np.vstack([c, tip]), np.concatenate([r, [edge.radius]])
+        for _ in range(8):
+            p = np.array([np.polyval(full[:, k], reach) for k in range(2)])
+            d = _unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+            reach = float(np.clip(reach + (edge.center - p) @ d, s[sel][0], edge.radius))
+        tip = np.array([np.polyval(full[:, k], reach) for k in range(2)])
+        tangent = _unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+        keep = s < reach - 1e-9
+        c, r = np.vstack([c[keep], tip]), np.concatenate([r[keep], [edge.radius]])
     if end == 0:
         return c[::-1], r[::-1], tangent, bend
     return c, r, tangent, bend
 
 
-def _closed_end(profile, centres, radii, end, circle, notes):
+def _closed_end(profile, centres, radii, end, circle, notes, window_pct):
     """The line closed onto the fitted edge circle at one end (see _line_end) and its edge
     point; when the closed end's tangent does not meet the profile (a corner, a clipped
     section), the unclosed end, with a note saying so."""
-    c, r, out, bend = _line_end(centres, radii, end, circle)
+    c, r, out, bend = _line_end(centres, radii, end, circle, window_pct)
     try:
         u, point = _ray_hit(profile, c[end], out)
     except InputError:
-        c, r, out, bend = _line_end(centres, radii, end)
+        c, r, out, bend = _line_end(centres, radii, end, window_pct=window_pct)
         u, point = _ray_hit(profile, c[end], out)
         notes.append("the camber line's end at (%.4f, %.4f) mm could not be brought abreast "
                      "of its edge circle; it ends at its last inscribed circle"
@@ -455,20 +460,6 @@ def _closed_end(profile, centres, radii, end, circle, notes):
                      "metal angle there depends on the rule (docs/airfoil.md)"
                      % (bend, c[end][0], c[end][1]))
     return c, r, out, u, point
-
-
-def _cut_abreast(c, r, point):
-    """The polyline of centres c (radii r) cut at its point nearest ``point`` when that lies
-    before its last centre (a nose whose curvature still grows beyond the fitted circle)."""
-    a, b = c[:-1], c[1:]
-    e = b - a
-    t = np.clip(np.einsum("ij,ij->i", point - a, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
-    foot = a + t[:, None] * e
-    i = int(np.argmin(np.linalg.norm(foot - point, axis=1)))
-    if i == len(e) - 1 and t[i] >= 1.0:
-        return c, r
-    rr = r[i] + t[i] * (r[i + 1] - r[i])
-    return np.vstack([c[:i + 1], foot[i]]), np.concatenate([r[:i + 1], [rr]])
 
 
 def _ray_hit(profile, origin, direction):
@@ -766,10 +757,14 @@ class Characteristics:
 
 def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
                     stations_pct=(), edge_offsets_mm=DEFAULT_EDGE_OFFSETS_MM,
-                    edge_zone_deg=DEFAULT_EDGE_ZONE_DEG, le_hint=None, noise_mm=0.0):
+                    edge_zone_deg=DEFAULT_EDGE_ZONE_DEG, le_hint=None, noise_mm=0.0,
+                    le_upstream=None, metal_angle_window_pct=DEFAULT_METAL_ANGLE_WINDOW_PCT):
     """All characteristics of one section. ``profile``: a Profile or an ordered (N, 2) array;
-    ``engine_axis``: a 2D direction in the section plane; ``le_hint``: a point near the
-    leading edge (e.g. on the CAD's named LE face), else the LE is the blunter end."""
+    ``engine_axis``: a 2D direction in the section plane, pointing downstream; ``le_hint``: a
+    point near the leading edge (e.g. on the CAD's named LE face); ``le_upstream``: a 2D
+    direction pointing upstream (the LE is the end furthest along it); with neither, the LE is
+    the blunter end, or the end upstream along the engine axis when the two edge radii agree
+    within their uncertainty (``le_rule`` says which rule decided, docs/airfoil.md)."""
     if not isinstance(profile, Profile):
         profile = Profile(profile, noise_mm)
     if chord_method not in CHORD_METHODS:
@@ -780,6 +775,9 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         raise InputError("engine axis: %s must be a finite non-zero 2D direction" % axis)
     axis = _unit(axis)
     L = profile.length
+    if not (np.isfinite(metal_angle_window_pct) and 0 < metal_angle_window_pct <= 100):
+        raise InputError("metal angle window: %r %% of the camber line must be in (0, 100]"
+                         % (metal_angle_window_pct,))
 
     # Sides split at the caliper diameter's ends (the edges of an airfoil), then the circles.
     cal_u1, cal_u2, cal_p1, cal_p2 = _farthest_pair(profile)
@@ -790,27 +788,22 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
 
     # Camber line end tangents, extended to the profile: the two edge points.
     # First the edge circles about the locus's ends, then the ends closed onto circular edges.
-    out_a = _line_end(centres, radii, 0)[2]
-    out_b = _line_end(centres, radii, -1)[2]
+    out_a = _line_end(centres, radii, 0, window_pct=metal_angle_window_pct)[2]
+    out_b = _line_end(centres, radii, -1, window_pct=metal_angle_window_pct)[2]
     circle_a = _edge_circle(profile, centres[0], out_a, _ray_hit(profile, centres[0], out_a)[0][0],
                             edge_zone_deg)
     circle_b = _edge_circle(profile, centres[-1], out_b,
                             _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
     notes = []
     centres, radii, out_a, ua_end, end_a = _closed_end(profile, centres, radii, 0, circle_a,
-                                                       notes)
+                                                       notes, metal_angle_window_pct)
     centres, radii, out_b, ub_end, end_b = _closed_end(profile, centres, radii, -1, circle_b,
-                                                       notes)
+                                                       notes, metal_angle_window_pct)
     circle_a = _edge_circle(profile, circle_a.center, out_a, ua_end[0], edge_zone_deg)
     circle_b = _edge_circle(profile, circle_b.center, out_b, ub_end[0], edge_zone_deg)
     t0, t1 = -out_a, out_b
-    if le_hint is not None:
-        hint = np.asarray(le_hint, dtype=float).reshape(2)
-        a_is_le = np.linalg.norm(end_a[0] - hint) <= np.linalg.norm(end_b[0] - hint)
-        le_rule = "given"
-    else:
-        a_is_le = circle_a.radius >= circle_b.radius
-        le_rule = "larger edge radius"
+    a_is_le, le_rule = _leading_end(end_a[0], end_b[0], circle_a, circle_b, axis, le_hint,
+                                    le_upstream, noise_mm)
     if a_is_le:
         le, te, le_u, te_u = end_a[0], end_b[0], ua_end[0], ub_end[0]
         le_circle, te_circle = circle_a, circle_b
@@ -876,6 +869,58 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
         profile=profile, suction_range=(suction.lo, suction.hi),
         pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
+
+
+def _leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, noise_mm):
+    """Whether end a is the LE, and the rule that decided (docs/airfoil.md)."""
+    if le_hint is not None:
+        hint = np.asarray(le_hint, dtype=float).reshape(2)
+        return bool(np.linalg.norm(end_a - hint) <= np.linalg.norm(end_b - hint)), "given"
+    if le_upstream is not None:
+        up = np.asarray(le_upstream, dtype=float).reshape(2)
+        if not np.all(np.isfinite(up)) or np.linalg.norm(up) < 1e-12:
+            raise InputError("LE upstream direction: %s must be a finite non-zero 2D "
+                             "direction" % up)
+        return bool((end_a - end_b) @ up >= 0), "given upstream direction"
+    sigma = np.hypot(edge_radius_sigma(circle_a, noise_mm), edge_radius_sigma(circle_b, noise_mm))
+    if abs(circle_a.radius - circle_b.radius) > LE_RADIUS_SIGMAS * sigma:
+        return bool(circle_a.radius > circle_b.radius), "larger edge radius"
+    return bool((end_a - end_b) @ axis <= 0), "upstream along the engine axis"
+
+
+def edge_radius_sigma(circle, noise_mm=0.0):
+    """1-sigma of a fitted edge radius: sigma_R = s / sqrt(n) * f(alpha) (docs/airfoil.md),
+    s the larger of the points' noise and the fit's rms (a non-circular edge's form counts as
+    the radius's definition spread), alpha the zone's half-angle."""
+    s = max(float(noise_mm), circle.rms)
+    return s / np.sqrt(circle.n_points) * circle_radius_factor(np.radians(circle.zone_deg))
+
+
+def circle_radius_factor(half_angle_rad):
+    """f(alpha) in sigma_R = sigma / sqrt(n) * f(alpha): the radius's standard deviation of a
+    geometric circle fit to n points spread evenly in angle over an arc of half-angle alpha,
+    each with normal noise sigma. From the Fisher information of (centre, radius) with the
+    residual's gradient (cos t, sin t, 1): f^2 = m_cc / (m_cc - m_c^2), m_c = sin(a)/a,
+    m_cc = (1 + sin(2a)/(2a))/2 (the centre's along-axis coordinate and the radius trade off
+    on a short arc)."""
+    a = float(half_angle_rad)
+    m_c = np.sin(a) / a
+    m_cc = 0.5 * (1.0 + np.sin(2 * a) / (2 * a))
+    return float(np.sqrt(m_cc / (m_cc - m_c ** 2)))
+
+
+def edge_points_needed(noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_ZONE_DEG):
+    """Points the edge zone (+-zone_deg) needs for the fitted radius's 1-sigma to be at most
+    radius_sigma_mm at the points' noise: n = (noise / sigma_R * f(alpha))^2 (issue 15 item 7)."""
+    f = circle_radius_factor(np.radians(zone_deg))
+    return int(np.ceil((float(noise_mm) / float(radius_sigma_mm) * f) ** 2))
+
+
+def edge_spacing_mm(radius_mm, noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_ZONE_DEG):
+    """Point spacing along an edge of radius radius_mm giving the zone those points: its arc
+    2 alpha r over edge_points_needed."""
+    arc = 2.0 * np.radians(zone_deg) * float(radius_mm)
+    return arc / edge_points_needed(noise_mm, radius_sigma_mm, zone_deg)
 
 
 def _corner_warnings(profile, le, te, chord):
