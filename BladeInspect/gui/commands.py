@@ -2,7 +2,6 @@
 and the selection, runs a pipeline stage with progress and cancel (gui.progress.run), and
 stores the outcome as document objects through the app layer's make_* functions, which remove
 what they made if anything fails."""
-import inspect as pyinspect
 import os
 import tempfile
 
@@ -181,14 +180,9 @@ class Scan(_Command):
         from ..inspection.pipeline import load_points
         doc = active_document()
         out_dir = scan_folder(doc)
-        params = pyinspect.signature(scan_to_dir).parameters
-        takes_strategy_options = any(p.kind == p.VAR_KEYWORD for p in params.values())
 
         def job(p):
-            # The strategy's own defaults stand for options the scan does not take.
-            kwargs = {k: v for k, v in options.items()
-                      if (k in params or takes_strategy_options) and v is not None}
-            scan_to_dir(out_dir, RIG.rig, progress=p, **kwargs)
+            scan_to_dir(out_dir, RIG.rig, progress=p, **options)
             path = os.path.join(out_dir, "points.csv")
             pointset = load_points(path)
             return objects.make_measurement(doc, pointset, name="Scan", source_file=path)
