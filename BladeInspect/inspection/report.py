@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from ..core import colormap
+from ..core import stats as stats_mod
 from ..core.errors import InputError
 from . import sections as sections_mod
 from . import verdict as verdict_mod
@@ -157,8 +158,8 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
 
 
 def figure_histogram(result, band_edges):
-    """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the Table 3
-    band edges."""
+    """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the tolerance
+    bands' edges (tolerance_histogram)."""
     plt, _, _ = _mpl()
     dev = result.deviation
     stats = result.deviation_stats
@@ -185,7 +186,7 @@ def figure_histogram(result, band_edges):
     ax.set_xlabel("signed deviation (mm), + outside material; the end bins hold all beyond")
     ax.set_ylabel("points")
     ax.set_title("Deviations: mean %+.4f mm, sigma %.4f mm, RMS %.4f mm; dashed +-sigma, "
-                 "dotted +-3 sigma, grey the Table 3 bands" % (mean, sigma, stats["rms"]),
+                 "dotted +-3 sigma, grey the tolerance bands" % (mean, sigma, stats["rms"]),
                  fontsize=10)
     return fig
 
@@ -285,9 +286,17 @@ def _fmt(value, pattern="%.4f"):
     return "-" if value is None else pattern % value
 
 
-def histogram_rows(result):
+def tolerance_histogram(result, tolerance):
+    """The deviations counted in the bands of the run's profile tolerance T (core.stats
+    tolerance_bands: +-T, +-1.5T, +-2T; Table 3's bands when T = 0.04 mm)."""
+    bands = stats_mod.tolerance_bands(tolerance)
+    return stats_mod.deviation_statistics(result.deviation, bands)["histogram"]
+
+
+def histogram_rows(histogram):
+    """The report's histogram table of ``histogram`` (tolerance_histogram's bands)."""
     rows = []
-    for band in result.deviation_stats["histogram"]:
+    for band in histogram:
         lo, hi = band["lo"], band["hi"]
         name = ("< %.3f" % hi if lo is None else "> %.3f" % lo if hi is None
                 else "%.3f to %.3f" % (lo, hi))
@@ -420,10 +429,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
     table = sections
     tolerance = float(tolerance)
     title = title or "BladeInspect inspection report"
-    band_edges = [b["lo"] for b in result.deviation_stats["histogram"][1:]]
+    histogram = tolerance_histogram(result, tolerance)
+    band_edges = [b["lo"] for b in histogram[1:]]
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     verdict_lines = _verdict_lines(verdict, table)
-    h_header, h_rows = histogram_rows(result)
+    h_header, h_rows = histogram_rows(histogram)
     s_header, s_rows = section_rows(table)
     p_rows = pose_rows(result)
 
