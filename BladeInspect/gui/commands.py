@@ -14,6 +14,9 @@ from ..core.errors import InputError
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
 from .session import RIG
 
+# Marks the command texts for translation (FreeCAD translates them in the command's context).
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
+
 POINT_FILTER = "Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)"
 CAD_FILTER = "CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)"
 
@@ -107,8 +110,10 @@ class _Command:
 
 class DemoBlade(_Command):
     name = "BladeInspect_DemoBlade"
-    menu = "Demo blade"
-    tip = "Build the parametric demo blade as the nominal CAD (parameters in a task panel)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_DemoBlade", "Demo blade")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_DemoBlade",
+        "Build the parametric demo blade as the nominal CAD (parameters in a task panel)")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(taskpanels.DemoBladePanel(self.build))
@@ -123,8 +128,10 @@ class DemoBlade(_Command):
 
 class LoadCad(_Command):
     name = "BladeInspect_LoadCad"
-    menu = "Load CAD..."
-    tip = "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_LoadCad", "Load CAD...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_LoadCad",
+        "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)")
 
     def Activated(self):
         path = ask_open_file("Nominal CAD", CAD_FILTER)
@@ -139,10 +146,19 @@ class LoadCad(_Command):
         return obj
 
 
+def simulated_rig(nominal, seed, kinematics=None):
+    """The simulated rig of ``nominal`` (a Nominal) with the sensor the preferences describe,
+    as ConnectRig opens it; ``kinematics``: its true geometry (default nominal)."""
+    from ..measurement.scan import open_rig
+    return open_rig("sim", nominal, seed, kinematics=kinematics, sensor=settings.sensor_model())
+
+
 class ConnectRig(_Command):
     name = "BladeInspect_ConnectRig"
-    menu = "Connect rig..."
-    tip = "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_ConnectRig", "Connect rig...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_ConnectRig",
+        "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
@@ -166,8 +182,10 @@ class ConnectRig(_Command):
 
 class Scan(_Command):
     name = "BladeInspect_Scan"
-    menu = "Scan..."
-    tip = "Scan the blade section by section with the connected rig (progress and abort)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Scan", "Scan...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Scan",
+        "Scan the blade section by section with the connected rig (progress and abort)")
 
     def ready(self):
         return RIG.connected
@@ -203,8 +221,10 @@ def scan_folder(doc):
 
 class ImportPoints(_Command):
     name = "BladeInspect_ImportPoints"
-    menu = "Import points..."
-    tip = "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_ImportPoints", "Import points...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_ImportPoints",
+        "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)")
 
     def Activated(self):
         path = ask_open_file("Measured points", POINT_FILTER)
@@ -229,8 +249,10 @@ class ImportPoints(_Command):
 
 class Reconstruct(_Command):
     name = "BladeInspect_Reconstruct"
-    menu = "Reconstruct"
-    tip = "Fit cubic B-spline section curves to the measurement and loft them into surfaces"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Reconstruct", "Reconstruct")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Reconstruct",
+        "Fit cubic B-spline section curves to the measurement and loft them into surfaces")
 
     def ready(self):
         return find_input((objects.Measurement.Type,)) is not None
@@ -255,9 +277,11 @@ class Reconstruct(_Command):
 
 class Register(_Command):
     name = "BladeInspect_Register"
-    menu = "Register"
-    tip = ("Register the measurement to the nominal with no starting pose (PCA, then "
-           "SNR-weighted ICP) and show the pose with its uncertainty")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Register", "Register")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Register",
+        "Register the measurement to the nominal with no starting pose (PCA, then SNR-"
+        "weighted ICP) and show the pose with its uncertainty")
 
     def ready(self):
         return find_input((objects.Measurement.Type,)) is not None and find_nominal() is not None
@@ -293,8 +317,10 @@ class Register(_Command):
 
 class DeviationMap(_Command):
     name = "BladeInspect_DeviationMap"
-    menu = "Deviation map"
-    tip = "Colour the registered points by signed deviation (limits from the preferences)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_DeviationMap", "Deviation map")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_DeviationMap",
+        "Colour the registered points by signed deviation (limits from the preferences)")
 
     def ready(self):
         return find_input((objects.Registration.Type,)) is not None
@@ -323,8 +349,10 @@ class DeviationMap(_Command):
 
 class SectionAnalysis(_Command):
     name = "BladeInspect_SectionAnalysis"
-    menu = "Section analysis"
-    tip = "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_SectionAnalysis", "Section analysis")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_SectionAnalysis",
+        "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge")
 
     def ready(self):
         reg = find_input((objects.Registration.Type,))
@@ -417,8 +445,10 @@ class Report(_Command):
 
 class Preferences(_Command):
     name = "BladeInspect_Preferences"
-    menu = "Preferences..."
-    tip = "Sensor and rig parameters, tolerance and colour limits"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Preferences", "Preferences...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Preferences",
+        "Sensor and rig parameters, tolerance and colour limits")
 
     def Activated(self):
         FreeCADGui.showPreferences("BladeInspect")

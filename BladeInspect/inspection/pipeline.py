@@ -24,7 +24,7 @@ from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
 from . import checks
 from .result import RegistrationResult
-from .verdict import DEFAULT_TOLERANCE
+from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
 
 # Points used for the ICP ranking of each PCA candidate and for the fine fit's inner
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
@@ -382,7 +382,7 @@ def _check_time(fit, time_limit_s):
 # ---------------------------------------------------------------- the whole registration
 
 def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
-             allow_mismatch=False, tolerance=DEFAULT_TOLERANCE, cad_source=None):
+             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
     Refused (InputError) before any fitting when the points are too degenerate to fix a pose
@@ -630,22 +630,12 @@ def write_register_outputs(out_dir, result, extra=None, output=None):
         _write_deviations_csv(out.path("deviations.csv"), result)
         result.timing_s["write"] = time.perf_counter() - t0
         with open(out.path("result.json"), "w") as fh:
-            json.dump(result_json(result, extra), fh, indent=1, default=_json_default)
+            json.dump(result_json(result, extra), fh, indent=1, default=json_default)
     if output is not None:
         write(output)
     else:
         with AtomicOutput(out_dir) as out:
             write(out)
-
-
-def _json_default(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, (np.floating, np.integer)):
-        return value.item()
-    if isinstance(value, np.bool_):
-        return bool(value)
-    raise TypeError("not JSON serialisable: %r" % type(value))
 
 
 def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..core import colormap
+from ..core import colormap, contracts
 from ..core import stats as stats_mod
 from ..core.errors import InputError
 from . import sections as sections_mod
@@ -542,8 +542,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 # ---------------------------------------------------------------- the `report` command
 
-def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
-               seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
+def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
+               seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
                nominal=None, document=True, flip_faces=(), allow_mismatch=False):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
@@ -555,9 +555,7 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     from .checks import check_out_dir
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
-    tolerance = float(tolerance)
-    if not np.isfinite(tolerance) or tolerance <= 0:
-        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    tolerance = contracts.profile_tolerance(tolerance)
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:

@@ -27,10 +27,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core import pca
+from ..core.contracts import SECTION_HEIGHTS_PCT, section_heights
 from ..core.errors import InputError
 from ..core.fitting import fit_plane
 
-DEFAULT_HEIGHTS_PCT = (10, 30, 50, 70, 90)
 EDGE_FRACTION = 0.03
 # Profile thickness is compared this far behind each end to tell the round nose from the tail.
 _THICKNESS_PROBE = 0.05
@@ -514,7 +514,7 @@ def _height_sections(result, nominal, span_axis, span_range, heights_pct, band):
     return out
 
 
-def section_table(result, nominal, heights_pct=DEFAULT_HEIGHTS_PCT, band=0.25, within=0.02,
+def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, within=0.02,
                   cmm=None, span_axis=None, edge_fraction=EDGE_FRACTION):
     """Table 2 for a registration: one Section per section plane with the optical figures (and
     the CMM's beside them when ``cmm`` — a path or CmmData — is given). See the module notes
@@ -523,9 +523,7 @@ def section_table(result, nominal, heights_pct=DEFAULT_HEIGHTS_PCT, band=0.25, w
     for name, value in (("band", band), ("within", within), ("edge_fraction", edge_fraction)):
         if not np.isfinite(value) or value <= 0:
             raise InputError("section table: %s must be positive, got %r" % (name, value))
-    heights = [float(h) for h in heights_pct]
-    if any(not (0.0 <= h <= 100.0) for h in heights):
-        raise InputError("section heights: must lie within 0..100 %% of span, got %s" % heights)
+    heights = section_heights(heights_pct, "section heights", allow_empty=True)
     axis, span_range = span_axis_of(nominal, span_axis)
     warnings = []
     if "section" in result.columns:

@@ -20,6 +20,7 @@ import tempfile
 
 import numpy as np
 
+from ..core.contracts import json_ready
 from ..core.errors import DeviceError, InputError
 from .journal import JOURNAL_FILE, JournaledRig, inner_rig
 from .strategy import ScanOptions, ScanStrategy, StrategyState
@@ -162,18 +163,6 @@ def _strategy_options(options):
     return ScanOptions.from_dict(options), kinematics
 
 
-def _json_options(options):
-    out = {}
-    for k, v in options.items():
-        if k == "kinematics":
-            out[k] = None if v is None else v.to_dict()
-        elif isinstance(v, (np.ndarray, list, tuple, np.floating, np.integer)):
-            out[k] = np.asarray(v).tolist()
-        else:
-            out[k] = v
-    return out
-
-
 def _new_record(rig, seed, options):
     from .. import __version__ as version
     sensor = rig.sensor
@@ -182,7 +171,7 @@ def _new_record(rig, seed, options):
         "kind": "blind section scan",
         "rig": type(inner_rig(rig)).__name__,
         "seed": int(seed),
-        "options": _json_options(options),
+        "options": json_ready(options),
         "sensor": sensor.to_dict() if hasattr(sensor, "to_dict") else None,
         "frame": "rotary table (machine frame turned back by the rotary angle)",
         "complete": False,
