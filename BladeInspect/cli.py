@@ -1,4 +1,4 @@
-"""BladeInspect's headless command line (DESIGN.md "Contracts").
+"""BladeInspect's headless command line (docs/contracts.md "Command line").
 
 Run as ``./bladeinspect <command> ...`` from the repository, or inside FreeCADCmd::
 

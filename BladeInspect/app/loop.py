@@ -1,4 +1,4 @@
-"""Document side of the closed loop (issue 8): the planned paths as Part geometry, and what an
+"""Document side of the closed loop: the planned paths as Part geometry, and what an
 inspection leaves on its Registration so a CMM file can be added to its Table 2 later.
 No GUI imports: the workbench commands in gui/loop_commands.py call these."""
 

@@ -1,4 +1,4 @@
-"""The closed-loop commands (issue 8, item 5): inspect a blade, calibrate the rig, add a CMM file
+"""The closed-loop commands (docs/contracts.md): inspect a blade, calibrate the rig, add a CMM file
 to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
 function as the command line (run_inspect, run_calibration, section_table, run_simulation)
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure

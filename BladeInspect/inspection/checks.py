@@ -26,7 +26,7 @@ from ..core import pca as pca_mod
 from ..rig.sensor import SensorModel
 from ..core.contracts import PROFILE_TOLERANCE_MM
 
-# The sensor's error bound at the reference SNR (DESIGN.md: accuracy < 6 um). A cloud whose
+# The sensor's error bound at the reference SNR (docs/contracts.md: accuracy < 6 um). A cloud whose
 # spread (standard deviation) in some direction is within it has no extent there, only noise:
 # noise of that bound spreads a flat patch by 3.5 um (uniform) or 2 um (clipped normal).
 SENSOR_ACCURACY_MM = SensorModel().accuracy

@@ -1,4 +1,4 @@
-"""The `inspect` workflow (issue 8, item 1): the paper's whole automated loop on one blade.
+"""The `inspect` workflow (docs/contracts.md loop 1): the paper's whole automated loop on one blade.
 
 1. blind section scan (measurement.scan.scan_to_dir: nothing about the pose is known yet);
 2. registration of those points (reconstruction, PCA, SNR-weighted ICP) -> pose on the table;

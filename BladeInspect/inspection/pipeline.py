@@ -1,4 +1,4 @@
-"""The registration pipeline, one plain function per stage (DESIGN.md "Data flow").
+"""The registration pipeline, one plain function per stage (docs/contracts.md "Data flow").
 
 The command line, the GUI commands and the tests all call these functions; nothing here knows
 about a terminal or a window. Long stages report through ``progress(fraction, message)``; a
@@ -56,7 +56,7 @@ SEARCH_TURNS_DEG = (-8.0, -4.0, 4.0, 8.0)
 # its ICPs and search rounds are bounded in number, so this only ends a stage that a slow
 # distance (points far inside or off the CAD) would stretch to minutes. Half the fine stage's.
 COARSE_TIME_LIMIT_S = 60.0
-# Wall-clock budget of the fine stage: twelve times DESIGN.md's 10 s for the whole
+# Wall-clock budget of the fine stage: twelve times docs/contracts.md's 10 s for the whole
 # registration of the paper's 269k-point cloud on two cores. A fit still iterating then is
 # lost (its points are not on this CAD), not slow; its iteration counts are bounded as well.
 FINE_TIME_LIMIT_S = 120.0
@@ -528,7 +528,7 @@ def freecad_version():
 
 
 def result_json(result, extra=None):
-    """The result.json contract of DESIGN.md, plus ``extra`` fields merged at the top level."""
+    """The result.json of docs/contracts.md, plus ``extra`` fields merged at the top level."""
     stats = dict(result.deviation_stats)
     doc = {
         "measured_to_cad": np.asarray(result.measured_to_cad).tolist(),
