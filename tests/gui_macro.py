@@ -239,7 +239,7 @@ def run():
         blade = state.get("blade")
         if blade is None:
             raise Skip("no demo blade")
-        from BladeInspect.core.colormap import deviation_colors
+        from BladeInspect.core.colourmap import deviation_colours
         result = _known_result(blade.Shape)
         reg = objects.make_registration(doc, result, name="KnownRegistration")
         Gui.Selection.clearSelection()
@@ -252,7 +252,7 @@ def run():
                 if o.Registration == reg][0]
         limit = dmap.Limit
         check("colours follow deviations", np.allclose(
-            colours_of(dmap), deviation_colors(result.deviation, limit), atol=1e-6))
+            colours_of(dmap), deviation_colours(result.deviation, limit), atol=1e-6))
         vobj = dmap.ViewObject
         check("display mode Color", vobj.DisplayMode == "Color", vobj.DisplayMode)
         check("legend in the scene", vobj.Proxy.legend is not None)
@@ -272,7 +272,7 @@ def run():
         settle(0.5)
         dmap2 = doc2.getObject(name)
         check("reopened colours intact", np.allclose(
-            colours_of(dmap2), deviation_colors(result.deviation, limit), atol=0.5 / 255 + 1e-9))
+            colours_of(dmap2), deviation_colours(result.deviation, limit), atol=0.5 / 255 + 1e-9))
         check("reopened display mode Color", dmap2.ViewObject.DisplayMode == "Color")
         check("reopened view provider and legend", isinstance(
             dmap2.ViewObject.Proxy, viewproviders.ViewProviderDeviationMap)

@@ -190,7 +190,7 @@ class RunReportTest(unittest.TestCase):
         colours those of the deviations, the pose, the section profiles and the verdict."""
         import FreeCAD
         from BladeInspect.app import objects
-        from BladeInspect.core import colormap
+        from BladeInspect.core import colourmap
         doc = FreeCAD.openDocument(os.path.join(self.out, "inspection.FCStd"))
         try:
             maps = objects.find_objects(doc, "BladeInspect::DeviationMap")
@@ -198,7 +198,7 @@ class RunReportTest(unittest.TestCase):
             cloud = maps[0]
             self.assertEqual(len(cloud.Color), len(self.known))
             self.assertEqual(cloud.Points.CountPoints, len(self.known))
-            expected = colormap.deviation_colors(np.asarray(cloud.Deviation), 0.04)
+            expected = colourmap.deviation_colours(np.asarray(cloud.Deviation), 0.04)
             # the file stores colours as 8-bit RGBA
             np.testing.assert_allclose(np.asarray(cloud.Color)[:, :3], expected,
                                        atol=0.5 / 255 + 1e-6)

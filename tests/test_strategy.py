@@ -11,7 +11,7 @@ from BladeInspect.core.errors import InputError
 from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
 from BladeInspect.measurement.strategy import (ScanOptions, ScanStrategy, ViewResult,
-                                               fit_section_curve)
+                                               fit_stage_profile)
 from tests.rig_parts import Sphere, TwistedEllipse
 
 TWIST = 25.0
@@ -215,7 +215,7 @@ class TestCurveFit(unittest.TestCase):
         z = truth(x) + rng.uniform(-0.006, 0.006, 400)
         bad = rng.random(400) < 0.03
         z[bad] += rng.uniform(0.1, 0.5, bad.sum())
-        curve, keep = fit_section_curve(x, z)
+        curve, keep = fit_stage_profile(x, z)
         self.assertTrue(np.all(~keep[bad]))
         self.assertGreater(keep[~bad].mean(), 0.97)
         xz = curve(np.linspace(0, curve.length, 500))
@@ -226,7 +226,7 @@ class TestCurveFit(unittest.TestCase):
     def test_extension_never_steeper_than_the_coverage(self):
         x = np.linspace(0, 1, 50)
         z = -30 * x          # steeper than 85 deg would allow
-        curve, _ = fit_section_curve(x, z)
+        curve, _ = fit_stage_profile(x, z)
         beyond = curve(np.array([curve.length, curve.length + 3.0]))
         self.assertGreaterEqual(beyond[1, 0] - beyond[0, 0], 3.0 * np.cos(np.radians(85)) - 1e-9)
 

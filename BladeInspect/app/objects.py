@@ -592,7 +592,7 @@ class DeviationMap(_Proxy):
         _add(obj, "App::PropertyInteger", "NPoints", g, "Points shown", read_only=True)
 
     def execute(self, obj):
-        from ..core import colormap
+        from ..core import colourmap
         if obj.Registration is None:
             raise InputError("%s: no registration linked" % obj.Label)
         if obj.Limit <= 0:
@@ -600,8 +600,8 @@ class DeviationMap(_Proxy):
         points, deviation, _ = registration_points(obj.Registration)
         obj.Points = _points_kernel(points)
         obj.Deviation = deviation.tolist()
-        obj.Color = [tuple(c) for c in colormap.deviation_colors(deviation, obj.Limit).tolist()]
-        values, colours = colormap.legend_ticks(obj.Limit)
+        obj.Color = [tuple(c) for c in colourmap.deviation_colours(deviation, obj.Limit).tolist()]
+        values, colours = colourmap.legend_ticks(obj.Limit)
         obj.LegendValues = values.tolist()
         obj.LegendColors = [tuple(c) for c in colours.tolist()]
         obj.NPoints = len(deviation)

@@ -5,7 +5,7 @@ workbench exactly as if the inspection had been done there: the nominal (DemoBla
 CadModel), the Measurement (the points as read, in their own frame), the Registration holding
 the result (linked to both, so it re-registers only if one of them changes), the DeviationMap
 (a Points::FeaturePython whose App::PropertyColorList "Color" has one colour per point, from
-core.colormap) and the nominal section profiles. The verdict is stored beside the section
+core.colourmap) and the nominal section profiles. The verdict is stored beside the section
 profiles. Nothing is recomputed on opening: each object carries the signature of its inputs.
 """
 

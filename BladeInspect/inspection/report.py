@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..core import colormap, contracts
+from ..core import colourmap, contracts
 from ..core import stats as stats_mod
 from ..core.errors import InputError
 from . import sections as sections_mod
@@ -46,7 +46,7 @@ def _mpl():
 
 def _cmap_and_norm(limit):
     _, ListedColormap, Normalize = _mpl()
-    return ListedColormap(colormap.colormap_table(), name="bladeinspect"), \
+    return ListedColormap(colourmap.colourmap_table(), name="bladeinspect"), \
         Normalize(-limit, limit)
 
 
@@ -58,7 +58,7 @@ def _add_legend(fig, ax_or_axes, limit, label="deviation (mm), + outside materia
         bar = fig.colorbar(mappable, cax=cax)
     else:
         bar = fig.colorbar(mappable, ax=ax_or_axes, fraction=0.035, pad=0.02)
-    values, _ = colormap.legend_ticks(limit)
+    values, _ = colourmap.legend_ticks(limit)
     bar.set_ticks(values)
     bar.set_ticklabels(["%+.3f" % v if v else "0" for v in values])
     bar.set_label(label)
@@ -93,7 +93,7 @@ def _view_frame(result, table):
     return span, chord, across
 
 
-def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
+def raster_view(xyz, colours, right, up, toward_viewer, px_per_mm, splat=1):
     """An orthographic z-buffered picture of coloured points: (RGBA image (H, W, 4), extent
     (left, right, bottom, top) in mm). Each point covers a (2 splat + 1)^2 pixel square and
     the point nearest the viewer wins a pixel, so the visible surface hides the far one; a
@@ -119,7 +119,7 @@ def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
     last = np.r_[pix[1:] != pix[:-1], True]       # nearest point of each pixel
     image = np.ones((height * width, 4))
     image[:, 3] = 0.0
-    image[pix[last], :3] = colors[src[last]]
+    image[pix[last], :3] = colours[src[last]]
     image[pix[last], 3] = 1.0
     extent = (u0, u0 + width / px_per_mm, v1 - height / px_per_mm, v1)
     return image.reshape(height, width, 4), extent
@@ -134,7 +134,7 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
         keep = np.sort(np.random.default_rng(seed).choice(len(xyz), max_points, replace=False))
         xyz, dev = xyz[keep], dev[keep]
     span, chord, across = _view_frame(result, table)
-    colors = colormap.deviation_colors(dev, limit)
+    colours = colourmap.deviation_colours(dev, limit)
     # (title, right, up, toward the viewer), each right-handed so no view is mirrored
     views = (("suction side", -chord, span, across),
              ("pressure side", chord, span, -across),
@@ -145,7 +145,7 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
     extent_mm = np.ptp(xyz @ np.column_stack([chord, span, across]), axis=0).max()
     px_per_mm = 900.0 / max(extent_mm, 1e-6)
     for ax, (title, right, up, toward_viewer) in zip(axes, views):
-        image, extent = raster_view(xyz, colors, right, up, toward_viewer, px_per_mm)
+        image, extent = raster_view(xyz, colours, right, up, toward_viewer, px_per_mm)
         ax.imshow(image, extent=extent, interpolation="antialiased")
         ax.set_title(title)
         ax.set_xlabel("mm")
@@ -172,8 +172,8 @@ def figure_histogram(result, band_edges):
     limit = max(abs(band_edges[0]), abs(band_edges[-1]))
     fig, ax = plt.subplots(figsize=(10, 4.8))
     fig.subplots_adjust(left=0.08, right=0.97, bottom=0.12, top=0.9)
-    ax.bar(centres, counts, width=np.diff(edges), color=colormap.deviation_colors(centres, limit),
-           edgecolor="none")
+    ax.bar(centres, counts, width=np.diff(edges),
+           color=colourmap.deviation_colours(centres, limit), edgecolor="none")
     top = counts.max() if len(counts) else 1
     for k, style, name in ((1, "--", "sigma"), (3, ":", "3 sigma")):
         for sign in (-1, 1):
@@ -245,11 +245,11 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
         base = sec.plane_coords(result.closest[idx])
         tip = base + sec.vectors_in_plane(result.normal[idx]) * \
             (result.deviation[idx] * magnification)[:, None]
-        colors = colormap.deviation_colors(result.deviation[idx], tolerance)
+        colours = colourmap.deviation_colours(result.deviation[idx], tolerance)
         # rasterized: thousands of vector whiskers make a PDF slow to write and to view
-        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors=colors,
+        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors=colours,
                                          linewidths=1.0, rasterized=True))
-        ax.scatter(tip[:, 0], tip[:, 1], c=colors, s=3, linewidths=0, rasterized=True)
+        ax.scatter(tip[:, 0], tip[:, 1], c=colours, s=3, linewidths=0, rasterized=True)
     if sec.cmm_xyz is not None and len(sec.cmm_xyz):
         base = sec.plane_coords(sec.cmm_closest)
         tip = base + sec.vectors_in_plane(sec.cmm_normal) * \

@@ -1,10 +1,10 @@
-"""Section profile errors (paper 4.2, Table 2, Figs 9-10): the registered points of each
-section against the CAD's cut in the same plane, optionally beside a CMM's points of the same
-sections.
+"""Profile sections' errors (paper 4.2, Table 2, Figs 9-10): the registered points of each
+profile section against the CAD's section curve in the same plane, optionally beside a CMM's
+points of the same sections (docs/internals.md "Words").
 
-Where the sections are:
-- with a ``section`` column, each section's own points (CAD frame) define its plane (least
-  squares) and all of that section's points belong to it;
+Where the profile sections are:
+- with a ``section`` column, each section line's own points (CAD frame) define its plane
+  (least squares) and all of that line's points belong to it;
 - otherwise planes across the CAD's span at ``heights_pct`` of its length, each taking the
   points within +-``band`` mm of the plane.
 

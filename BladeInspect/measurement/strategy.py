@@ -126,8 +126,10 @@ def _penalised_fit(s, values, length, knot_spacing):
     return BSpline(knots, coef, 3, extrapolate=False)
 
 
-def fit_section_curve(x, z, knot_spacing=KNOT_SPACING_MM, max_incidence_deg=85.0):
-    """Cubic uniform B-spline through section points seen from above (a graph z(x)). Gross
+def fit_stage_profile(x, z, knot_spacing=KNOT_SPACING_MM, max_incidence_deg=85.0):
+    """The surface profile one view reads along a section line, in stage coordinates: a cubic
+    uniform B-spline through the points seen from above (a graph z(x); the path the rescan
+    follows, not cad.loft's curve of a whole measured section line). Gross
     errors are removed by a robust scale of the point-to-curve distances (of every point, so
     a point wrongly dropped while an outlier still bent the curve comes back) and the fit is
     repeated until the kept set settles. Returns (SectionCurve, kept mask in input order)."""
@@ -596,7 +598,7 @@ class ScanStrategy:
         open_ends = [True, True]
         extension = [self.options.extension_mm, self.options.extension_mm]
         for _ in range(self.options.max_passes):
-            curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
+            curve, _ = fit_stage_profile(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
             lo = -extension[0] if open_ends[0] else 0.0
             hi = curve.length + (extension[1] if open_ends[1] else 0.0)
             s = self._samples(lo, hi, self.options.probe_spacing)
@@ -622,7 +624,7 @@ class ScanStrategy:
             extension = [min(2.0 * e, most) if g else e for e, g in zip(extension, grew)]
             if not any(open_ends) and np.all(err <= self.options.epsilon):
                 break
-        curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)
+        curve, _ = fit_stage_profile(x_all, z_all, max_incidence_deg=max_incidence)
         surface_z = float(np.median(z_all))
         if final:
             s = self._samples(0.0, curve.length, self.options.point_spacing)  # step 5
