@@ -45,10 +45,26 @@ def run():
         check("demo blade task panel open", panel is not None)
         window_shot("task_panel_demo_blade")
         panel.boxes["span"].setValue(60.0)
-        panel.accept()
-        settle()
+        # The console (and a recorded macro) sees the lines the command runs: doCommand's.
+        console = []
+        do_command = Gui.doCommand
+
+        def recorded(line):
+            console.append(line)
+            return do_command(line)
+        Gui.doCommand = recorded
+        try:
+            panel.accept()
+            settle()
+        finally:
+            Gui.doCommand = do_command
         blade = objects.find_objects(doc, "BladeInspect::DemoBlade")
         check("demo blade made", len(blade) == 1)
+        made = [line for line in console if "objects.make_demo_blade(" in line]
+        check("demo blade made through doCommand, shown in the console",
+              len(made) == 1 and "span=60.0" in made[0], console)
+        import __main__
+        check("the console's obj is the demo blade", getattr(__main__, "obj", None) == blade[0])
         check("demo blade has the panel's span",
               abs(blade[0].Shape.BoundBox.ZLength - 60.0) < 1e-6, blade[0].Shape.BoundBox)
         state["blade"] = blade[0]

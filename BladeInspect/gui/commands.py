@@ -77,6 +77,31 @@ def find_nominal():
     return None
 
 
+def do_command(imports, call):
+    """Make a document object by running ``call`` (Python text) through FreeCADGui.doCommand,
+    after the ``imports`` lines, so that it shows in the Python console and is recorded in a
+    macro, as FreeCAD's own commands (Fem's) make theirs. Returns the object made (the
+    console's ``obj``); an error raised by ``call`` propagates as it is."""
+    for line in ("import FreeCAD",) + tuple(imports):
+        FreeCADGui.doCommand(line)
+    FreeCADGui.doCommand("obj = " + call)
+    import __main__
+    return __main__.obj
+
+
+def document_text(doc):
+    """Python text naming ``doc`` in the console."""
+    return "FreeCAD.getDocument(%r)" % doc.Name
+
+
+def object_text(obj):
+    """Python text naming the document object ``obj`` in the console."""
+    return "%s.getObject(%r)" % (document_text(obj.Document), obj.Name)
+
+
+APP_OBJECTS = "from BladeInspect.app import objects"
+
+
 def fit_view():
     if FreeCADGui.ActiveDocument is not None:
         view = FreeCADGui.ActiveDocument.ActiveView
@@ -120,7 +145,9 @@ class DemoBlade(_Command):
 
     def build(self, params):
         doc = active_document()
-        obj = progress.run("Demo blade", lambda p: objects.make_demo_blade(doc, params))
+        obj = progress.run("Demo blade", lambda p: do_command(
+            (APP_OBJECTS, "from BladeInspect.cad.demo_blade import BladeParams"),
+            "objects.make_demo_blade(%s, %r)" % (document_text(doc), params)))
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -140,7 +167,8 @@ class LoadCad(_Command):
 
     def load(self, path):
         doc = active_document()
-        obj = progress.run("Load CAD", lambda p: objects.make_cad_model(doc, path))
+        obj = progress.run("Load CAD", lambda p: do_command(
+            (APP_OBJECTS,), "objects.make_cad_model(%s, %r)" % (document_text(doc), path)))
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -232,13 +260,14 @@ class ImportPoints(_Command):
             self.load(path)
 
     def load(self, path):
-        from ..inspection.pipeline import load_points
         doc = active_document()
 
         def job(p):
             p(0.1, "reading %s" % os.path.basename(path))
-            obj = objects.make_measurement(doc, load_points(path), name="Measurement",
-                                           source_file=path)
+            obj = do_command(
+                (APP_OBJECTS, "from BladeInspect.inspection.pipeline import load_points"),
+                "objects.make_measurement(%s, load_points(%r), name='Measurement', "
+                "source_file=%r)" % (document_text(doc), path, path))
             obj.Label = os.path.splitext(os.path.basename(path))[0]
             return obj
         obj = progress.run("Import points", job)
@@ -331,8 +360,9 @@ class DeviationMap(_Command):
     def make(self, registration, limit=None):
         doc = registration.Document
         limit = settings.colour_limit() if limit is None else limit
-        obj = progress.run("Deviation map",
-                           lambda p: objects.make_deviation_map(doc, registration, limit))
+        obj = progress.run("Deviation map", lambda p: do_command(
+            (APP_OBJECTS,), "objects.make_deviation_map(%s, %s, %r)"
+            % (document_text(doc), object_text(registration), float(limit))))
         if obj is not None:
             # The map shows the points on the CAD; the measurement and its reconstruction lie
             # in the measured frame elsewhere and would only pull the view away.
