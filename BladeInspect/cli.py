@@ -1,4 +1,4 @@
-"""BladeInspect's headless command line (DESIGN.md "Contracts").
+"""BladeInspect's headless command line (docs/contracts.md "Command line").
 
 Run as ``./bladeinspect <command> ...`` from the repository, or inside FreeCADCmd::
 
@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from .core import contracts
 from .core.errors import Cancelled, DeviceError, InputError
 
 EXIT_BAD_INPUT = 2
@@ -46,13 +47,9 @@ def _seed(value):
 
 def _heights(text):
     try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError("expected comma-separated percentages, got %r" % text)
-    for v in values:
-        if not 0.0 <= v <= 100.0:
-            raise argparse.ArgumentTypeError("section height %g%% is outside 0-100" % v)
-    return values
+        return contracts.parse_section_heights(text, "section heights", allow_empty=True)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(str(exc))
 
 
 def _face_indices(text):
@@ -131,7 +128,8 @@ def build_parser():
     rp.add_argument("--points", required=True)
     rp.add_argument("--out", required=True)
     rp.add_argument("--cmm", default=None, help="CMM points x,y,z[,section] in the CAD frame")
-    rp.add_argument("--tolerance", type=float, default=0.04, help="profile tolerance +-T mm")
+    rp.add_argument("--tolerance", type=float, default=contracts.PROFILE_TOLERANCE_MM,
+                    help="profile tolerance +-T mm")
     rp.add_argument("--section-heights", type=_heights, default=None,
                     help="section planes in %% of span (default 10,30,50,70,90)")
     rp.add_argument("--seed", type=_seed, default=0)
@@ -142,7 +140,7 @@ def build_parser():
     b.add_argument("--cad", required=True)
     b.add_argument("--scans", required=True)
     b.add_argument("--out", required=True)
-    b.add_argument("--tolerance", type=float, default=0.04)
+    b.add_argument("--tolerance", type=float, default=contracts.PROFILE_TOLERANCE_MM)
     b.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     b.add_argument("--scheduler", default=None, help="Dask scheduler tcp://HOST:PORT")
     b.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
@@ -152,11 +150,12 @@ def build_parser():
     i.add_argument("--out", required=True)
     i.add_argument("--rig", default="sim")
     i.add_argument("--rig-file", default=None)
-    i.add_argument("--section-heights", type=_heights, default=[10.0, 30.0, 50.0, 70.0, 90.0])
+    i.add_argument("--section-heights", type=_heights,
+                   default=list(contracts.SECTION_HEIGHTS_PCT))
     i.add_argument("--complete", action="store_true")
     i.add_argument("--pitch", type=float, default=0.1)
     i.add_argument("--cmm", default=None)
-    i.add_argument("--tolerance", type=float, default=0.04)
+    i.add_argument("--tolerance", type=float, default=contracts.PROFILE_TOLERANCE_MM)
     i.add_argument("--seed", type=_seed, default=0)
     i.add_argument("--resume", action="store_true",
                    help="continue an inspection in DIR interrupted by a rig failure, from its "

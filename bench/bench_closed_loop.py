@@ -1,4 +1,4 @@
-"""Figures for closing the loop (issue 8): rotary-axis calibration against injected truth,
+"""Figures for closing the loop (docs/contracts.md): rotary-axis calibration against injected truth,
 CAD-planned sections measured by the simulated rig, and (when the inspect workflow is
 available) the whole loop.
 

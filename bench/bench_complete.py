@@ -1,4 +1,4 @@
-"""Figures for the complete scan (issue 8 item 3, paper 4.3) on the demo blade at a random
+"""Figures for the complete scan (docs/contracts.md loop 3; paper 4.3) on the demo blade at a random
 fixture pose: points, the simulated scan's wall time against the real sensor's acquisition
 time at its rate (must be >= 10x faster), the real rig's estimated time, and the whole
 `inspect --complete` wall time (must be < 60 s on two cores).

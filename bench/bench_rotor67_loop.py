@@ -1,4 +1,4 @@
-"""The `inspect` loop on NASA Rotor 67 over several random fixture poses (issue 8's figures on
+"""The `inspect` loop on NASA Rotor 67 over several random fixture poses (the loop's figures on
 the real blade), set up as tests/test_rotor67_loop.py does for one: quiet sensor (0.5 um), a
 30 um bump on the suction side at the 30 % section, judged by the simulator's truth.
 

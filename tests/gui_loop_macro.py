@@ -106,6 +106,24 @@ def run():
               progress.MESSAGES[-1][1], progress.MESSAGES[-1:])
         check("bad height adds nothing", [o.Name for o in doc.Objects] == before)
 
+    @step("inspect's simulated rig has the preferences' sensor, as Connect rig's")
+    def _():
+        from BladeInspect.app import settings
+        from BladeInspect.gui.session import RIG
+        RIG.disconnect()
+        saved = settings.value("StandoffMm")
+        settings.store("StandoffMm", 41.5)
+        try:
+            with loop_commands.inspection_rig(state["blade"], 0) as rig:
+                standoff = rig.sensor.standoff
+            connected = commands.BY_NAME["BladeInspect_ConnectRig"].connect("sim", 0)
+            connected_standoff = connected.sensor.standoff if connected is not None else None
+        finally:
+            settings.store("StandoffMm", saved)
+            RIG.disconnect()
+        check("inspect's simulated rig reads the standoff preference", standoff == 41.5, standoff)
+        check("connect rig reads the same", connected_standoff == 41.5, connected_standoff)
+
     @step("inspect cancelled leaves the document as it was")
     def _():
         before = [o.Name for o in doc.Objects]

@@ -44,10 +44,26 @@ def run():
         check("demo blade task panel open", panel is not None)
         window_shot("task_panel_demo_blade")
         panel.boxes["span"].setValue(60.0)
-        panel.accept()
-        settle()
+        # The console (and a recorded macro) sees the lines the command runs: doCommand's.
+        console = []
+        do_command = Gui.doCommand
+
+        def recorded(line):
+            console.append(line)
+            return do_command(line)
+        Gui.doCommand = recorded
+        try:
+            panel.accept()
+            settle()
+        finally:
+            Gui.doCommand = do_command
         blade = objects.find_objects(doc, "BladeInspect::DemoBlade")
         check("demo blade made", len(blade) == 1)
+        made = [line for line in console if "objects.make_demo_blade(" in line]
+        check("demo blade made through doCommand, shown in the console",
+              len(made) == 1 and "span=60.0" in made[0], console)
+        import __main__
+        check("the console's obj is the demo blade", getattr(__main__, "obj", None) == blade[0])
         check("demo blade has the panel's span",
               abs(blade[0].Shape.BoundBox.ZLength - 60.0) < 1e-6, blade[0].Shape.BoundBox)
         state["blade"] = blade[0]
@@ -222,7 +238,7 @@ def run():
     @step("deviation map of a known result, legend, save and reopen")
     def _():
         blade = state["blade"]
-        from BladeInspect.core.colormap import deviation_colors
+        from BladeInspect.core.colourmap import deviation_colours
         result = _known_result(blade.Shape)
         reg = objects.make_registration(doc, result, name="KnownRegistration")
         Gui.Selection.clearSelection()
@@ -235,7 +251,7 @@ def run():
                 if o.Registration == reg][0]
         limit = dmap.Limit
         check("colours follow deviations", np.allclose(
-            colours_of(dmap), deviation_colors(result.deviation, limit), atol=1e-6))
+            colours_of(dmap), deviation_colours(result.deviation, limit), atol=1e-6))
         vobj = dmap.ViewObject
         check("display mode Color", vobj.DisplayMode == "Color", vobj.DisplayMode)
         check("legend in the scene", vobj.Proxy.legend is not None)
@@ -255,7 +271,7 @@ def run():
         settle(0.5)
         dmap2 = doc2.getObject(name)
         check("reopened colours intact", np.allclose(
-            colours_of(dmap2), deviation_colors(result.deviation, limit), atol=0.5 / 255 + 1e-9))
+            colours_of(dmap2), deviation_colours(result.deviation, limit), atol=0.5 / 255 + 1e-9))
         check("reopened display mode Color", dmap2.ViewObject.DisplayMode == "Color")
         check("reopened view provider and legend", isinstance(
             dmap2.ViewObject.Proxy, viewproviders.ViewProviderDeviationMap)

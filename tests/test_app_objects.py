@@ -271,9 +271,9 @@ class TestRegistration(DocumentCase):
             self.doc.recompute()
             self.assertEqual(calls, [0])
             np.testing.assert_allclose(dmap.Deviation, new_xyz[:, 2])
-            from BladeInspect.core.colormap import deviation_colors
+            from BladeInspect.core.colourmap import deviation_colours
             np.testing.assert_allclose(np.array(dmap.Color)[:, :3],
-                                       deviation_colors(new_xyz[:, 2], 0.05),
+                                       deviation_colours(new_xyz[:, 2], 0.05),
                                        atol=0.5 / 255 + 1e-9)
             reg.Seed = 7
             self.doc.recompute()
@@ -286,7 +286,7 @@ class TestRegistration(DocumentCase):
 
 class TestDeviationMap(DocumentCase):
     def test_colours_follow_each_points_deviation_and_survive_reopen(self):
-        from BladeInspect.core.colormap import deviation_colors
+        from BladeInspect.core.colourmap import deviation_colours
         rng = np.random.default_rng(5)
         limit = 0.04
         dev = rng.uniform(-0.1, 0.1, 400)
@@ -299,7 +299,7 @@ class TestDeviationMap(DocumentCase):
         self.assertEqual(len(colours), 400)
         self.assertEqual(obj.Points.CountPoints, 400)
         # Colours are saved as 8 bits per channel.
-        np.testing.assert_allclose(colours, deviation_colors(dev, limit), atol=0.5 / 255 + 1e-9)
+        np.testing.assert_allclose(colours, deviation_colours(dev, limit), atol=0.5 / 255 + 1e-9)
         # The map's meaning, independent of its implementation: green at zero, red above,
         # blue below, saturated beyond the limit.
         g0 = colours[0]
@@ -315,7 +315,7 @@ class TestDeviationMap(DocumentCase):
         # A new limit recolours: points between the old and new limit stop saturating.
         obj.Limit = 0.1
         self.doc.recompute()
-        np.testing.assert_allclose(np.array(obj.Color)[:, :3], deviation_colors(dev, 0.1),
+        np.testing.assert_allclose(np.array(obj.Color)[:, :3], deviation_colours(dev, 0.1),
                                    atol=0.5 / 255 + 1e-9)
 
     def test_an_error_leaves_no_half_built_objects(self):

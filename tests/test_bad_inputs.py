@@ -18,7 +18,7 @@ import numpy as np
 
 from tests.helpers import demo_nominal
 
-SENSOR_ACCURACY_MM = 0.006   # DESIGN.md: the ConoProbe's accuracy, uniform error on +-0.006
+SENSOR_ACCURACY_MM = 0.006   # docs/contracts.md: the ConoProbe's accuracy, uniform error on +-0.006
 
 
 def run_main(*args):

@@ -23,7 +23,7 @@ class TestLoopCommandsGui(GuiMacroChecks, unittest.TestCase):
         for name, info in self.report["steps"].items():
             print("  gui loop step %-70s %s" % (name, info))
             self.assertEqual(info["status"], "ran", (name, info))
-        self.assertEqual(len(self.report["steps"]), 8)
+        self.assertEqual(len(self.report["steps"]), 9)
 
     def test_screenshots_saved(self):
         for name in ("loop_planned_paths", "loop_task_panel_inspect", "loop_inspection_table",

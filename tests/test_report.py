@@ -118,6 +118,23 @@ class WriteReportTest(unittest.TestCase):
         self.assertIn("within +-3 sigma: %.3f %%"
                       % self.result.deviation_stats["pct_within_3sigma"], self.html)
 
+    def test_histogram_bands_follow_the_tolerance(self):
+        # +-T, +-1.5T, +-2T for the run's T; the counts straight from the deviations
+        tolerance = 0.02
+        out = os.path.join(self.tmp, "report-tolerance")
+        verdict = V.judge(self.result, self.table, tolerance=tolerance)
+        R.write_report(out, self.result, self.nominal, self.table, verdict, tolerance)
+        with open(os.path.join(out, "report.html"), encoding="utf-8") as fh:
+            text = fh.read()
+        dev = self.result.deviation
+        edges = (-0.04, -0.03, -0.02, 0.02, 0.03, 0.04)
+        self.assertIn("<td>&lt; -0.040</td><td>%d</td>" % np.count_nonzero(dev < -0.04), text)
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            count = np.count_nonzero((dev >= lo) & (dev < hi))
+            self.assertIn("<td>%.3f to %.3f</td><td>%d</td>" % (lo, hi, count), text)
+        self.assertIn("<td>&gt; 0.040</td><td>%d</td>" % np.count_nonzero(dev >= 0.04), text)
+        self.assertNotIn("0.060 to 0.080", text)
+
     def test_without_cmm_no_cmm_columns(self):
         header, rows = R.section_rows(S.section_table(self.result, self.nominal))
         self.assertNotIn("CMM max", header)
@@ -173,7 +190,7 @@ class RunReportTest(unittest.TestCase):
         colours those of the deviations, the pose, the section profiles and the verdict."""
         import FreeCAD
         from BladeInspect.app import objects
-        from BladeInspect.core import colormap
+        from BladeInspect.core import colourmap
         doc = FreeCAD.openDocument(os.path.join(self.out, "inspection.FCStd"))
         try:
             maps = objects.find_objects(doc, "BladeInspect::DeviationMap")
@@ -181,7 +198,7 @@ class RunReportTest(unittest.TestCase):
             cloud = maps[0]
             self.assertEqual(len(cloud.Color), len(self.known))
             self.assertEqual(cloud.Points.CountPoints, len(self.known))
-            expected = colormap.deviation_colors(np.asarray(cloud.Deviation), 0.04)
+            expected = colourmap.deviation_colours(np.asarray(cloud.Deviation), 0.04)
             # the file stores colours as 8-bit RGBA
             np.testing.assert_allclose(np.asarray(cloud.Color)[:, :3], expected,
                                        atol=0.5 / 255 + 1e-6)

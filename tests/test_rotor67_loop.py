@@ -166,7 +166,7 @@ def _bump_at_section(nominal, height_pct):
 
 @unittest.skipUnless(have_rotor67(), "Rotor 67 data not present")
 class TestInspectLoop(unittest.TestCase):
-    """Issue 8 on the real blade: run_inspect with the simulated rig, a quiet sensor (so that
+    """The loop on the real blade: run_inspect with the simulated rig, a quiet sensor (so that
     Table 2 can be held to the field within 2 um) and a bump."""
 
     @classmethod

@@ -10,7 +10,8 @@ from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
 from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
-from BladeInspect.measurement.strategy import ScanStrategy, ViewResult, fit_section_curve
+from BladeInspect.measurement.strategy import (ScanOptions, ScanStrategy, ViewResult,
+                                               fit_stage_profile)
 from tests.rig_parts import Sphere, TwistedEllipse
 
 TWIST = 25.0
@@ -20,7 +21,7 @@ def scan(seed, **options):
     part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
     pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
     rig = SimulatedRig(part, pose, seed=seed)
-    strategy = ScanStrategy(rig, **options)
+    strategy = ScanStrategy(rig, ScanOptions(**options))
     return part, pose, rig, strategy, strategy.run()
 
 
@@ -112,7 +113,7 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
             part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
             pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
             rig = SimulatedRig(part, pose, seed=seed)
-            sections = ScanStrategy(rig, n_sections=3).run()
+            sections = ScanStrategy(rig, ScanOptions(n_sections=3)).run()
             for sec in sections:
                 for view in sec.views[1:]:
                     first = view.passes[0]
@@ -130,7 +131,7 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
             part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
             pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
             rig = SimulatedRig(part, pose, seed=seed)
-            strategy = ScanStrategy(rig, n_sections=1, sides=1, edges=False)
+            strategy = ScanStrategy(rig, ScanOptions(n_sections=1, sides=1, edges=False))
             strategy.section_y
             first = rig.pass_index
             readings = []
@@ -148,7 +149,7 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
             part = TwistedEllipse(a=25.0, b=3.0, length=70.0, twist_deg=TWIST)
             pose = random_fixture_pose(np.random.default_rng(seed), cad_center=(0, 0, 35.0))
             rig = SimulatedRig(part, pose, seed=seed)
-            sections = ScanStrategy(rig, n_sections=2).run()
+            sections = ScanStrategy(rig, ScanOptions(n_sections=2)).run()
             side1 = sections[0].views[0]
             self.assertEqual(side1.name, "side1")
             self.assertEqual([p["kind"] for p in side1.passes if p["kind"] == "linear"], [])
@@ -163,7 +164,8 @@ class TestSearchStartsWhereTheSurfaceIs(unittest.TestCase):
         """A plate's top face read at z = 8 from above at 0 deg (axis at the origin, along Y):
         turned by 180 deg about the axis that face lies at z = -8, under the other face, which
         a plate of a few mm puts within the working range of that height."""
-        strategy = ScanStrategy(SimulatedRig(Sphere(10.0), np.eye(4)), span_range=(0, 1))
+        strategy = ScanStrategy(SimulatedRig(Sphere(10.0), np.eye(4)),
+                                ScanOptions(span_range=(0, 1)))
         x = np.linspace(-20.0, 20.0, 81)
         top = 8.0
         reading = np.full(len(x), 44.0)
@@ -186,7 +188,8 @@ class TestCalibratedKinematics(unittest.TestCase):
         results = {}
         for name, believed in (("calibrated", true), ("nominal", RigKinematics())):
             rig = SimulatedRig(part, pose, seed=31, kinematics=true)
-            sections = ScanStrategy(rig, n_sections=2, edges=False, kinematics=believed).run()
+            sections = ScanStrategy(rig, ScanOptions(n_sections=2, edges=False),
+                                    kinematics=believed).run()
             xyz = np.vstack([sec.table_xyz for sec in sections])
             snr = np.concatenate([sec.snr for sec in sections])
             dev = part.signed_distance(tf.apply_transform(pose, xyz))
@@ -212,7 +215,7 @@ class TestCurveFit(unittest.TestCase):
         z = truth(x) + rng.uniform(-0.006, 0.006, 400)
         bad = rng.random(400) < 0.03
         z[bad] += rng.uniform(0.1, 0.5, bad.sum())
-        curve, keep = fit_section_curve(x, z)
+        curve, keep = fit_stage_profile(x, z)
         self.assertTrue(np.all(~keep[bad]))
         self.assertGreater(keep[~bad].mean(), 0.97)
         xz = curve(np.linspace(0, curve.length, 500))
@@ -223,7 +226,7 @@ class TestCurveFit(unittest.TestCase):
     def test_extension_never_steeper_than_the_coverage(self):
         x = np.linspace(0, 1, 50)
         z = -30 * x          # steeper than 85 deg would allow
-        curve, _ = fit_section_curve(x, z)
+        curve, _ = fit_stage_profile(x, z)
         beyond = curve(np.array([curve.length, curve.length + 3.0]))
         self.assertGreaterEqual(beyond[1, 0] - beyond[0, 0], 3.0 * np.cos(np.radians(85)) - 1e-9)
 
@@ -234,12 +237,12 @@ class TestInputs(unittest.TestCase):
         for options in ({"sides": 3}, {"epsilon": 9.0}, {"n_sections": 0},
                         {"span_range": (5, 1)}, {"point_spacing": 0}):
             with self.assertRaises(InputError):
-                ScanStrategy(rig, **options)
+                ScanStrategy(rig, ScanOptions(**options))
 
     def test_nothing_to_scan(self):
         rig = SimulatedRig(Sphere(5.0, center=[0, 0, 500.0]), np.eye(4))
         with self.assertRaises(InputError):
-            ScanStrategy(rig, n_sections=1, search_radius=20.0).run()
+            ScanStrategy(rig, ScanOptions(n_sections=1, search_radius=20.0)).run()
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Document side of the closed loop (issue 8): the planned paths as Part geometry, and what an
+"""Document side of the closed loop: the planned paths as Part geometry, and what an
 inspection leaves on its Registration so a CMM file can be added to its Table 2 later.
 No GUI imports: the workbench commands in gui/loop_commands.py call these."""
 
@@ -45,6 +45,9 @@ def show_plan(doc, plan, obj=None, name="PlannedPaths"):
                             "Nominal section heights, % of span")
             obj.addProperty("App::PropertyInteger", "NPaths", PLAN_GROUP, "Rig passes")
             obj.addProperty("App::PropertyInteger", "NPoints", PLAN_GROUP, "Planned readings")
+            # The plan's record: editing it would not re-plan the paths.
+            for prop in ("HeightsPct", "NPaths", "NPoints"):
+                obj.setEditorMode(prop, ["ReadOnly"])
             if obj.ViewObject is not None:
                 # Magenta is on no deviation colour (blue-green-red): paths stay apart from maps.
                 obj.ViewObject.LineColor = (0.85, 0.0, 0.85)
@@ -70,6 +73,8 @@ def mark_inspection(registration, heights_pct, first_planned_row, out_dir):
             ("App::PropertyFile", "CmmFile", "CMM file compared in Table 2")):
         if prop not in registration.PropertiesList:
             registration.addProperty(kind, prop, INSPECTION_GROUP, tip)
+            # Set by the inspection (and AddCmm), read by AddCmm: not an input to edit.
+            registration.setEditorMode(prop, ["ReadOnly"])
     registration.InspectionHeights = [float(h) for h in heights_pct]
     registration.FirstPlannedRow = int(first_planned_row)
     registration.InspectionFolder = out_dir

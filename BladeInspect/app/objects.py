@@ -26,6 +26,7 @@ import numpy as np
 
 import FreeCAD
 
+from ..core.contracts import json_default
 from ..core.errors import InputError
 
 _view_provider_hook = None
@@ -411,7 +412,7 @@ def store_reconstruction(obj, recon):
     # cad.loft reports a dict per curve (section, side, n_points, rms, max).
     obj.FitErrors = [float(e["rms"]) for e in errors]
     obj.MaxFitErrorMm = max((float(e["max"]) for e in errors), default=0.0)
-    obj.FitErrorsJson = json.dumps(errors, default=_json_default)
+    obj.FitErrorsJson = json.dumps(errors, default=json_default)
     obj.NCurves = len(recon.curves)
     obj.NSurfaces = len(recon.surfaces)
 
@@ -538,19 +539,11 @@ def store_registration(obj, result):
     obj.NPoints = result.n_points
     obj.NInliers = result.n_inliers
     obj.Warnings = [str(w) for w in result.warnings]
-    obj.StatisticsJson = json.dumps(stats, default=_json_default)
-    obj.CoarseJson = json.dumps(result.coarse, default=_json_default)
+    obj.StatisticsJson = json.dumps(stats, default=json_default)
+    obj.CoarseJson = json.dumps(result.coarse, default=json_default)
     obj.PointsCad = np.asarray(result.points_cad, dtype=float).ravel().tolist()
     obj.Deviation = np.asarray(result.deviation, dtype=float).tolist()
     obj.Inlier = np.asarray(result.inlier, dtype=int).tolist()
-
-
-def _json_default(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError("not JSON serialisable: %r" % type(value))
 
 
 def make_registration(doc, result, measurement=None, nominal=None, seed=0,
@@ -599,7 +592,7 @@ class DeviationMap(_Proxy):
         _add(obj, "App::PropertyInteger", "NPoints", g, "Points shown", read_only=True)
 
     def execute(self, obj):
-        from ..core import colormap
+        from ..core import colourmap
         if obj.Registration is None:
             raise InputError("%s: no registration linked" % obj.Label)
         if obj.Limit <= 0:
@@ -607,8 +600,8 @@ class DeviationMap(_Proxy):
         points, deviation, _ = registration_points(obj.Registration)
         obj.Points = _points_kernel(points)
         obj.Deviation = deviation.tolist()
-        obj.Color = [tuple(c) for c in colormap.deviation_colors(deviation, obj.Limit).tolist()]
-        values, colours = colormap.legend_ticks(obj.Limit)
+        obj.Color = [tuple(c) for c in colourmap.deviation_colours(deviation, obj.Limit).tolist()]
+        values, colours = colourmap.legend_ticks(obj.Limit)
         obj.LegendValues = values.tolist()
         obj.LegendColors = [tuple(c) for c in colours.tolist()]
         obj.NPoints = len(deviation)
@@ -682,6 +675,10 @@ def make_section_profiles(doc, table, registration=None, name="SectionProfiles")
             obj.addProperty("App::PropertyLink", "Registration", "Sections",
                             "Registration the sections were analysed for")
             obj.Registration = registration
+        # What was analysed is a record, not an input: editing it would not recut the sections.
+        for prop in ("Sections", "Registration"):
+            if prop in obj.PropertiesList:
+                obj.setEditorMode(prop, ["ReadOnly"])
         if obj.ViewObject is not None:
             obj.ViewObject.LineColor = (0.8, 0.1, 0.1)
             obj.ViewObject.LineWidth = 3

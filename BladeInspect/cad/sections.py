@@ -1,4 +1,5 @@
-"""Plane sections of a CAD shape as dense ordered polylines (the profiles a CMM measures)."""
+"""Section curves: plane cuts of a CAD shape as dense ordered polylines (the nominal profiles
+a CMM measures; docs/internals.md "Words")."""
 import numpy as np
 
 import FreeCAD

@@ -4,7 +4,7 @@ Each fit minimises the sum of squared *geometric* distances (orthogonal to the s
 curve), which is the maximum-likelihood fit when the point errors are isotropic and normal; an
 algebraic fit (linear in its unknowns, biased on partial arcs and caps) only supplies the start
 of the Gauss-Newton iterations. Optional weights are inverse variances (the sensor's SNR, see
-DESIGN.md "SNR and weights"). Degenerate input raises InputError.
+docs/contracts.md "The sensor and its noise"). Degenerate input raises InputError.
 """
 
 from typing import NamedTuple, Optional

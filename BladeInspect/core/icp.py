@@ -4,8 +4,8 @@ The objective is  sum_i w_i d_i(T)^2  with d_i the signed distance of T p_i to t
 w_i = a_i * rho_i:
 
 * a_i = SNR_i / mean(SNR) — the sensor's noise is sigma_i^2 = sigma_ref^2 SNR_ref / SNR_i
-  (DESIGN.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the mean makes
-  a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
+  (docs/contracts.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the
+  mean makes a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
 * rho_i in [0, 1] — a redescending robust weight of the standardised residual
   u_i = |z_i| / s with z_i = d_i sqrt(a_i) and s = max(1.4826 MAD(z), median |z| / k_full),
   a robust scale re-estimated at every iteration (see _robust_deviation). rho = 1 for
@@ -150,8 +150,8 @@ def robust_weights(distances, a, options, neighbourhoods=None):
     if not usable.any():
         return np.zeros(len(distances)), np.nan
     # The noise model grants a point of low SNR a noise of sigma0 / sqrt(a_i), without bound;
-    # but gross errors are what low SNRs bring (DESIGN.md), so when judging outliers no point
-    # is granted more than max_noise_ratio times a typical point's noise (by default none: the
+    # but gross errors are what low SNRs bring (docs/contracts.md), so when judging outliers no
+    # point is granted more than max_noise_ratio times a typical point's noise (by default none: the
     # SNR lowers a point's weight, it does not excuse its residual).
     z = np.where(usable, distances * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2)),
                  np.inf)

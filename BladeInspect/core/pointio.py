@@ -1,4 +1,4 @@
-"""Measured point files: CSV with a header, and whitespace .xyz/.asc/.txt (DESIGN.md "PTS").
+"""Measured point files: CSV with a header, and whitespace .xyz/.asc/.txt (docs/contracts.md).
 
 Rows a sensor left without a reading ('nan', blank, garbage, a short row) are skipped and
 counted, never fatal: one bad reading must not stop a batch. Everything that makes the whole

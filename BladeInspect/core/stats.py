@@ -2,10 +2,8 @@
 
 import numpy as np
 
+from .contracts import PROFILE_TOLERANCE_MM
 from .errors import InputError
-
-# Paper Table 3: < -0.08, -0.08..-0.06, -0.06..-0.04, -0.04..0.04, 0.04..0.06, 0.06..0.08, > 0.08
-DEFAULT_BAND_EDGES = (-0.08, -0.06, -0.04, 0.04, 0.06, 0.08)
 
 
 def tolerance_bands(tolerance):
@@ -18,6 +16,10 @@ def tolerance_bands(tolerance):
         raise InputError("tolerance: must be a positive number of millimetres, got %r"
                          % (tolerance,))
     return (-2.0 * t, -1.5 * t, -t, t, 1.5 * t, 2.0 * t)
+
+
+# Paper Table 3: < -0.08, -0.08..-0.06, -0.06..-0.04, -0.04..0.04, 0.04..0.06, 0.06..0.08, > 0.08
+DEFAULT_BAND_EDGES = tolerance_bands(PROFILE_TOLERANCE_MM)
 
 
 def _check_edges(band_edges):

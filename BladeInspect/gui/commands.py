@@ -2,7 +2,6 @@
 and the selection, runs a pipeline stage with progress and cancel (gui.progress.run), and
 stores the outcome as document objects through the app layer's make_* functions, which remove
 what they made if anything fails."""
-import inspect as pyinspect
 import os
 import tempfile
 
@@ -14,6 +13,9 @@ from ..app import objects, settings
 from ..core.errors import InputError
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
 from .session import RIG
+
+# Marks the command texts for translation (FreeCAD translates them in the command's context).
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 POINT_FILTER = "Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)"
 CAD_FILTER = "CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)"
@@ -75,6 +77,31 @@ def find_nominal():
     return None
 
 
+def do_command(imports, call):
+    """Make a document object by running ``call`` (Python text) through FreeCADGui.doCommand,
+    after the ``imports`` lines, so that it shows in the Python console and is recorded in a
+    macro, as FreeCAD's own commands (Fem's) make theirs. Returns the object made (the
+    console's ``obj``); an error raised by ``call`` propagates as it is."""
+    for line in ("import FreeCAD",) + tuple(imports):
+        FreeCADGui.doCommand(line)
+    FreeCADGui.doCommand("obj = " + call)
+    import __main__
+    return __main__.obj
+
+
+def document_text(doc):
+    """Python text naming ``doc`` in the console."""
+    return "FreeCAD.getDocument(%r)" % doc.Name
+
+
+def object_text(obj):
+    """Python text naming the document object ``obj`` in the console."""
+    return "%s.getObject(%r)" % (document_text(obj.Document), obj.Name)
+
+
+APP_OBJECTS = "from BladeInspect.app import objects"
+
+
 def fit_view():
     if FreeCADGui.ActiveDocument is not None:
         view = FreeCADGui.ActiveDocument.ActiveView
@@ -108,15 +135,19 @@ class _Command:
 
 class DemoBlade(_Command):
     name = "BladeInspect_DemoBlade"
-    menu = "Demo blade"
-    tip = "Build the parametric demo blade as the nominal CAD (parameters in a task panel)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_DemoBlade", "Demo blade")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_DemoBlade",
+        "Build the parametric demo blade as the nominal CAD (parameters in a task panel)")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(taskpanels.DemoBladePanel(self.build))
 
     def build(self, params):
         doc = active_document()
-        obj = progress.run("Demo blade", lambda p: objects.make_demo_blade(doc, params))
+        obj = progress.run("Demo blade", lambda p: do_command(
+            (APP_OBJECTS, "from BladeInspect.cad.demo_blade import BladeParams"),
+            "objects.make_demo_blade(%s, %r)" % (document_text(doc), params)))
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -124,8 +155,10 @@ class DemoBlade(_Command):
 
 class LoadCad(_Command):
     name = "BladeInspect_LoadCad"
-    menu = "Load CAD..."
-    tip = "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_LoadCad", "Load CAD...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_LoadCad",
+        "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)")
 
     def Activated(self):
         path = ask_open_file("Nominal CAD", CAD_FILTER)
@@ -134,16 +167,26 @@ class LoadCad(_Command):
 
     def load(self, path):
         doc = active_document()
-        obj = progress.run("Load CAD", lambda p: objects.make_cad_model(doc, path))
+        obj = progress.run("Load CAD", lambda p: do_command(
+            (APP_OBJECTS,), "objects.make_cad_model(%s, %r)" % (document_text(doc), path)))
         if obj is not None:
             _recompute_gui(doc)
         return obj
 
 
+def simulated_rig(nominal, seed, kinematics=None):
+    """The simulated rig of ``nominal`` (a Nominal) with the sensor the preferences describe,
+    as ConnectRig opens it; ``kinematics``: its true geometry (default nominal)."""
+    from ..measurement.scan import open_rig
+    return open_rig("sim", nominal, seed, kinematics=kinematics, sensor=settings.sensor_model())
+
+
 class ConnectRig(_Command):
     name = "BladeInspect_ConnectRig"
-    menu = "Connect rig..."
-    tip = "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_ConnectRig", "Connect rig...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_ConnectRig",
+        "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
@@ -167,8 +210,10 @@ class ConnectRig(_Command):
 
 class Scan(_Command):
     name = "BladeInspect_Scan"
-    menu = "Scan..."
-    tip = "Scan the blade section by section with the connected rig (progress and abort)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Scan", "Scan...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Scan",
+        "Scan the blade section by section with the connected rig (progress and abort)")
 
     def ready(self):
         return RIG.connected
@@ -181,14 +226,9 @@ class Scan(_Command):
         from ..inspection.pipeline import load_points
         doc = active_document()
         out_dir = scan_folder(doc)
-        params = pyinspect.signature(scan_to_dir).parameters
-        takes_strategy_options = any(p.kind == p.VAR_KEYWORD for p in params.values())
 
         def job(p):
-            # The strategy's own defaults stand for options the scan does not take.
-            kwargs = {k: v for k, v in options.items()
-                      if (k in params or takes_strategy_options) and v is not None}
-            scan_to_dir(out_dir, RIG.rig, progress=p, **kwargs)
+            scan_to_dir(out_dir, RIG.rig, progress=p, **options)
             path = os.path.join(out_dir, "points.csv")
             pointset = load_points(path)
             return objects.make_measurement(doc, pointset, name="Scan", source_file=path)
@@ -209,8 +249,10 @@ def scan_folder(doc):
 
 class ImportPoints(_Command):
     name = "BladeInspect_ImportPoints"
-    menu = "Import points..."
-    tip = "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_ImportPoints", "Import points...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_ImportPoints",
+        "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)")
 
     def Activated(self):
         path = ask_open_file("Measured points", POINT_FILTER)
@@ -218,13 +260,14 @@ class ImportPoints(_Command):
             self.load(path)
 
     def load(self, path):
-        from ..inspection.pipeline import load_points
         doc = active_document()
 
         def job(p):
             p(0.1, "reading %s" % os.path.basename(path))
-            obj = objects.make_measurement(doc, load_points(path), name="Measurement",
-                                           source_file=path)
+            obj = do_command(
+                (APP_OBJECTS, "from BladeInspect.inspection.pipeline import load_points"),
+                "objects.make_measurement(%s, load_points(%r), name='Measurement', "
+                "source_file=%r)" % (document_text(doc), path, path))
             obj.Label = os.path.splitext(os.path.basename(path))[0]
             return obj
         obj = progress.run("Import points", job)
@@ -235,8 +278,10 @@ class ImportPoints(_Command):
 
 class Reconstruct(_Command):
     name = "BladeInspect_Reconstruct"
-    menu = "Reconstruct"
-    tip = "Fit cubic B-spline section curves to the measurement and loft them into surfaces"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Reconstruct", "Reconstruct")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Reconstruct",
+        "Fit cubic B-spline section curves to the measurement and loft them into surfaces")
 
     def ready(self):
         return find_input((objects.Measurement.Type,)) is not None
@@ -261,9 +306,11 @@ class Reconstruct(_Command):
 
 class Register(_Command):
     name = "BladeInspect_Register"
-    menu = "Register"
-    tip = ("Register the measurement to the nominal with no starting pose (PCA, then "
-           "SNR-weighted ICP) and show the pose with its uncertainty")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Register", "Register")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Register",
+        "Register the measurement to the nominal with no starting pose (PCA, then SNR-"
+        "weighted ICP) and show the pose with its uncertainty")
 
     def ready(self):
         return find_input((objects.Measurement.Type,)) is not None and find_nominal() is not None
@@ -299,8 +346,10 @@ class Register(_Command):
 
 class DeviationMap(_Command):
     name = "BladeInspect_DeviationMap"
-    menu = "Deviation map"
-    tip = "Colour the registered points by signed deviation (limits from the preferences)"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_DeviationMap", "Deviation map")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_DeviationMap",
+        "Colour the registered points by signed deviation (limits from the preferences)")
 
     def ready(self):
         return find_input((objects.Registration.Type,)) is not None
@@ -311,8 +360,9 @@ class DeviationMap(_Command):
     def make(self, registration, limit=None):
         doc = registration.Document
         limit = settings.colour_limit() if limit is None else limit
-        obj = progress.run("Deviation map",
-                           lambda p: objects.make_deviation_map(doc, registration, limit))
+        obj = progress.run("Deviation map", lambda p: do_command(
+            (APP_OBJECTS,), "objects.make_deviation_map(%s, %s, %r)"
+            % (document_text(doc), object_text(registration), float(limit))))
         if obj is not None:
             # The map shows the points on the CAD; the measurement and its reconstruction lie
             # in the measured frame elsewhere and would only pull the view away.
@@ -329,8 +379,10 @@ class DeviationMap(_Command):
 
 class SectionAnalysis(_Command):
     name = "BladeInspect_SectionAnalysis"
-    menu = "Section analysis"
-    tip = "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_SectionAnalysis", "Section analysis")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_SectionAnalysis",
+        "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge")
 
     def ready(self):
         reg = find_input((objects.Registration.Type,))
@@ -423,8 +475,10 @@ class Report(_Command):
 
 class Preferences(_Command):
     name = "BladeInspect_Preferences"
-    menu = "Preferences..."
-    tip = "Sensor and rig parameters, tolerance and colour limits"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Preferences", "Preferences...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Preferences",
+        "Sensor and rig parameters, tolerance and colour limits")
 
     def Activated(self):
         FreeCADGui.showPreferences("BladeInspect")

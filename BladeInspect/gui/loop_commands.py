@@ -1,8 +1,9 @@
-"""The closed-loop commands (issue 8, item 5): inspect a blade, calibrate the rig, add a CMM file
+"""The closed-loop commands (docs/contracts.md): inspect a blade, calibrate the rig, add a CMM file
 to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
 function as the command line (run_inspect, run_calibration, section_table, run_simulation)
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
 or a cancel leaves the document as it was."""
+import contextlib
 import os
 import shutil
 import tempfile
@@ -14,9 +15,13 @@ import FreeCADGui
 from PySide import QtGui
 
 from ..app import loop, objects, settings
+from ..core import contracts
 from ..core.errors import InputError
 from . import commands, progress, taskpanels
 from .session import RIG
+
+# Marks the command texts for translation (FreeCAD translates them in the command's context).
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 CMM_FILTER = "CMM files (*.csv *.txt *.dat);;All files (*)"
 RIG_FILTER = "Rig calibration (*.json);;All files (*)"
@@ -28,6 +33,23 @@ LAST_RIG_FILE = [None]
 # Callables told of each plan once it is drawn, before its paths run: listener(plan, obj).
 # Tests photograph the view there.
 PLAN_LISTENERS = []
+
+
+@contextlib.contextmanager
+def inspection_rig(nominal_obj, seed, rig_file=None):
+    """The rig Inspect runs on: the connected one, else the simulated rig with the
+    preferences' sensor (as ConnectRig opens it), its true geometry ``rig_file``'s, closed
+    after."""
+    if RIG.connected:
+        yield RIG.rig
+        return
+    from ..rig.kinematics import RigKinematics
+    kinematics = RigKinematics.from_json(rig_file) if rig_file else None
+    rig = commands.simulated_rig(objects.nominal_of(nominal_obj), seed, kinematics)
+    try:
+        yield rig
+    finally:
+        rig.close()
 
 
 def ask_save_file(title, filters, default_name):
@@ -46,22 +68,6 @@ def show_result(title, text):
         box.finished.connect(lambda *_: progress._open_boxes.remove(box))
         progress._open_boxes.append(box)
         box.show()
-
-
-def parse_heights(text):
-    """Section heights typed as "10, 30, 50" (% of span)."""
-    parts = [t for t in text.replace(";", ",").replace(" ", ",").split(",") if t]
-    try:
-        heights = [float(t) for t in parts]
-    except ValueError:
-        raise InputError("section heights: %r is not a comma-separated list of numbers"
-                         % text) from None
-    if not heights:
-        raise InputError("section heights: at least one height is needed")
-    bad = [h for h in heights if not (np.isfinite(h) and 0.0 <= h <= 100.0)]
-    if bad:
-        raise InputError("section heights: %g is outside 0-100 %% of the span" % bad[0])
-    return heights
 
 
 def output_folder(doc, kind):
@@ -96,9 +102,9 @@ class InspectPanel(taskpanels._Panel):
 
     def __init__(self, on_accept):
         super().__init__()
-        from ..inspection.closed_loop import DEFAULT_HEIGHTS
         self.on_accept = on_accept
-        self.heights = QtGui.QLineEdit(", ".join("%g" % h for h in DEFAULT_HEIGHTS))
+        self.heights = QtGui.QLineEdit(", ".join("%g" % h
+                                                 for h in contracts.SECTION_HEIGHTS_PCT))
         self.heights.setToolTip("Nominal sections to measure, % of the span from hub to tip")
         self.tolerance = taskpanels._spin(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm")
         self.seed = taskpanels._spin(settings.value("Seed"), 0, 2 ** 31 - 1)
@@ -187,9 +193,11 @@ class SimulatePanel(taskpanels._Panel):
 
 class Inspect(commands._Command):
     name = "BladeInspect_Inspect"
-    menu = "Inspect..."
-    tip = ("The whole loop: blind section scan, registration, paths planned from the CAD at "
-           "its nominal sections (drawn before they run), their scan, Table 2 and verdict")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Inspect", "Inspect...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Inspect",
+        "The whole loop: blind section scan, registration, paths planned from the CAD at its "
+        "nominal sections (drawn before they run), their scan, Table 2 and verdict")
 
     def ready(self):
         return commands.find_nominal() is not None
@@ -199,7 +207,7 @@ class Inspect(commands._Command):
 
     def start(self, heights_text, tolerance, seed, rig_file=None):
         try:
-            heights = parse_heights(heights_text)
+            heights = contracts.parse_section_heights(heights_text, "section heights")
         except InputError as exc:
             progress.report_error("Inspect", str(exc))
             return None
@@ -230,11 +238,12 @@ class Inspect(commands._Command):
         def job(p):
             if rig_file and not os.path.isfile(rig_file):
                 raise InputError("rig calibration %s: no such file" % rig_file)
-            with objects.building(doc, "Inspect"):
+            with objects.building(doc, "Inspect"), \
+                    inspection_rig(nominal_obj, seed, rig_file) as rig:
                 summary = run_inspect(
                     getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
                     section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
-                    progress=p, rig=RIG.rig if RIG.connected else None,
+                    progress=p, rig=rig,
                     nominal=objects.nominal_of(nominal_obj), document=False, on_plan=draw)
                 result = summary["result"]
                 p(0.95, "adding the inspection to the document")
@@ -288,9 +297,11 @@ class Inspect(commands._Command):
 
 class Calibrate(commands._Command):
     name = "BladeInspect_Calibrate"
-    menu = "Calibrate rig..."
-    tip = ("Measure a reference sphere at several rotary angles, find the rotary axis and "
-           "write RIG.json (simulated rig or a serial port)")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Calibrate", "Calibrate rig...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Calibrate",
+        "Measure a reference sphere at several rotary angles, find the rotary axis and write "
+        "RIG.json (simulated rig or a serial port)")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(CalibratePanel(self.start))
@@ -335,9 +346,11 @@ def calibration_text(result, out_path):
 
 class AddCmm(commands._Command):
     name = "BladeInspect_AddCmm"
-    menu = "Add CMM file..."
-    tip = ("Compare a CMM file's sections with the optical ones (Table 2): for an inspection, "
-           "at its nominal sections")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_AddCmm", "Add CMM file...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_AddCmm",
+        "Compare a CMM file's sections with the optical ones (Table 2): for an inspection, at"
+        " its nominal sections")
 
     def ready(self):
         reg = commands.find_input((objects.Registration.Type,))
@@ -364,9 +377,11 @@ class AddCmm(commands._Command):
 
 class Simulate(commands._Command):
     name = "BladeInspect_Simulate"
-    menu = "Simulation test bed..."
-    tip = ("The paper's simulation test bed: points from the CAD (or the demo blade) at a "
-           "random pose with measurement error, registered blind; pose error against its bound")
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Simulate", "Simulation test bed...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Simulate",
+        "The paper's simulation test bed: points from the CAD (or the demo blade) at a random"
+        " pose with measurement error, registered blind; pose error against its bound")
 
     def Activated(self):
         FreeCADGui.Control.showDialog(SimulatePanel(self.simulate))

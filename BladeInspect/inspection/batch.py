@@ -21,9 +21,9 @@ import socket
 import threading
 import time
 
+from ..core.contracts import PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from . import airfoil as airfoil_mod
-from . import verdict as verdict_mod
 
 POINT_EXTENSIONS = (".csv", ".xyz", ".asc", ".txt", ".ply", ".pcd")
 SUMMARY_FIELDS = ["file", "status", "n_points", "rms_mm", "worst_deviation_mm", "verdict",
@@ -166,7 +166,7 @@ def _csv_value(v):
 
 
 def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
-              tolerance=verdict_mod.DEFAULT_TOLERANCE, seed=0, progress=None,
+              tolerance=PROFILE_TOLERANCE_MM, seed=0, progress=None,
               allow_mismatch=False, airfoil=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the

@@ -24,9 +24,9 @@ import numpy as np
 from ..core.errors import InputError
 from ..core import pca as pca_mod
 from ..rig.sensor import SensorModel
-from .verdict import DEFAULT_TOLERANCE
+from ..core.contracts import PROFILE_TOLERANCE_MM
 
-# The sensor's error bound at the reference SNR (DESIGN.md: accuracy < 6 um). A cloud whose
+# The sensor's error bound at the reference SNR (docs/contracts.md: accuracy < 6 um). A cloud whose
 # spread (standard deviation) in some direction is within it has no extent there, only noise:
 # noise of that bound spreads a flat patch by 3.5 um (uniform) or 2 um (clipped normal).
 SENSOR_ACCURACY_MM = SensorModel().accuracy
@@ -55,7 +55,7 @@ EXTENT_PERCENTILES = (1.0, 99.0)
 FIT_MIN_FRACTION = 0.5
 
 
-def fit_distance_mm(tolerance=DEFAULT_TOLERANCE):
+def fit_distance_mm(tolerance=PROFILE_TOLERANCE_MM):
     return float(tolerance) + SENSOR_ACCURACY_MM
 
 
@@ -131,7 +131,7 @@ def check_scale(xyz, nominal, source, cad_source):
                                                 ratio * cad_extent, cad_extent))
 
 
-def surface_fit(deviation, tolerance=DEFAULT_TOLERANCE):
+def surface_fit(deviation, tolerance=PROFILE_TOLERANCE_MM):
     """The surface-fit record of result.json: which fraction of the points lies within the fit
     distance of the CAD, against the rule's minimum."""
     distance = fit_distance_mm(tolerance)

@@ -1,4 +1,4 @@
-"""The `inspect` workflow (issue 8, item 1): the paper's whole automated loop on one blade.
+"""The `inspect` workflow (docs/contracts.md loop 1): the paper's whole automated loop on one blade.
 
 1. blind section scan (measurement.scan.scan_to_dir: nothing about the pose is known yet);
 2. registration of those points (reconstruction, PCA, SNR-weighted ICP) -> pose on the table;
@@ -35,6 +35,7 @@ import time
 
 import numpy as np
 
+from ..core import contracts
 from ..core import transforms as tf
 from ..core.errors import Cancelled, DeviceError, InputError
 from ..core.pointio import PointSet, read_points, write_points_csv
@@ -42,7 +43,6 @@ from ..measurement.journal import JOURNAL_FILE, JournaledRig
 from ..measurement.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
 from . import airfoil as airfoil_mod
 
-DEFAULT_HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 EPSILON_MM = 2.0
 # The planned points must lie within 0.01 mm of their nominal planes: a pose that moves them by
 # more than a quarter of that budget (5 um, the fraction 1/400 of the 2 mm epsilon) is worth a
@@ -67,21 +67,6 @@ RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf",
 
 def _no_progress(fraction, message):
     pass
-
-
-def _check_heights(heights):
-    values = []
-    for h in heights:
-        try:
-            v = float(h)
-        except (TypeError, ValueError):
-            raise InputError("--section-heights: %r is not a number" % (h,)) from None
-        if not (np.isfinite(v) and 0.0 <= v <= 100.0):
-            raise InputError("--section-heights: %g is outside 0-100 %% of the span" % v)
-        values.append(v)
-    if not values:
-        raise InputError("--section-heights: at least one height is needed")
-    return values
 
 
 def scan_plan(rig, plan, kinematics, progress=_no_progress, first_path=0, on_section=None):
@@ -213,8 +198,9 @@ def _pointset(xyz, snr, columns, source):
                     columns=columns, n_rows_skipped=0, source=source)
 
 
-def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGHTS,
-                complete=False, pitch=0.1, cmm=None, tolerance=0.04, seed=0, rig_file=None,
+def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SECTION_HEIGHTS_PCT,
+                complete=False, pitch=0.1, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
+                seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
                 scan_options=None, on_plan=None, resume=False, flip_faces=(),
                 allow_mismatch=False, airfoil=None):
@@ -247,10 +233,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=DEFAULT_HEIGH
     progress = progress or _no_progress
     if not out_dir:
         raise InputError("--out: a folder is required")
-    heights = _check_heights(section_heights)
-    tolerance = float(tolerance)
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    heights = contracts.section_heights(section_heights)
+    tolerance = contracts.profile_tolerance(tolerance)
     if complete:
         from ..measurement.complete import _check_step
         pitch = _check_step(pitch, "--pitch")
@@ -454,7 +438,7 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
         "planned": {"points": n_planned, "paths": path_records, "rig_s": rig_s - blind_rig_s}}
     scan_record["replans"] = replans
     with open(out.path("scan.json"), "w") as fh:
-        json.dump(scan_record, fh, indent=1, default=pipeline._json_default)
+        json.dump(scan_record, fh, indent=1, default=contracts.json_default)
     files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
                          title="BladeInspect inspection (CAD-planned sections)")
     if document:
@@ -642,7 +626,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
                      "simulated_s": timing["complete_scan"],
                      "sensor_rate_s": n_read / float(rig.sensor.rate_hz)}}
     with open(out.path("scan.json"), "w") as fh:
-        json.dump(scan_record, fh, indent=1, default=pipeline._json_default)
+        json.dump(scan_record, fh, indent=1, default=contracts.json_default)
     files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
                          title="BladeInspect inspection (complete scan, pitch %g mm)" % pitch)
     if document:
@@ -872,20 +856,12 @@ def _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan
     points (JSON-ready). ``scan_options`` None: whatever the interrupted run used."""
     options = None
     if scan_options is not None:
-        options = json.loads(json.dumps(scan_options, default=_json_option))
+        options = contracts.json_ready(scan_options)
     return {"cad_bbox": np.asarray(nominal.bbox_corners, dtype=float).tolist(),
             "seed": int(seed), "section_heights": [float(h) for h in heights],
             "complete": bool(complete), "pitch_mm": float(pitch) if complete else None,
             "epsilon_mm": float(epsilon), "kinematics": kinematics.to_dict(),
             "scan_options": options}
-
-
-def _json_option(value):
-    if hasattr(value, "to_dict"):
-        return value.to_dict()
-    if isinstance(value, (np.ndarray, np.floating, np.integer)):
-        return value.tolist()
-    raise TypeError("not JSON serialisable: %r" % type(value))
 
 
 IDENTITY_FLAGS = (("cad_bbox", "the CAD (its bounding box)"), ("seed", "--seed"),

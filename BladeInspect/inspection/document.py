@@ -5,7 +5,7 @@ workbench exactly as if the inspection had been done there: the nominal (DemoBla
 CadModel), the Measurement (the points as read, in their own frame), the Registration holding
 the result (linked to both, so it re-registers only if one of them changes), the DeviationMap
 (a Points::FeaturePython whose App::PropertyColorList "Color" has one colour per point, from
-core.colormap) and the nominal section profiles. The verdict is stored beside the section
+core.colourmap) and the nominal section profiles. The verdict is stored beside the section
 profiles. Nothing is recomputed on opening: each object carries the signature of its inputs.
 """
 
@@ -15,6 +15,7 @@ import os
 import numpy as np
 
 from ..core import transforms as tf
+from ..core.contracts import PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from ..core.pointio import PointSet
 
@@ -27,8 +28,8 @@ def _measured_pointset(result):
                     n_rows_skipped=int(result.n_rows_skipped), source=result.source)
 
 
-def write_inspection_document(path, nominal, result, sections, tolerance=0.04, verdict=None,
-                              cad_path=None, name="Inspection"):
+def write_inspection_document(path, nominal, result, sections, tolerance=PROFILE_TOLERANCE_MM,
+                              verdict=None, cad_path=None, name="Inspection"):
     """Save the inspection document at ``path`` (.FCStd) and close it. ``cad_path`` is the CAD
     file the nominal came from (None: the built-in demo blade). Returns the path."""
     import FreeCAD

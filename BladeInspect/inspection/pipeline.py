@@ -1,4 +1,4 @@
-"""The registration pipeline, one plain function per stage (DESIGN.md "Data flow").
+"""The registration pipeline, one plain function per stage (docs/contracts.md "Data flow").
 
 The command line, the GUI commands and the tests all call these functions; nothing here knows
 about a terminal or a window. Long stages report through ``progress(fraction, message)``; a
@@ -24,7 +24,7 @@ from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
 from . import checks
 from .result import RegistrationResult
-from .verdict import DEFAULT_TOLERANCE
+from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
 
 # Points used for the ICP ranking of each PCA candidate and for the fine fit's inner
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
@@ -56,7 +56,7 @@ SEARCH_TURNS_DEG = (-8.0, -4.0, 4.0, 8.0)
 # its ICPs and search rounds are bounded in number, so this only ends a stage that a slow
 # distance (points far inside or off the CAD) would stretch to minutes. Half the fine stage's.
 COARSE_TIME_LIMIT_S = 60.0
-# Wall-clock budget of the fine stage: twelve times DESIGN.md's 10 s for the whole
+# Wall-clock budget of the fine stage: twelve times docs/contracts.md's 10 s for the whole
 # registration of the paper's 269k-point cloud on two cores. A fit still iterating then is
 # lost (its points are not on this CAD), not slow; its iteration counts are bounded as well.
 FINE_TIME_LIMIT_S = 120.0
@@ -382,7 +382,7 @@ def _check_time(fit, time_limit_s):
 # ---------------------------------------------------------------- the whole registration
 
 def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
-             allow_mismatch=False, tolerance=DEFAULT_TOLERANCE, cad_source=None):
+             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
     Refused (InputError) before any fitting when the points are too degenerate to fix a pose
@@ -528,7 +528,7 @@ def freecad_version():
 
 
 def result_json(result, extra=None):
-    """The result.json contract of DESIGN.md, plus ``extra`` fields merged at the top level."""
+    """The result.json of docs/contracts.md, plus ``extra`` fields merged at the top level."""
     stats = dict(result.deviation_stats)
     doc = {
         "measured_to_cad": np.asarray(result.measured_to_cad).tolist(),
@@ -630,22 +630,12 @@ def write_register_outputs(out_dir, result, extra=None, output=None):
         _write_deviations_csv(out.path("deviations.csv"), result)
         result.timing_s["write"] = time.perf_counter() - t0
         with open(out.path("result.json"), "w") as fh:
-            json.dump(result_json(result, extra), fh, indent=1, default=_json_default)
+            json.dump(result_json(result, extra), fh, indent=1, default=json_default)
     if output is not None:
         write(output)
     else:
         with AtomicOutput(out_dir) as out:
             write(out)
-
-
-def _json_default(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, (np.floating, np.integer)):
-        return value.item()
-    if isinstance(value, np.bool_):
-        return bool(value)
-    raise TypeError("not JSON serialisable: %r" % type(value))
 
 
 def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),

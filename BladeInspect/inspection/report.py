@@ -19,7 +19,8 @@ import time
 
 import numpy as np
 
-from ..core import colormap
+from ..core import colourmap, contracts
+from ..core import stats as stats_mod
 from ..core.errors import InputError
 from . import airfoil as airfoil_mod
 from . import airfoil_report
@@ -47,7 +48,7 @@ def _mpl():
 
 def _cmap_and_norm(limit):
     _, ListedColormap, Normalize = _mpl()
-    return ListedColormap(colormap.colormap_table(), name="bladeinspect"), \
+    return ListedColormap(colourmap.colourmap_table(), name="bladeinspect"), \
         Normalize(-limit, limit)
 
 
@@ -59,7 +60,7 @@ def _add_legend(fig, ax_or_axes, limit, label="deviation (mm), + outside materia
         bar = fig.colorbar(mappable, cax=cax)
     else:
         bar = fig.colorbar(mappable, ax=ax_or_axes, fraction=0.035, pad=0.02)
-    values, _ = colormap.legend_ticks(limit)
+    values, _ = colourmap.legend_ticks(limit)
     bar.set_ticks(values)
     bar.set_ticklabels(["%+.3f" % v if v else "0" for v in values])
     bar.set_label(label)
@@ -94,7 +95,7 @@ def _view_frame(result, table):
     return span, chord, across
 
 
-def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
+def raster_view(xyz, colours, right, up, toward_viewer, px_per_mm, splat=1):
     """An orthographic z-buffered picture of coloured points: (RGBA image (H, W, 4), extent
     (left, right, bottom, top) in mm). Each point covers a (2 splat + 1)^2 pixel square and
     the point nearest the viewer wins a pixel, so the visible surface hides the far one; a
@@ -120,7 +121,7 @@ def raster_view(xyz, colors, right, up, toward_viewer, px_per_mm, splat=1):
     last = np.r_[pix[1:] != pix[:-1], True]       # nearest point of each pixel
     image = np.ones((height * width, 4))
     image[:, 3] = 0.0
-    image[pix[last], :3] = colors[src[last]]
+    image[pix[last], :3] = colours[src[last]]
     image[pix[last], 3] = 1.0
     extent = (u0, u0 + width / px_per_mm, v1 - height / px_per_mm, v1)
     return image.reshape(height, width, 4), extent
@@ -135,7 +136,7 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
         keep = np.sort(np.random.default_rng(seed).choice(len(xyz), max_points, replace=False))
         xyz, dev = xyz[keep], dev[keep]
     span, chord, across = _view_frame(result, table)
-    colors = colormap.deviation_colors(dev, limit)
+    colours = colourmap.deviation_colours(dev, limit)
     # (title, right, up, toward the viewer), each right-handed so no view is mirrored
     views = (("suction side", -chord, span, across),
              ("pressure side", chord, span, -across),
@@ -146,7 +147,7 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
     extent_mm = np.ptp(xyz @ np.column_stack([chord, span, across]), axis=0).max()
     px_per_mm = 900.0 / max(extent_mm, 1e-6)
     for ax, (title, right, up, toward_viewer) in zip(axes, views):
-        image, extent = raster_view(xyz, colors, right, up, toward_viewer, px_per_mm)
+        image, extent = raster_view(xyz, colours, right, up, toward_viewer, px_per_mm)
         ax.imshow(image, extent=extent, interpolation="antialiased")
         ax.set_title(title)
         ax.set_xlabel("mm")
@@ -159,8 +160,8 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
 
 
 def figure_histogram(result, band_edges):
-    """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the Table 3
-    band edges."""
+    """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the tolerance
+    bands' edges (tolerance_histogram)."""
     plt, _, _ = _mpl()
     dev = result.deviation
     stats = result.deviation_stats
@@ -173,8 +174,8 @@ def figure_histogram(result, band_edges):
     limit = max(abs(band_edges[0]), abs(band_edges[-1]))
     fig, ax = plt.subplots(figsize=(10, 4.8))
     fig.subplots_adjust(left=0.08, right=0.97, bottom=0.12, top=0.9)
-    ax.bar(centres, counts, width=np.diff(edges), color=colormap.deviation_colors(centres, limit),
-           edgecolor="none")
+    ax.bar(centres, counts, width=np.diff(edges),
+           color=colourmap.deviation_colours(centres, limit), edgecolor="none")
     top = counts.max() if len(counts) else 1
     for k, style, name in ((1, "--", "sigma"), (3, ":", "3 sigma")):
         for sign in (-1, 1):
@@ -187,7 +188,7 @@ def figure_histogram(result, band_edges):
     ax.set_xlabel("signed deviation (mm), + outside material; the end bins hold all beyond")
     ax.set_ylabel("points")
     ax.set_title("Deviations: mean %+.4f mm, sigma %.4f mm, RMS %.4f mm; dashed +-sigma, "
-                 "dotted +-3 sigma, grey the Table 3 bands" % (mean, sigma, stats["rms"]),
+                 "dotted +-3 sigma, grey the tolerance bands" % (mean, sigma, stats["rms"]),
                  fontsize=10)
     return fig
 
@@ -246,11 +247,11 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
         base = sec.plane_coords(result.closest[idx])
         tip = base + sec.vectors_in_plane(result.normal[idx]) * \
             (result.deviation[idx] * magnification)[:, None]
-        colors = colormap.deviation_colors(result.deviation[idx], tolerance)
+        colours = colourmap.deviation_colours(result.deviation[idx], tolerance)
         # rasterized: thousands of vector whiskers make a PDF slow to write and to view
-        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors=colors,
+        ax.add_collection(LineCollection(np.stack([base, tip], axis=1), colors=colours,
                                          linewidths=1.0, rasterized=True))
-        ax.scatter(tip[:, 0], tip[:, 1], c=colors, s=3, linewidths=0, rasterized=True)
+        ax.scatter(tip[:, 0], tip[:, 1], c=colours, s=3, linewidths=0, rasterized=True)
     if sec.cmm_xyz is not None and len(sec.cmm_xyz):
         base = sec.plane_coords(sec.cmm_closest)
         tip = base + sec.vectors_in_plane(sec.cmm_normal) * \
@@ -287,9 +288,17 @@ def _fmt(value, pattern="%.4f"):
     return "-" if value is None else pattern % value
 
 
-def histogram_rows(result):
+def tolerance_histogram(result, tolerance):
+    """The deviations counted in the bands of the run's profile tolerance T (core.stats
+    tolerance_bands: +-T, +-1.5T, +-2T; Table 3's bands when T = 0.04 mm)."""
+    bands = stats_mod.tolerance_bands(tolerance)
+    return stats_mod.deviation_statistics(result.deviation, bands)["histogram"]
+
+
+def histogram_rows(histogram):
+    """The report's histogram table of ``histogram`` (tolerance_histogram's bands)."""
     rows = []
-    for band in result.deviation_stats["histogram"]:
+    for band in histogram:
         lo, hi = band["lo"], band["hi"]
         name = ("< %.3f" % hi if lo is None else "> %.3f" % lo if hi is None
                 else "%.3f to %.3f" % (lo, hi))
@@ -422,10 +431,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
     table = sections
     tolerance = float(tolerance)
     title = title or "BladeInspect inspection report"
-    band_edges = [b["lo"] for b in result.deviation_stats["histogram"][1:]]
+    histogram = tolerance_histogram(result, tolerance)
+    band_edges = [b["lo"] for b in histogram[1:]]
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     verdict_lines = _verdict_lines(verdict, table)
-    h_header, h_rows = histogram_rows(result)
+    h_header, h_rows = histogram_rows(histogram)
     s_header, s_rows = section_rows(table)
     p_rows = pose_rows(result)
 
@@ -535,8 +545,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 # ---------------------------------------------------------------- the `report` command
 
-def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
-               seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
+def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
+               seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
                nominal=None, document=True, flip_faces=(), allow_mismatch=False, airfoil=None):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
@@ -549,9 +559,7 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     from .checks import check_out_dir
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
-    tolerance = float(tolerance)
-    if not np.isfinite(tolerance) or tolerance <= 0:
-        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    tolerance = contracts.profile_tolerance(tolerance)
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:

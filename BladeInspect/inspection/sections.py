@@ -1,10 +1,10 @@
-"""Section profile errors (paper 4.2, Table 2, Figs 9-10): the registered points of each
-section against the CAD's cut in the same plane, optionally beside a CMM's points of the same
-sections.
+"""Profile sections' errors (paper 4.2, Table 2, Figs 9-10): the registered points of each
+profile section against the CAD's section curve in the same plane, optionally beside a CMM's
+points of the same sections (docs/internals.md "Words").
 
-Where the sections are:
-- with a ``section`` column, each section's own points (CAD frame) define its plane (least
-  squares) and all of that section's points belong to it;
+Where the profile sections are:
+- with a ``section`` column, each section line's own points (CAD frame) define its plane
+  (least squares) and all of that line's points belong to it;
 - otherwise planes across the CAD's span at ``heights_pct`` of its length, each taking the
   points within +-``band`` mm of the plane.
 
@@ -27,10 +27,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core import pca
+from ..core.contracts import SECTION_HEIGHTS_PCT, section_heights
 from ..core.errors import InputError
 from ..core.fitting import fit_plane
 
-DEFAULT_HEIGHTS_PCT = (10, 30, 50, 70, 90)
 EDGE_FRACTION = 0.03
 # Profile thickness is compared this far behind each end to tell the round nose from the tail.
 _THICKNESS_PROBE = 0.05
@@ -514,7 +514,7 @@ def _height_sections(result, nominal, span_axis, span_range, heights_pct, band):
     return out
 
 
-def section_table(result, nominal, heights_pct=DEFAULT_HEIGHTS_PCT, band=0.25, within=0.02,
+def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, within=0.02,
                   cmm=None, span_axis=None, edge_fraction=EDGE_FRACTION):
     """Table 2 for a registration: one Section per section plane with the optical figures (and
     the CMM's beside them when ``cmm`` — a path or CmmData — is given). See the module notes
@@ -523,9 +523,7 @@ def section_table(result, nominal, heights_pct=DEFAULT_HEIGHTS_PCT, band=0.25, w
     for name, value in (("band", band), ("within", within), ("edge_fraction", edge_fraction)):
         if not np.isfinite(value) or value <= 0:
             raise InputError("section table: %s must be positive, got %r" % (name, value))
-    heights = [float(h) for h in heights_pct]
-    if any(not (0.0 <= h <= 100.0) for h in heights):
-        raise InputError("section heights: must lie within 0..100 %% of span, got %s" % heights)
+    heights = section_heights(heights_pct, "section heights", allow_empty=True)
     axis, span_range = span_axis_of(nominal, span_axis)
     warnings = []
     if "section" in result.columns:

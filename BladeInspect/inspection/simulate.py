@@ -13,10 +13,10 @@ from ..core import transforms as tf
 from ..core.errors import InputError
 from ..core.pointio import PointSet, write_points_csv
 
-# Good readings and gross outliers get these SNRs: outliers come from poor signal (DESIGN.md).
+# Good readings and gross outliers get these SNRs: outliers come from poor signal.
 GOOD_SNR = (60.0, 95.0)
 OUTLIER_SNR = (2.0, 10.0)
-SECTION_HEIGHTS_PCT = (25.0, 50.0, 75.0)
+SECTION_LINE_HEIGHTS_PCT = (25.0, 50.0, 75.0)
 
 
 def measurement_faces(nominal, sides):
@@ -85,7 +85,7 @@ def section_lines(nominal, heights_pct, spacing, axis=2):
 
 def measurement_error(n, noise, rng, amplitude=0.006, sigma=0.002):
     """Uniform on [-a, a] (the paper's protocol) or normal sigma clipped at +-3 sigma (what its
-    Fig. 8 figures fit, see DESIGN.md)."""
+    Fig. 8 figures fit, see docs/contracts.md)."""
     if noise == "uniform":
         return rng.uniform(-amplitude, amplitude, n)
     if noise == "normal":
@@ -95,7 +95,7 @@ def measurement_error(n, noise, rng, amplitude=0.006, sigma=0.002):
 
 def simulate_measurement(nominal, n_points=20000, sides="both", noise="uniform",
                          amplitude=0.006, sigma=0.002, outlier_fraction=0.0,
-                         section_heights=SECTION_HEIGHTS_PCT, seed=0, max_translation=100.0,
+                         section_heights=SECTION_LINE_HEIGHTS_PCT, seed=0, max_translation=100.0,
                          pose=None):
     """A measured point set in an unknown frame and the truth that maps it into the CAD frame.
 

@@ -16,10 +16,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from ..core.contracts import PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from .sections import classify
 
-DEFAULT_TOLERANCE = 0.04
 SPOT_NEIGHBOURS = 8
 MIN_SPOT_POINTS = 3
 
@@ -67,7 +67,7 @@ def place_of(table, xyz):
     return k, pct, zone
 
 
-def judge(result, table, tolerance=DEFAULT_TOLERANCE, spot_neighbours=SPOT_NEIGHBOURS,
+def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NEIGHBOURS,
           min_spot_points=MIN_SPOT_POINTS, n_worst=5):
     """The verdict as JSON-ready data: overall pass, per-section pass (optical, and CMM when
     present), the out-of-tolerance spots worst first with their place, and a one-line summary."""

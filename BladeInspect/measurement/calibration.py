@@ -1,4 +1,4 @@
-"""Rotary-axis calibration with a reference sphere (issue 8, item 4).
+"""Rotary-axis calibration with a reference sphere (docs/contracts.md loop 4).
 
 A sphere of calibrated diameter sits on the rotary table off the axis. At each of several
 rotary angles the sensor rasters the sphere's upper cap; each cap gives the sphere's centre in

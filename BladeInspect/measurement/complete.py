@@ -1,4 +1,4 @@
-"""The complete scan (issue 8 item 3, paper 4.3): raster lines every ``pitch`` mm across the
+"""The complete scan (paper 4.3): raster lines every ``pitch`` mm across the
 span at a few rotary angles, so that suction and pressure sides and both edges are measured.
 
 Planned from the CAD once the pose is known. The span runs along the rotary axis (machine Y),

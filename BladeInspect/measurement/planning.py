@@ -1,6 +1,6 @@
-"""Measurement paths planned from the CAD once the part's pose on the table is known (issue 8,
-item 2; paper 3.2 and 5: registration unifies the part and machine frames "to plan the
-measurement path and find the section curve accurately").
+"""Measurement paths planned from the CAD once the part's pose on the table is known
+(docs/contracts.md; paper 3.2 and 5: registration unifies the part and machine frames "to plan
+the measurement path and find the section curve accurately").
 
 A nominal section is the CAD cut by a plane across the span. Its points are brought into the
 machine by the registration pose (table -> CAD, inverted) and the rotary angle; each point gets

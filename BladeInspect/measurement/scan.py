@@ -20,9 +20,10 @@ import tempfile
 
 import numpy as np
 
+from ..core.contracts import json_ready
 from ..core.errors import DeviceError, InputError
 from .journal import JOURNAL_FILE, JournaledRig, inner_rig
-from .strategy import ScanStrategy, StrategyState
+from .strategy import ScanOptions, ScanStrategy, StrategyState
 
 POINTS_FILE = "points.csv"
 RECORD_FILE = "scan.json"
@@ -58,9 +59,9 @@ def demo_nominal():
 
 def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None, phase=None,
                 on_record=None, **strategy_options):
-    """Run the blind scan (measurement.strategy.ScanStrategy with ``strategy_options``) and write it
-    to ``out_dir`` section by section. Returns the scan record (what scan.json holds, plus
-    ``points``: the number of points). ``progress(fraction, message)`` is called per section.
+    """Run the blind scan (measurement.strategy.ScanStrategy; ``strategy_options`` are
+    ScanOptions' fields and ``kinematics``) and write it to ``out_dir`` section by section.
+    Returns the scan record (what scan.json holds, plus ``points``: the number of points). ``progress(fraction, message)`` is called per section.
     ``phase``: a value for a last ``phase`` column of points.csv (``inspect`` appends its
     planned rows to the same file). ``on_record(record)`` may add to each scan.json before it
     is written. ``rig`` may be journaled already (measurement.journal.JournaledRig: the caller keeps
@@ -93,10 +94,10 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
         check_same_rig(record, rig, seed, record_path)
         options = record["options"]
         state = StrategyState.from_dict(record["checkpoint"]["strategy"])
-    kwargs = _strategy_kwargs(options)
+    scan_options, kinematics = _strategy_options(options)
     if fresh:
         # A bad option fails here, before anything is written.
-        ScanStrategy(rig, **kwargs)
+        ScanStrategy(rig, scan_options, kinematics=kinematics)
         os.makedirs(out_dir, exist_ok=True)
     own_journal = not isinstance(rig, JournaledRig)
     if own_journal:
@@ -110,7 +111,7 @@ def scan_to_dir(out_dir, rig, n_sections=5, seed=0, resume=False, progress=None,
     else:
         _truncate_points(points_path, record["checkpoint"]["points_bytes"])
         rig.resume(record["checkpoint"].get("journal_passes"))
-    strategy = ScanStrategy(rig, state=state, **kwargs)
+    strategy = ScanStrategy(rig, scan_options, kinematics=kinematics, state=state)
     start_elapsed = rig.elapsed_s
     base_simulated = record["simulated_s"]
     try:
@@ -152,30 +153,14 @@ def _write(path, record, on_record):
     write_record(path, record)
 
 
-def _strategy_kwargs(options):
-    allowed = ("n_sections", "span_range", "section_spacing", "point_spacing", "probe_spacing",
-               "epsilon", "sides", "edges", "max_passes", "search_radius", "end_margin",
-               "extension_mm", "kinematics")
-    unknown = sorted(set(options) - set(allowed))
-    if unknown:
-        raise InputError("scan: unknown option %s" % ", ".join(unknown))
-    kwargs = dict(options)
-    if isinstance(kwargs.get("kinematics"), dict):
+def _strategy_options(options):
+    """scan.json's ``options`` as ScanStrategy's arguments: (ScanOptions, kinematics)."""
+    options = dict(options)
+    kinematics = options.pop("kinematics", None)
+    if isinstance(kinematics, dict):
         from ..rig.kinematics import RigKinematics
-        kwargs["kinematics"] = RigKinematics.from_dict(kwargs["kinematics"], "scan.json options")
-    return kwargs
-
-
-def _json_options(options):
-    out = {}
-    for k, v in options.items():
-        if k == "kinematics":
-            out[k] = None if v is None else v.to_dict()
-        elif isinstance(v, (np.ndarray, list, tuple, np.floating, np.integer)):
-            out[k] = np.asarray(v).tolist()
-        else:
-            out[k] = v
-    return out
+        kinematics = RigKinematics.from_dict(kinematics, "scan.json options")
+    return ScanOptions.from_dict(options), kinematics
 
 
 def _new_record(rig, seed, options):
@@ -186,7 +171,7 @@ def _new_record(rig, seed, options):
         "kind": "blind section scan",
         "rig": type(inner_rig(rig)).__name__,
         "seed": int(seed),
-        "options": _json_options(options),
+        "options": json_ready(options),
         "sensor": sensor.to_dict() if hasattr(sensor, "to_dict") else None,
         "frame": "rotary table (machine frame turned back by the rotary angle)",
         "complete": False,

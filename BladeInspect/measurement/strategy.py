@@ -25,7 +25,7 @@ Everything is in stage coordinates while planning (surface height = Z - d); the 
 (RIG.json) turns the kept readings into machine and then table-frame points.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 from scipy.interpolate import BSpline
@@ -126,8 +126,10 @@ def _penalised_fit(s, values, length, knot_spacing):
     return BSpline(knots, coef, 3, extrapolate=False)
 
 
-def fit_section_curve(x, z, knot_spacing=KNOT_SPACING_MM, max_incidence_deg=85.0):
-    """Cubic uniform B-spline through section points seen from above (a graph z(x)). Gross
+def fit_stage_profile(x, z, knot_spacing=KNOT_SPACING_MM, max_incidence_deg=85.0):
+    """The surface profile one view reads along a section line, in stage coordinates: a cubic
+    uniform B-spline through the points seen from above (a graph z(x); the path the rescan
+    follows, not cad.loft's curve of a whole measured section line). Gross
     errors are removed by a robust scale of the point-to-curve distances (of every point, so
     a point wrongly dropped while an outlier still bent the curve comes back) and the fit is
     repeated until the kept set settles. Returns (SectionCurve, kept mask in input order)."""
@@ -222,61 +224,96 @@ class StrategyState:
 
 # ---------------------------------------------------------------- the strategy
 
-class ScanStrategy:
-    """The paper's section-line scan on any Rig.
+@dataclass(frozen=True)
+class ScanOptions:
+    """What the blind scan measures and how finely (``ScanStrategy``'s options; scan.json's
+    ``options`` hold them by these names).
 
     ``span_range`` (lo, hi): the blade's extent along the rotary axis (machine Y); None probes
     it. Sections are evenly spread inside it, ``end_margin`` (fraction of the span, at least
     1 mm) from its ends, or ``section_spacing`` mm apart centred on it. ``point_spacing``: final
     pass, along the section; ``probe_spacing``: probes and intermediate passes. ``epsilon``:
     the standoff criterion |d - z_s|. ``sides`` 1 or 2, ``edges``: the extra edge views.
-    ``search_radius``: the part lies within this distance of the rotary axis.
-    ``kinematics``: the rig geometry believed (RIG.json); default nominal."""
+    ``search_radius``: the part lies within this distance of the rotary axis."""
+    n_sections: int = 5
+    span_range: tuple = None
+    section_spacing: float = None
+    point_spacing: float = 0.1
+    probe_spacing: float = 0.5
+    epsilon: float = 2.0
+    sides: int = 2
+    edges: bool = True
+    max_passes: int = 8
+    search_radius: float = 45.0
+    end_margin: float = 0.05
+    extension_mm: float = 3.0
 
-    def __init__(self, rig, n_sections=5, span_range=None, section_spacing=None,
-                 point_spacing=0.1, probe_spacing=0.5, epsilon=2.0, sides=2, edges=True,
-                 max_passes=8, search_radius=45.0, end_margin=0.05, extension_mm=3.0,
-                 kinematics=None, state=None):
-        sensor = rig.sensor
-        if sensor is None:
-            raise InputError("scan: the rig has no sensor model")
-        if int(n_sections) != n_sections or n_sections < 1:
-            raise InputError("--sections: must be a positive integer, got %r" % (n_sections,))
-        if sides not in (1, 2):
-            raise InputError("--sides: must be 1 or 2, got %r" % (sides,))
-        if not 0 < epsilon <= sensor.half_range:
+    @classmethod
+    def from_dict(cls, options):
+        """The options named in ``options`` (the rest at their defaults); an unknown name is an
+        InputError."""
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(options) - names)
+        if unknown:
+            raise InputError("scan: unknown option %s" % ", ".join(unknown))
+        return cls(**options)
+
+    def validated(self, sensor):
+        """These options with numbers as numbers; InputError for a value the scan cannot use
+        with ``sensor``."""
+        if int(self.n_sections) != self.n_sections or self.n_sections < 1:
+            raise InputError("--sections: must be a positive integer, got %r"
+                             % (self.n_sections,))
+        if self.sides not in (1, 2):
+            raise InputError("--sides: must be 1 or 2, got %r" % (self.sides,))
+        if not 0 < self.epsilon <= sensor.half_range:
             raise InputError("--epsilon: must be in (0, %g] mm (the half range), got %r"
-                             % (sensor.half_range, epsilon))
-        for name, value in (("point spacing", point_spacing), ("probe spacing", probe_spacing),
-                            ("search radius", search_radius), ("extension", extension_mm)):
+                             % (sensor.half_range, self.epsilon))
+        for name, value in (("point spacing", self.point_spacing),
+                            ("probe spacing", self.probe_spacing),
+                            ("search radius", self.search_radius),
+                            ("extension", self.extension_mm)):
             if not (np.isfinite(value) and value > 0):
                 raise InputError("scan %s: must be a positive number of mm, got %r"
                                  % (name, value))
-        if int(max_passes) != max_passes or max_passes < 1:
+        if int(self.max_passes) != self.max_passes or self.max_passes < 1:
             raise InputError("scan max_passes: must be a positive integer, got %r"
-                             % (max_passes,))
+                             % (self.max_passes,))
+        span_range = self.span_range
         if span_range is not None:
-            span_range = [float(v) for v in span_range]
+            span_range = tuple(float(v) for v in span_range)
             if len(span_range) != 2 or not span_range[1] > span_range[0]:
                 raise InputError("scan span range: expected (lo, hi) with lo < hi, got %r"
-                                 % (span_range,))
+                                 % (self.span_range,))
+        return replace(self, n_sections=int(self.n_sections), span_range=span_range,
+                       point_spacing=float(self.point_spacing),
+                       probe_spacing=float(self.probe_spacing), epsilon=float(self.epsilon),
+                       max_passes=int(self.max_passes),
+                       search_radius=float(self.search_radius),
+                       end_margin=float(self.end_margin),
+                       extension_mm=float(self.extension_mm))
+
+
+class ScanStrategy:
+    """The paper's section-line scan on any Rig, with ``options`` (ScanOptions; default
+    ScanOptions()). ``kinematics``: the rig geometry believed (RIG.json); default nominal.
+    ``state``: a checkpoint to continue from (StrategyState)."""
+
+    def __init__(self, rig, options=None, kinematics=None, state=None):
+        sensor = rig.sensor
+        if sensor is None:
+            raise InputError("scan: the rig has no sensor model")
+        self.options = (options if options is not None else ScanOptions()).validated(sensor)
         self.rig = rig
         self.sensor = sensor
-        self.n_sections = int(n_sections)
-        self.section_spacing = section_spacing
-        self.point_spacing = float(point_spacing)
-        self.probe_spacing = float(probe_spacing)
-        self.epsilon = float(epsilon)
-        self.views = SIDE_VIEWS[:sides] + (EDGE_VIEWS if edges else ())
-        self.max_passes = int(max_passes)
-        self.search_radius = float(search_radius)
-        self.end_margin = float(end_margin)
-        self.extension_mm = float(extension_mm)
+        self.views = SIDE_VIEWS[:self.options.sides] + (EDGE_VIEWS if self.options.edges else ())
         self.kinematics = kinematics if kinematics is not None else RigKinematics()
         d = self.kinematics.axis_direction
         # Turning the table by +phi lowers a chord inclined by phi when the axis runs along +Y.
         self._twist_sign = 1.0 if d[1] >= 0 else -1.0
-        self.state = state if state is not None else StrategyState(span_range=span_range)
+        self.state = (state if state is not None
+                      else StrategyState(span_range=None if self.options.span_range is None
+                                         else list(self.options.span_range)))
         # (angle, y, surface height) of the span probe's readings; not part of the checkpoint,
         # which is only taken once the first section (and its levelling) is done.
         self._probed = []
@@ -317,17 +354,19 @@ class ScanStrategy:
             self.state.span_range = self._probe_span()
         lo, hi = self.state.span_range
         span = hi - lo
-        margin = max(1.0, self.end_margin * span)
-        if self.n_sections == 1:
+        margin = max(1.0, self.options.end_margin * span)
+        if self.options.n_sections == 1:
             return [0.5 * (lo + hi)]
-        if self.section_spacing is not None:
-            total = self.section_spacing * (self.n_sections - 1)
-            if not (self.section_spacing > 0 and total <= span - 2 * margin):
+        if self.options.section_spacing is not None:
+            total = self.options.section_spacing * (self.options.n_sections - 1)
+            if not (self.options.section_spacing > 0 and total <= span - 2 * margin):
                 raise InputError("--section-spacing %r: %d sections do not fit in the %.1f mm "
-                                 "span" % (self.section_spacing, self.n_sections, span))
+                                 "span" % (self.options.section_spacing,
+                                           self.options.n_sections, span))
             mid = 0.5 * (lo + hi)
-            return list(mid - 0.5 * total + self.section_spacing * np.arange(self.n_sections))
-        return list(np.linspace(lo + margin, hi - margin, self.n_sections))
+            return list(mid - 0.5 * total
+                        + self.options.section_spacing * np.arange(self.options.n_sections))
+        return list(np.linspace(lo + margin, hi - margin, self.options.n_sections))
 
     def _probe_span(self):
         """The blade's extent along the rotary axis: passes along Y over the axis, stepping
@@ -360,7 +399,8 @@ class ScanStrategy:
             found = np.concatenate(found)
             return [float(found.min()), float(found.max())]
         raise InputError("scan: the sensor found no surface within %g mm of the rotary axis "
-                         "(check the part is mounted and the search radius)" % self.search_radius)
+                         "(check the part is mounted and the search radius)"
+                         % self.options.search_radius)
 
     def _read_along(self, xy, z_stage, angle):
         """Y of the readings of one pass over the (x, y) points at height z_stage. The surface
@@ -384,8 +424,8 @@ class ScanStrategy:
         envelope down; consecutive working windows overlap by a fifth of the range."""
         az = self.kinematics.axis_point[2]
         half = self.sensor.half_range
-        return list(np.arange(az + self.search_radius - 0.8 * half,
-                              az - self.search_radius - half, -1.6 * half))
+        return list(np.arange(az + self.options.search_radius - 0.8 * half,
+                              az - self.options.search_radius - half, -1.6 * half))
 
     def _predict_level(self, next_y):
         """The angle that should put the next section's chord level: the last level angle
@@ -556,12 +596,12 @@ class ScanStrategy:
         x_all, z_all = found
         max_incidence = 0.5 * self.sensor.coverage_deg
         open_ends = [True, True]
-        extension = [self.extension_mm, self.extension_mm]
-        for _ in range(self.max_passes):
-            curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
+        extension = [self.options.extension_mm, self.options.extension_mm]
+        for _ in range(self.options.max_passes):
+            curve, _ = fit_stage_profile(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
             lo = -extension[0] if open_ends[0] else 0.0
             hi = curve.length + (extension[1] if open_ends[1] else 0.0)
-            s = self._samples(lo, hi, self.probe_spacing)
+            s = self._samples(lo, hi, self.options.probe_spacing)
             stage, s = self._stage_path(curve(s), y, s)
             if len(stage) < MIN_VIEW_POINTS:
                 break       # the curve left the stages' travel
@@ -580,27 +620,27 @@ class ScanStrategy:
             open_ends = [open_ends[0] and grew[0], open_ends[1] and grew[1]]
             # While an end keeps reading, reach further: the working range often hides much
             # of the section from the first linear scan.
-            extension = [min(2.0 * e, MAX_EXTENSION_FACTOR * self.extension_mm) if g else e
-                         for e, g in zip(extension, grew)]
-            if not any(open_ends) and np.all(err <= self.epsilon):
+            most = MAX_EXTENSION_FACTOR * self.options.extension_mm
+            extension = [min(2.0 * e, most) if g else e for e, g in zip(extension, grew)]
+            if not any(open_ends) and np.all(err <= self.options.epsilon):
                 break
-        curve, _ = fit_section_curve(x_all, z_all, max_incidence_deg=max_incidence)
+        curve, _ = fit_stage_profile(x_all, z_all, max_incidence_deg=max_incidence)
         surface_z = float(np.median(z_all))
         if final:
-            s = self._samples(0.0, curve.length, self.point_spacing)  # step 5
+            s = self._samples(0.0, curve.length, self.options.point_spacing)  # step 5
             stage, s = self._stage_path(curve(s), y, s)
         if len(stage) < MIN_VIEW_POINTS:
             return ViewResult(name, angle, np.zeros((0, 3)), np.zeros(0), np.zeros(0), passes,
                               surface_z)
         if not final:
             # Levelling only needs the points of the last rescan, not a final pass.
-            keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.epsilon)
+            keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.options.epsilon)
             return ViewResult(name, angle, stage[keep], d[keep],
                               np.asarray(readings.snr, dtype=float)[keep], passes, surface_z)
         readings = self.rig.scan_path(stage, angle)
         d = np.asarray(readings.reading_mm, dtype=float)
         passes.append(self._pass_info("final", readings, d))
-        keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.epsilon)
+        keep = np.isfinite(d) & (np.abs(d - self.sensor.standoff) <= self.options.epsilon)
         return ViewResult(name, angle, stage[keep], d[keep],
                           np.asarray(readings.snr, dtype=float)[keep], passes, surface_z)
 
@@ -614,7 +654,7 @@ class ScanStrategy:
         if len(beyond) == 0:
             return False
         reach = np.hypot(beyond[:, 0] - x_all[end], beyond[:, 1] - z_all[end])
-        return bool(reach.max() >= self.probe_spacing)
+        return bool(reach.max() >= self.options.probe_spacing)
 
     def _find_surface(self, name, y, angle, passes, near=None, predicted=None):
         """Steps 1-2: linear passes along X at fixed Z until the sensor reads: first at the
@@ -630,7 +670,7 @@ class ScanStrategy:
         if near is not None:
             z_stage = near[1] + self.sensor.standoff
             xs = self._samples(near[0] - EDGE_WINDOW_MM, near[0] + EDGE_WINDOW_MM,
-                               min(self.point_spacing, EDGE_PROBE_SPACING_MM))
+                               min(self.options.point_spacing, EDGE_PROBE_SPACING_MM))
             xs = xs[(xs >= lim.x[0]) & (xs <= lim.x[1])]
             if lim.z[0] <= z_stage <= lim.z[1] and len(xs):
                 stage = np.column_stack([xs, np.full(len(xs), y), np.full(len(xs), z_stage)])
@@ -641,9 +681,9 @@ class ScanStrategy:
                 if np.count_nonzero(valid) >= MIN_EDGE_POINTS:
                     return stage[valid, 0], z_stage - d[valid]
         ax = self.kinematics.axis_point[0]
-        x0 = max(ax - self.search_radius, lim.x[0])
-        x1 = min(ax + self.search_radius, lim.x[1])
-        xs = self._samples(x0, x1, self.probe_spacing)
+        x0 = max(ax - self.options.search_radius, lim.x[0])
+        x1 = min(ax + self.options.search_radius, lim.x[1])
+        xs = self._samples(x0, x1, self.options.probe_spacing)
         known = [v for v in (predicted, self.state.surface_z.get(name)) if v is not None]
         levels = self._levels()
         if known:

@@ -1,5 +1,5 @@
-"""The conoscopic point sensor as a statistical model (paper Table 1, DESIGN.md "The rig and its
-sensor"): which readings exist, their SNR, their noise and their gross errors.
+"""The conoscopic point sensor as a statistical model (paper Table 1, docs/contracts.md "The sensor
+and its noise"): which readings exist, their SNR, their noise and their gross errors.
 
 One noise model serves measurement and registration: a reading's standard deviation is
 sigma(SNR) = sigma_ref * sqrt(SNR_ref / SNR), so 1/sigma^2 is proportional to SNR and the paper's
@@ -15,7 +15,7 @@ from ..core.errors import InputError
 
 NOISE_KINDS = ("uniform", "normal")
 # The normal option is clipped at this many sigma: the paper's Fig. 8 figures fit a normal error
-# of sigma = accuracy / 3 clipped at +-accuracy (DESIGN.md "Simulation noise").
+# of sigma = accuracy / 3 clipped at +-accuracy (docs/contracts.md "The sensor and its noise").
 NORMAL_CLIP_SIGMAS = 3.0
 
 

@@ -25,7 +25,7 @@ _ANCHORS_LAB = np.array([
 ])
 
 LUT_SIZE = 511          # odd, so that one entry is exactly zero deviation
-NAN_COLOR = (0.6, 0.6, 0.6)
+NAN_COLOUR = (0.6, 0.6, 0.6)
 
 # D65 white point, the reference of sRGB.
 _WHITE = np.array([0.95047, 1.0, 1.08883])
@@ -61,7 +61,7 @@ def _build_lut(size=LUT_SIZE):
 _LUT = _build_lut()
 
 
-def colormap_table(size=LUT_SIZE):
+def colourmap_table(size=LUT_SIZE):
     """(size, 3) sRGB colours from -limit to +limit, e.g. for a matplotlib ListedColormap."""
     return _LUT.copy() if size == LUT_SIZE else _build_lut(size)
 
@@ -73,21 +73,21 @@ def _check_limit(limit):
     return limit
 
 
-def deviation_colors(deviation, limit):
+def deviation_colours(deviation, limit):
     """(N, 3) sRGB floats in [0, 1] for signed deviations (mm); beyond +-limit the end colours,
     NaN grey. Vectorised lookup: a few ms for a quarter of a million points."""
     limit = _check_limit(limit)
     dev = np.asarray(deviation, dtype=float).ravel()
     scaled = np.clip(dev / limit, -1.0, 1.0)
     index = np.rint((np.nan_to_num(scaled) + 1.0) * 0.5 * (LUT_SIZE - 1)).astype(int)
-    colors = _LUT[index]
-    colors[~np.isfinite(dev)] = NAN_COLOR
-    return colors
+    colours = _LUT[index]
+    colours[~np.isfinite(dev)] = NAN_COLOUR
+    return colours
 
 
-def deviation_colors_uint8(deviation, limit):
+def deviation_colours_uint8(deviation, limit):
     """(N, 3) uint8 RGB, for image and mesh formats."""
-    return np.rint(deviation_colors(deviation, limit) * 255.0).astype(np.uint8)
+    return np.rint(deviation_colours(deviation, limit) * 255.0).astype(np.uint8)
 
 
 def legend_ticks(limit, n_ticks=9):
@@ -97,4 +97,4 @@ def legend_ticks(limit, n_ticks=9):
     if int(n_ticks) < 2:
         raise InputError("legend: at least 2 ticks needed, got %r" % (n_ticks,))
     values = np.linspace(-limit, limit, int(n_ticks))
-    return values, deviation_colors(values, limit)
+    return values, deviation_colours(values, limit)
