@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import airfoil as kernel
+from ..core import contracts
 from ..core import transforms as tf
 from ..core.errors import InputError
 
@@ -629,7 +630,7 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
     doc.update(stage.extras())
     with pipeline.AtomicOutput(out_dir) as out:
         with open(out.path("airfoil.json"), "w") as fh:
-            json.dump(doc, fh, indent=1, default=pipeline._json_default)
+            json.dump(doc, fh, indent=1, default=contracts.json_default)
         write_csv(out.path("airfoil.csv"), stage.blocks)
     progress(1.0, stage.verdict["summary"])
     return {"stage": stage, "result": result, "sections": table, "doc": doc}

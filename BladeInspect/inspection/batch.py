@@ -18,6 +18,7 @@ import json
 import os
 import shutil
 import socket
+import sys
 import threading
 import time
 
@@ -226,6 +227,21 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     return {"rows": ordered, "summary_csv": summary_path, "message": message}
 
 
+def _spawn_context():
+    """Worker processes started afresh, not forked: this process has threads (the distance and
+    ray-cast pools, BLAS), and a child forked from it can wait forever on a lock one of them held
+    (seen under FreeCAD 1.0). They run the distribution's Python, not FreeCADCmd, which is
+    sys.executable in a batch run from FreeCADCmd; report_one starts FreeCAD in each."""
+    import multiprocessing
+    context = multiprocessing.get_context("spawn")
+    executable = sys.executable
+    if not os.path.basename(executable).startswith("python"):
+        executable = os.path.join(sys.base_exec_prefix, "bin",
+                                  "python%d.%d" % sys.version_info[:2])
+    context.set_executable(executable)
+    return context
+
+
 def _attempt_log(out_dir, stem):
     # Absolute: a worker elsewhere runs in another folder (the lot's folder must be shared).
     return os.path.join(os.path.abspath(out_dir), ATTEMPTS_FOLDER, stem)
@@ -243,7 +259,8 @@ def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allo
                                       airfoil))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo)),
+                             mp_context=_spawn_context()) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
                                tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
                                airfoil):
