@@ -206,7 +206,7 @@ def _parity_votes(surfaces, domains, reversed_, voters):
         areas.append(np.mean(np.linalg.norm(np.cross(Su, Sv), axis=1)) * (u1 - u0) * (v1 - v0))
     spacing = max(np.sqrt(sum(areas) / MESH_CELLS), 1e-9)
     rng = np.random.default_rng(0)
-    triangles, tests, owners, offsets_out = [], [], [], []
+    triangles, tests, owners = [], [], []
     for f, (surf, domain) in enumerate(zip(surfaces, domains)):
         tris, centre_uv, on_mesh = _face_mesh(surf, domain, spacing)
         triangles.append(tris)

@@ -608,7 +608,7 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     opts = opts or Options()
-    heights = list(sections_mod.DEFAULT_HEIGHTS_PCT if heights_pct is None else heights_pct)
+    heights = list(contracts.SECTION_HEIGHTS_PCT if heights_pct is None else heights_pct)
     if nominal is None:
         nominal = pipeline.load_nominal(cad_path)
     doc = {"cad_file": cad_path or "built-in demo blade", "points_file": points_path}
