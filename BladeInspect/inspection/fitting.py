@@ -207,6 +207,8 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
         record.update(chosen.to_json())
         record["measured_to_cad_least_squares"] = out.start.tolist()
         _move(result, nominal, chosen)
+        record["cad_motion"] = record.pop("measured_to_cad")   # the fit's motion, CAD frame
+        record["measured_to_cad"] = np.asarray(result.measured_to_cad).tolist()
         seconds["deviations"] = time.perf_counter() - t0
     record["timing_s"] = seconds
     result.fit = record
