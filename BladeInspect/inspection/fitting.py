@@ -169,6 +169,15 @@ def _run(objective, result, nominal, choice, tolerance, free, labels, closest):
                     at_init=(np.asarray(result.deviation), np.asarray(result.normal)))
 
 
+def _tolerance_of_minimax(minimax, tolerance):
+    """The fit to the zone +-T from the minimax fit of the same points: the slack of a point is
+    T - |d|, so the pose of largest smallest slack is the pose of least largest |d| and the
+    margin is T - max |d| (exactly the same problem, solved once)."""
+    margin = float(tolerance) - minimax.max_abs_deviation
+    return dataclasses.replace(minimax, objective="tolerance", margin=margin,
+                               fits=bool(margin >= 0))
+
+
 def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None):
     """Move ``result`` (in place) to the pose of the chosen fit and record it in result.fit;
     with ``all_objectives`` also fit every other objective from the same start, for
@@ -184,8 +193,11 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
     for objective in wanted:
         progress(0.0, "fit: %s" % objective)
         t0 = time.perf_counter()
-        runs[objective] = _run(objective, result, nominal, choice, tolerance, free, labels,
-                               closest)
+        if objective == "tolerance" and runs.get("minimax") is not None:
+            runs[objective] = _tolerance_of_minimax(runs["minimax"], tolerance)
+        else:
+            runs[objective] = _run(objective, result, nominal, choice, tolerance, free,
+                                   labels, closest)
         seconds[objective] = time.perf_counter() - t0
     out = FitRuns(start=np.asarray(result.measured_to_cad).copy(),
                   start_deviation=np.asarray(result.deviation).copy(), runs=runs,
