@@ -202,6 +202,93 @@ class FitObjectivesTest(unittest.TestCase):
         self.assertLess(abs(np.median(moved.deviation[sel])), 0.005)
 
 
+def block_face_points(rng, per_face=400, inset=1.0, noise=0.001):
+    """Points on the six faces of the demo root block (cad.demo_blade.ROOT_BLOCK_*), away from
+    its edges, each moved along its face's normal by uniform noise of +-``noise`` mm."""
+    from BladeInspect.cad.demo_blade import ROOT_BLOCK_MIN, ROOT_BLOCK_SIZE
+    lo = np.array(ROOT_BLOCK_MIN)
+    hi = lo + np.array(ROOT_BLOCK_SIZE)
+    out = []
+    for axis in range(3):
+        for end in (lo[axis], hi[axis]):
+            p = rng.uniform(lo + inset, hi - inset, (per_face, 3))
+            p[:, axis] = end + rng.uniform(-noise, noise, per_face)
+            out.append(p)
+    return np.vstack(out)
+
+
+class DatumFitTest(unittest.TestCase):
+    """--fit datum on the demo blade with its root block: the part (block and blade) in a known
+    pose, the blade built twisted about the stacking axis relative to its root, the start a
+    pose near the truth (as a least-squares fit that the twist pulls away from it)."""
+
+    @classmethod
+    def setUpClass(cls):
+        from BladeInspect.cad.demo_blade import make_demo_blade
+        from BladeInspect.cad.nominal import nominal_from_shape
+        model = make_demo_blade(root_block=True)
+        cls.nominal = nominal_from_shape(model.shape, roles=model.roles)
+        rng = np.random.default_rng(11)
+        cls.block = block_face_points(rng)
+        cls.blade = demo_cloud(fx.demo_nominal(), lambda p: np.zeros(len(p)), 120)
+        R = Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix()
+        cls.part_to_measured = np.eye(4)
+        cls.part_to_measured[:3, :3] = R
+        cls.part_to_measured[:3, 3] = [12.0, -7.0, 4.0]
+
+    def datum_fit(self, twist_deg):
+        from BladeInspect.inspection import fitting
+        twist = Rotation.from_rotvec([0.0, 0.0, np.radians(twist_deg)]).as_matrix()
+        part = np.vstack([self.block, self.blade @ twist.T])
+        truth = np.linalg.inv(self.part_to_measured)                 # measured -> CAD
+        start_error = np.eye(4)
+        start_error[:3, :3] = Rotation.from_rotvec([2e-5, -3e-5, 4e-4]).as_matrix()
+        start_error[:3, 3] = [0.004, -0.003, 0.002]
+        start = start_error @ truth
+        result = fx.make_result(self.nominal, part @ start_error[:3, :3].T + start_error[:3, 3],
+                                measured_to_cad=start)
+        fitting.apply(result, self.nominal, fitting.FitChoice(objective="datum"), T)
+        return result, truth, part
+
+    def corner_error(self, A, B):
+        corners = np.asarray(self.nominal.bbox_corners, dtype=float)
+        c = np.c_[corners, np.ones(len(corners))]
+        return float(np.max(np.linalg.norm((c @ A.T - c @ B.T)[:, :3], axis=1)))
+
+    def test_the_root_blocks_pose_is_recovered_from_its_datum_faces(self):
+        for twist_deg in (0.0, 0.2):
+            with self.subTest(twist_deg=twist_deg):
+                result, truth, _ = self.datum_fit(twist_deg)
+                self.assertLess(self.corner_error(result.measured_to_cad, truth), 1e-3)
+                self.assertEqual([d["order"] for d in result.fit["datums"]],
+                                 ["primary", "secondary", "tertiary"])
+                self.assertEqual(result.fit["objective"], "datum")
+
+    def test_a_blade_twisted_relative_to_its_root_shows_the_twist(self):
+        result, _, part = self.datum_fit(0.2)
+        on_blade = np.arange(len(self.block), len(part))
+        expected = self.nominal.signed_distance(part[on_blade]).distance
+        np.testing.assert_allclose(result.deviation[on_blade], expected, atol=1e-3)
+        self.assertGreater(np.max(np.abs(expected)), 0.05)   # 0.2 deg at the chord's ends
+
+    def test_datum_faces_by_index_and_bad_names(self):
+        from BladeInspect.core.errors import InputError
+        from BladeInspect.inspection import fitting
+        roles = self.nominal.roles
+        by_index = ",".join(str(roles[r][0]) for r in fitting.DATUM_ROLES)
+        choice = fitting.FitChoice(objective="datum", datum_faces=by_index)
+        self.assertEqual([g[1] for g in fitting.datum_groups(choice, self.nominal)],
+                         [roles[r] for r in fitting.DATUM_ROLES])
+        for faces in ("datum_primary,nose,datum_tertiary", "0,1", "999,1,2"):
+            with self.assertRaises(InputError):
+                fitting.datum_groups(fitting.FitChoice(objective="datum", datum_faces=faces),
+                                     self.nominal)
+        with self.assertRaises(InputError):   # the suction and pressure sides are no frame
+            result, _, _ = self.datum_fit(0.0)
+            fitting.apply(result, self.nominal, fitting.FitChoice(
+                objective="datum", datum_faces="hub,tip,datum_tertiary"), T)
+
+
 class RegisterCommandTest(unittest.TestCase):
     """register --fit minimax --free rx,ry,rz on a point file of the demo blade (a STEP) in a
     known frame: the locked translations stay exactly where the least-squares ICP put them,

@@ -30,6 +30,9 @@ from . import sections as sections_mod
 ENGINE_AXIS = (1.0, 0.0, 0.0)        # CAD +X: the engine axis of a blade modelled along Z
 ZONE_HEIGHTS_PCT = tuple(np.arange(2.5, 100.0, 5.0))
 DEFAULT_OBJECTIVE = "least-squares"
+DATUM = "datum"
+OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM,)
+DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
 
 
 @dataclass
@@ -41,12 +44,20 @@ class FitChoice:
     weights_by_zone: Optional[str] = None
     decision_rule: str = "iso14253"
     engine_axis: tuple = ENGINE_AXIS
+    datum_faces: Optional[str] = None
 
     def __post_init__(self):
         # Checked before anything is measured or written: a typo must not cost a scan.
-        if self.objective not in fits.OBJECTIVES:
+        if self.objective not in OBJECTIVE_NAMES:
             raise InputError("--fit: unknown objective '%s' (use %s)"
-                             % (self.objective, ", ".join(fits.OBJECTIVES)))
+                             % (self.objective, ", ".join(OBJECTIVE_NAMES)))
+        if self.datum_faces is not None and self.objective != DATUM:
+            raise InputError("--datum-faces: for --fit datum only")
+        if self.objective == DATUM and self.free is not None:
+            raise InputError("--free: a datum reference frame fixes all six degrees of freedom")
+        if self.datum_faces is not None and len(self.datum_faces.split(",")) != 3:
+            raise InputError("--datum-faces: '%s' is not three faces (primary,secondary,"
+                             "tertiary, by index or name)" % self.datum_faces)
         if self.decision_rule not in decision_mod.RULES:
             raise InputError("--decision-rule: unknown rule '%s' (use %s)"
                              % (self.decision_rule, ", ".join(decision_mod.RULES)))
@@ -70,16 +81,23 @@ class FitChoice:
                 and self.weights_by_zone is None)
 
     def to_json(self):
-        return {"objective": self.objective, "free": self.free or "all",
-                "weights_by_zone": self.zone_weights(), "decision_rule": self.decision_rule,
-                "engine_axis": list(self.engine_axis)}
+        doc = {"objective": self.objective, "free": self.free or "all",
+               "weights_by_zone": self.zone_weights(), "decision_rule": self.decision_rule,
+               "engine_axis": list(self.engine_axis)}
+        if self.objective == DATUM:
+            doc["datum_faces"] = self.datum_faces or ",".join(DATUM_ROLES)
+        return doc
 
 
 def add_arguments(parser):
     """--fit, --free, --weights-by-zone and --decision-rule on a subcommand."""
-    parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=fits.OBJECTIVES,
+    parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=OBJECTIVE_NAMES,
                         help="fit objective after the robust least-squares ICP "
                              "(default least-squares: the ICP's pose)")
+    parser.add_argument("--datum-faces", default=None,
+                        help="--fit datum: primary,secondary,tertiary CAD faces by index or "
+                             "role name (default the CAD's datum_primary,datum_secondary,"
+                             "datum_tertiary)")
     parser.add_argument("--free", default=None,
                         help="free degrees of freedom, any of tx,ty,tz,rx,ry,rz and "
                              "t_stacking,r_stacking,t_engine,r_engine (default all six)")
@@ -92,7 +110,7 @@ def add_arguments(parser):
 
 def from_args(args):
     return FitChoice(objective=args.fit, free=args.free, weights_by_zone=args.weights_by_zone,
-                     decision_rule=args.decision_rule)
+                     decision_rule=args.decision_rule, datum_faces=args.datum_faces)
 
 
 def _axes(stacking, engine):
@@ -153,7 +171,64 @@ class FitRuns:
     seconds: dict
 
 
+def datum_groups(choice, nominal):
+    """[(name, face indices)] of the primary, secondary and tertiary datum faces."""
+    tokens = [t.strip() for t in (choice.datum_faces or ",".join(DATUM_ROLES)).split(",")]
+    groups = []
+    for token in tokens:
+        if token.isdigit():
+            index = int(token)
+            if index >= len(nominal.faces):
+                raise InputError("--datum-faces: face %d does not exist (the CAD has %d faces)"
+                                 % (index, len(nominal.faces)))
+            groups.append((token, [index]))
+        elif token in nominal.roles:
+            groups.append((token, list(nominal.roles[token])))
+        else:
+            raise InputError("--datum-faces: '%s' is neither a face index nor a face name of "
+                             "this CAD (names: %s)" % (token, ", ".join(sorted(nominal.roles))
+                                                       or "none"))
+    return groups
+
+
+@dataclass
+class DatumRun:
+    """A datum fit: the motion (CAD frame) and the planes it came from."""
+    transform: np.ndarray
+    planes: list
+    distances: np.ndarray          # (N,) every point's deviation at this pose
+    max_abs_deviation: float       # of the inliers, mm
+    margin: Optional[float] = None
+
+    def to_json(self):
+        return {"objective": DATUM, "free": "datum reference frame (all six)",
+                "cad_motion": np.asarray(self.transform).tolist(), "datums": self.planes}
+
+
+def _datum_run(result, nominal, choice):
+    from ..core import datum
+    groups = datum_groups(choice, nominal)
+    measured, cad, planes = [], [], []
+    for order, (name, faces) in zip(datum.ORDER, groups):
+        on_face = np.asarray(result.inlier, bool) & np.isin(result.face, faces)
+        label = "--datum-faces: %s datum %s" % (order, name)
+        measured.append(datum.plane_of(result.points_cad[on_face], label))
+        cad.append(datum.plane_of(nominal.samples.xyz[np.isin(nominal.samples.face, faces)],
+                                  label + " (CAD)"))
+        planes.append({"order": order, "faces": faces, "name": name,
+                       "n_points": measured[-1].n_points,
+                       "flatness_rms_mm": measured[-1].rms_mm,
+                       "cad_flatness_rms_mm": cad[-1].rms_mm})
+    G = datum.datum_pose(measured, cad)
+    distances = nominal.signed_distance(tf.apply_transform(G, result.points_cad)).distance
+    inlier = np.asarray(result.inlier, bool)
+    return DatumRun(transform=G, planes=planes, distances=distances,
+                    max_abs_deviation=float(np.max(np.abs(distances[inlier]))))
+
+
 def _run(objective, result, nominal, choice, tolerance, free, labels, closest):
+    if objective == DATUM:
+        return _datum_run(result, nominal, choice)
     if objective == "least-squares" and free is None and choice.weights_by_zone is None:
         return None
     weights = fit_weights(result)
@@ -189,6 +264,8 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
     labels = zones_of(result, nominal) if choice.weights_by_zone is not None else None
     closest = exact_closest_fn(nominal)
     wanted = fits.OBJECTIVES if all_objectives else (choice.objective,)
+    if choice.objective not in wanted:
+        wanted = wanted + (choice.objective,)
     runs, seconds = {}, {}
     for objective in wanted:
         progress(0.0, "fit: %s" % objective)
@@ -219,8 +296,13 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
         record.update(chosen.to_json())
         record["measured_to_cad_least_squares"] = out.start.tolist()
         _move(result, nominal, chosen)
-        record["cad_motion"] = record.pop("measured_to_cad")   # the fit's motion, CAD frame
+        if "measured_to_cad" in record:   # core.fits' pose is the motion in the CAD frame
+            record["cad_motion"] = record.pop("measured_to_cad")
         record["measured_to_cad"] = np.asarray(result.measured_to_cad).tolist()
+        if choice.objective == DATUM:
+            inlier = np.asarray(result.inlier, bool)
+            record.update(max_abs_deviation_mm=float(np.max(np.abs(
+                result.deviation[inlier]))), rms_mm=result.rms_mm)
         seconds["deviations"] = time.perf_counter() - t0
     record["timing_s"] = seconds
     result.fit = record
