@@ -88,18 +88,20 @@ class DecisionThroughVerdictTest(unittest.TestCase):
         cls.on = demo_cloud(cls.nominal, lambda p: np.zeros(len(p)))
         mid = cls.on[np.argmin(np.abs(cls.on[:, 2] - np.median(cls.on[:, 2])))]
         cls.cluster = np.argsort(np.linalg.norm(cls.on - mid, axis=1))[:6]
+        from BladeInspect.inspection import sections
+        axis, (lo, hi) = sections.span_axis_of(cls.nominal)
+        # The section's points are those near its plane, wherever their deviation puts them.
+        cls.table = sections.section_table(fx.make_result(cls.nominal, cls.on), cls.nominal,
+                                           heights_pct=[100.0 * (mid[2] - lo) / (hi - lo)])
 
     def verdict(self, value, rule):
-        from BladeInspect.inspection import sections, verdict
+        from BladeInspect.inspection import verdict
         dev = np.zeros(len(self.on))
         dev[self.cluster] = value
         result = fx.make_result(self.nominal, fx.displaced(self.nominal, self.on, dev))
         result = dataclasses.replace(result, pose_covariance=np.zeros((6, 6)))
-        z = self.on[self.cluster[0], 2]
-        axis, (lo, hi) = sections.span_axis_of(self.nominal)
-        table = sections.section_table(result, self.nominal,
-                                       heights_pct=[100.0 * (z - lo) / (hi - lo)])
-        return verdict.judge(result, table, tolerance=T, decision_rule=rule)
+        self.assertTrue(np.isin(self.cluster, self.table.sections[0].point_index).all())
+        return verdict.judge(result, self.table, tolerance=T, decision_rule=rule)
 
     def test_iso14253_and_simple_acceptance(self):
         values = [T - 2 * self.U, T - self.U / 2, T + self.U / 2, T + 2 * self.U]
@@ -169,9 +171,8 @@ class FitObjectivesTest(unittest.TestCase):
     def test_tolerance_fit_reports_the_least_violation(self):
         result = fx.make_result(self.nominal, demo_cloud(self.nominal,
                                                          suction_bump(self.nominal, 0.2)))
-        ls = self.fitted(result, "least-squares")
         tol = self.fitted(result, "tolerance")
-        lp = iterated_minimax_lp(self.nominal, ls.points_cad, ls.inlier)
+        lp = iterated_minimax_lp(self.nominal, result.points_cad, result.inlier)
         self.assertFalse(tol.fit["fits"])
         self.assertAlmostEqual(tol.fit["violation_mm"], lp - T, delta=0.5e-3)
 
@@ -185,21 +186,31 @@ class FitObjectivesTest(unittest.TestCase):
         with self.assertRaises(InputError):
             fitting.FitChoice(free="tx,spin")
 
-    def test_zone_weights_move_the_pose_towards_the_weighted_zone(self):
-        """A suction side offset by +10 um against a pressure side at 0: least squares with
-        the suction side weighted 9:1 leaves it a tenth of the offset (the weighted mean)."""
+    def test_zone_weights_against_the_weighted_mean_shift(self):
+        """The points on the CAD's suction face offset by +10 um against the pressure face's
+        at 0, translations free, the suction zone weighted 9:1 and the edges left out: the
+        translation is the weighted least-squares shift, t = -(sum w n n^T)^-1 sum w n d, the
+        labels the fit's own (its zones must put the suction face's points on the suction
+        side or an edge)."""
         from BladeInspect.inspection import fitting
-        labels_of = lambda r: fitting.zones_of(r, self.nominal)
         on = demo_cloud(self.nominal, lambda p: np.zeros(len(p)))
-        base = fx.make_result(self.nominal, on)
-        suction = labels_of(base) == "suction"
-        result = fx.make_result(self.nominal, fx.displaced(self.nominal, on, 0.01 * suction))
+        on_suction = np.isin(self.nominal.signed_distance(on).face,
+                             self.nominal.roles["suction"])
+        result = fx.make_result(self.nominal, fx.displaced(self.nominal, on, 0.01 * on_suction))
         moved = dataclasses.replace(result)
-        fitting.apply(moved, self.nominal, fitting.FitChoice(
-            weights_by_zone="suction=9,pressure=1,LE=0,TE=0"), T)
+        weights = {"suction": 9.0, "pressure": 1.0, "LE": 0.0, "TE": 0.0}
+        runs = fitting.apply(moved, self.nominal, fitting.FitChoice(
+            free="tx,ty,tz", weights_by_zone=",".join("%s=%g" % kv for kv in weights.items())),
+            T)
+        labels = runs.zone_labels
         self.assertIn("zone_rule", moved.fit)
-        sel = suction & moved.inlier
-        self.assertLess(abs(np.median(moved.deviation[sel])), 0.005)
+        self.assertEqual(set(labels[on_suction]) - {"LE", "TE"}, {"suction"})
+        w = np.array([weights[z] for z in labels])
+        n, d = result.normal, result.deviation
+        t = -np.linalg.solve((w[:, None] * n).T @ n, (w[:, None] * n).T @ d)
+        np.testing.assert_allclose(moved.fit["twist"]["t_mm"], t, atol=5e-4)
+        self.assertEqual(moved.fit["twist"]["w_rad"], [0.0, 0.0, 0.0])
+        self.assertLess(np.median(moved.deviation[labels == "suction"]), 0.003)
 
 
 def block_face_points(rng, per_face=400, inset=1.0, noise=0.001):
