@@ -167,7 +167,8 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
-    'message': one line for the command line}. ``allow_mismatch``, ``fit_choice``: as for `report`."""
+    'message': one line for the command line}. ``allow_mismatch``, ``fit_choice``: as for
+    `report`."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
