@@ -78,6 +78,16 @@ ALLOW_MISMATCH_HELP = ("write the result even when the scan does not fit the CAD
                        "the surface), with the warning in result.json")
 
 
+def fitting_args(parser):
+    from .inspection.fitting import add_arguments
+    add_arguments(parser)
+
+
+def _fit_choice(args):
+    from .inspection.fitting import from_args
+    return from_args(args)
+
+
 def build_parser():
     p = Parser(prog="bladeinspect", description="Register turbine blade scans to their CAD "
                "and report the deviations.")
@@ -95,6 +105,9 @@ def build_parser():
     r.add_argument("--seed", type=_seed, default=0)
     r.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
     r.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
+    r.add_argument("--tolerance", type=float, default=0.04,
+                   help="profile tolerance +-T mm (the fit check and --fit tolerance)")
+    fitting_args(r)
 
     s = sub.add_parser("simulate", help="the paper's simulation test bed (4.1)")
     s.add_argument("--cad", default=None, help="CAD file (default: the built-in demo blade)")
@@ -135,6 +148,9 @@ def build_parser():
     rp.add_argument("--seed", type=_seed, default=0)
     rp.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
     rp.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
+    rp.add_argument("--rig-file", default=None,
+                    help="RIG.json whose calibration uncertainty enters U")
+    fitting_args(rp)
 
     b = sub.add_parser("batch", help="inspect every point file of a production lot")
     b.add_argument("--cad", required=True)
@@ -144,6 +160,7 @@ def build_parser():
     b.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     b.add_argument("--scheduler", default=None, help="Dask scheduler tcp://HOST:PORT")
     b.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
+    fitting_args(b)
 
     i = sub.add_parser("inspect", help="blind scan, register, CAD-planned scan, report")
     i.add_argument("--cad", default=None)
@@ -162,6 +179,7 @@ def build_parser():
                         "last complete section (same CAD, seed and options)")
     i.add_argument("--flip-face", type=_face_indices, default=[], help=FLIP_FACE_HELP)
     i.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
+    fitting_args(i)
 
     a = sub.add_parser("airfoil", help="airfoil characteristics per section (nominal, or "
                        "measured against nominal with --points)")
@@ -219,7 +237,8 @@ def _print_result(result, out_dir, stream=None):
 def cmd_register(args):
     from .inspection.pipeline import run_register
     result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress(),
-                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch)
+                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
+                          fit_choice=_fit_choice(args), tolerance=args.tolerance)
     _print_result(result, args.out)
 
 
@@ -333,16 +352,23 @@ def cmd_report(args, cad=None, points=None):
     summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
                          tolerance=args.tolerance, seed=args.seed, progress=Progress(),
                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
-                         airfoil=_airfoil_options(args), **options)
+                         airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
+                         measurement_model=_model(args), **options)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
+
+
+def _model(args):
+    from .inspection.uncertainty import model_from_rig_file
+    return model_from_rig_file(args.rig_file)
 
 
 def cmd_batch(args):
     from .inspection.batch import run_batch
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
-                        allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args))
+                        allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args),
+                        fit_choice=_fit_choice(args))
     sys.stdout.write("%s\n" % summary["message"])
 
 
@@ -354,7 +380,8 @@ def cmd_inspect(args):
                           seed=args.seed, rig_file=args.rig_file, progress=Progress(),
                           resume=args.resume, flip_faces=args.flip_face,
                           allow_mismatch=args.allow_mismatch,
-                          airfoil=_airfoil_options(args))
+                          airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
+                          measurement_model=_model(args))
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 

@@ -194,9 +194,20 @@ def section_points(params, s):
 _CACHE = {}
 
 
-def make_demo_blade(params=None):
+# The root block of make_demo_blade(root_block=True), mm: a box below the hub with a gap (the
+# platform and fillets between are not modelled), its faces the datum faces of a fixture.
+ROOT_BLOCK_MIN = (-30.0, -15.0, -25.0)
+ROOT_BLOCK_SIZE = (70.0, 35.0, 20.0)
+
+
+def make_demo_blade(params=None, root_block=False):
     """The demo blade as a ``BladeModel``: a valid closed solid with roles suction, pressure,
-    hub (plane z = 0) and tip (plane z = span)."""
+    hub (plane z = 0) and tip (plane z = span). ``root_block``: a compound of the blade and a
+    root block below it (ROOT_BLOCK_*), with the roles root_block (its six faces) and
+    datum_primary (its bottom, z = min), datum_secondary (its side y = min) and
+    datum_tertiary (its end x = min)."""
+    if root_block:
+        return _with_root_block(make_demo_blade(params))
     params = BladeParams() if params is None else params
     if not isinstance(params, BladeParams):
         raise InputError("make_demo_blade: params must be a BladeParams, got %s"
@@ -207,6 +218,28 @@ def make_demo_blade(params=None):
     shape, roles = _CACHE[params]
     return BladeModel(shape=shape.copy(), roles={k: list(v) for k, v in roles.items()},
                       params=params)
+
+
+def _with_root_block(model):
+    import Part
+    from FreeCAD import Vector
+    box = Part.makeBox(*ROOT_BLOCK_SIZE, Vector(*ROOT_BLOCK_MIN))
+    shape = Part.makeCompound([model.shape, box])
+    first = len(model.shape.Faces)
+    lo = np.array(ROOT_BLOCK_MIN)
+
+    def face_at(axis):
+        for k, face in enumerate(box.Faces):
+            bb = face.BoundBox
+            extent = (bb.XLength, bb.YLength, bb.ZLength)[axis]
+            low = (bb.XMin, bb.YMin, bb.ZMin)[axis]
+            if extent < 1e-9 and abs(low - lo[axis]) < 1e-9:
+                return first + k
+        raise AssertionError("root block: no face at the low end of axis %d" % axis)
+    roles = dict(model.roles, root_block=list(range(first, first + len(box.Faces))),
+                 datum_primary=[face_at(2)], datum_secondary=[face_at(1)],
+                 datum_tertiary=[face_at(0)])
+    return BladeModel(shape=shape, roles=roles, params=model.params)
 
 
 def _build(params):

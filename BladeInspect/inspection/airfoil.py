@@ -559,6 +559,8 @@ def attach(result, nominal, table, verdict, opts=None):
                               if verdict["pass"] else
                               "%s; %s" % (verdict["summary"], stage.verdict["summary"]))
         verdict["pass"] = False
+        if "verdict" in verdict:   # the part's decision (core.decision) takes the failure in
+            verdict["verdict"] = "fail"
     verdict["airfoil"] = stage.verdict
     return stage
 

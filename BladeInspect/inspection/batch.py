@@ -71,7 +71,8 @@ def _row_from_result_json(name, doc):
     worst = max((dev.get("min"), dev.get("max")), key=lambda v: abs(v or 0.0))
     row = {"file": name, "status": "ok", "n_points": doc.get("n_points"),
            "rms_mm": doc.get("rms_mm"), "worst_deviation_mm": worst,
-           "verdict": "pass" if verdict.get("pass") else "fail",
+           # the decision rule's pass / not proven / fail (issue 16), else today's pass/fail
+           "verdict": verdict.get("verdict") or ("pass" if verdict.get("pass") else "fail"),
            "pose_uncertainty_mm": doc.get("pose_uncertainty_mm"), "error": ""}
     for sec in (doc.get("sections") or {}).get("sections", []):
         for key in SECTION_FIELDS:
@@ -91,7 +92,7 @@ def _read_done(folder):
 
 
 def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
-               allow_mismatch=False, airfoil=None):
+               allow_mismatch=False, airfoil=None, fit_choice=None):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
     ``attempt_log``: the file this run is recorded in before it begins."""
     # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
@@ -106,7 +107,7 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
     try:
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
                    nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch,
-                   airfoil=airfoil)
+                   airfoil=airfoil, fit_choice=fit_choice)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -168,13 +169,13 @@ def _csv_value(v):
 
 def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
               tolerance=PROFILE_TOLERANCE_MM, seed=0, progress=None,
-              allow_mismatch=False, airfoil=None):
+              allow_mismatch=False, airfoil=None, fit_choice=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
-    'message': one line for the command line}. ``allow_mismatch``, ``airfoil``: as for
-    `report`; with ``airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil)."""
+    'message': one line for the command line}. ``allow_mismatch``, ``airfoil``, ``fit_choice``:
+    as for `report`; with ``airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil)."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
@@ -204,10 +205,10 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     t0 = time.perf_counter()
     if todo and scheduler:
         _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                  airfoil)
+                  airfoil, fit_choice)
     elif todo:
         _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                   airfoil)
+                   airfoil, fit_choice)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
     airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
@@ -217,8 +218,10 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
              for k in ("pass", "fail")}
     retried = ["%s (%d attempts)" % (r["file"], r["attempts"]) for r in ordered
                if (r.get("attempts") or 0) > 1]
-    message = ("%d files: %d pass, %d fail, %d error (%d already done, %.1f s)%s; %s"
+    not_proven = sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == "not proven")
+    message = ("%d files: %d pass, %d fail, %s%d error (%d already done, %.1f s)%s; %s"
                % (len(files), count["pass"], count["fail"],
+                  "%d not proven, " % not_proven if not_proven else "",
                   sum(1 for r in ordered if r["status"] == "error"),
                   len(files) - len(todo), time.perf_counter() - t0,
                   ("; retried after a lost worker: " + ", ".join(retried)) if retried else "",
@@ -248,7 +251,7 @@ def _attempt_log(out_dir, stem):
 
 
 def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-               airfoil=None):
+               airfoil=None, fit_choice=None):
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
@@ -256,21 +259,21 @@ def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allo
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
                                       seed, _attempt_log(out_dir, stem), allow_mismatch,
-                                      airfoil))
+                                      airfoil, fit_choice))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                              mp_context=_spawn_context()) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
                                tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
-                               airfoil):
+                               airfoil, fit_choice):
                    stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
 def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-              airfoil=None):
+              airfoil=None, fit_choice=None):
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -288,7 +291,7 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, all
         for stem, path in todo:
             fut = client.submit(report_one, cad, os.path.abspath(path),
                                 os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
-                                _attempt_log(out_dir, stem), allow_mismatch, airfoil,
+                                _attempt_log(out_dir, stem), allow_mismatch, airfoil, fit_choice,
                                 pure=False)
             stems[fut.key] = stem
             futures.append(fut)

@@ -176,7 +176,7 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
         pose_unmeasured=unmeasured, pose_uncertainty_statistical_mm=float(statistical),
-        pose_uncertainty_includes_rival=includes_rival)
+        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights)
 
 
 def _sections_json(table, plan):
@@ -203,7 +203,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
                 seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
                 scan_options=None, on_plan=None, resume=False, flip_faces=(),
-                allow_mismatch=False, airfoil=None):
+                allow_mismatch=False, airfoil=None, fit_choice=None, measurement_model=None):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (measurement.scan.scan_to_dir, e.g. n_sections).
@@ -213,6 +213,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     outward side is reversed (``--flip-face``, cad.orient). ``allow_mismatch``: go on with a
     blind scan that does not fit the CAD, with the warning (pipeline.register). ``airfoil``: an
     inspection.airfoil.Options to add the airfoil characteristics (issue 15; None: none).
+    ``fit_choice``, ``measurement_model``: the fit and the decision, as for `report`.
     Returns a summary dict. The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
@@ -260,20 +261,23 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
             scan_options = dict(checkpoint.identity["scan_options"] or {})
             register_options = {"allow_mismatch": allow_mismatch, "tolerance": tolerance,
                                 "cad_source": cad_path or "the demo blade"}
+            judge_options = {"fit_choice": fit_choice,   # hook: issue 16
+                             "measurement_model": measurement_model}
             try:
                 if complete:
                     summary = _complete_loop(nominal, checkpoint.rig, kinematics, heights,
                                              seed, epsilon, cmm_data, tolerance, pitch, out,
                                              checkpoint, timing, progress, document,
                                              scan_options, cad_path or "built-in demo blade",
-                                             register_options, airfoil=airfoil)
+                                             register_options, judge_options,
+                                             airfoil=airfoil)
                 else:
                     summary = _loop(nominal, checkpoint.rig, kinematics, heights, seed, epsilon,
                                     cmm_data, tolerance, out, checkpoint, timing, progress,
                                     plan_sections, scan_mod, pipeline, sections_mod,
                                     verdict_mod, write_report, document, scan_options,
                                     cad_path or "built-in demo blade", register_options,
-                                    airfoil=airfoil)
+                                    judge_options, airfoil=airfoil)
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
@@ -335,7 +339,7 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
 def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out,
           checkpoint, timing, progress, plan_sections, scan_mod, pipeline, sections_mod,
           verdict_mod, write_report, document, scan_options, cad_label, register_options,
-          airfoil=None):
+          judge_options=None, airfoil=None):
     # 1-2. blind section scan and its registration
     resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "planned" else None
     scan_record, blind, blind_rig_s, first = _blind_stage(
@@ -422,7 +426,7 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
                                      "inspect: blind and planned scans")
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_planned, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
-                                        verdict_mod)
+                                        verdict_mod, **(judge_options or {}))
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     timing["sections"] = time.perf_counter() - t0
@@ -514,15 +518,25 @@ def _save_plan(plan, checkpoint):
 
 
 def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm_data,
-                       tolerance, sections_mod, verdict_mod):
+                       tolerance, sections_mod, verdict_mod, fit_choice=None,
+                       measurement_model=None):
     """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
-    indexed back into the whole result, and the verdict on every point."""
+    indexed back into the whole result, and the verdict on every point; the result moved to
+    the pose of ``fit_choice`` first (inspection.fitting), its fit sensitivity recorded."""
+    from . import fitting   # hook: issue 16
+    fit_choice = fit_choice or fitting.FitChoice()
+    runs = fitting.apply(result, nominal, fit_choice, tolerance, all_objectives=True)
     rows = np.arange(n_blind, n_blind + n_rows)
     table = sections_mod.section_table(result.planned_rows(rows), nominal, heights_pct=heights,
                                        span_axis=span_axis, cmm=cmm_data)
     for sec in table.sections:
         sec.point_index = sec.point_index + n_blind
-    return table, verdict_mod.judge(result, table, tolerance=tolerance)
+    judge_options = {"measurement_model": measurement_model}
+    verdict = verdict_mod.judge(result, table, tolerance=tolerance,
+                                decision_rule=fit_choice.decision_rule, **judge_options)
+    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, fit_choice,
+                                                 judge_options)
+    return table, verdict
 
 
 def _blind_column(pointset, name, n):
@@ -534,7 +548,7 @@ def _blind_column(pointset, name, n):
 
 def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
                    out, checkpoint, timing, progress, document, scan_options, cad_label,
-                   register_options, airfoil=None):
+                   register_options, judge_options=None, airfoil=None):
     """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
     the whole blade rastered every ``pitch`` mm (measurement.complete) from that pose, ICP on every
     point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
@@ -609,7 +623,7 @@ def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, t
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_read, heights,
                                         span_axis, cmm_data, tolerance, sections_mod,
-                                        verdict_mod)
+                                        verdict_mod, **(judge_options or {}))
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     timing["sections"] = time.perf_counter() - t0

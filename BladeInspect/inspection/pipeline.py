@@ -382,14 +382,15 @@ def _check_time(fit, time_limit_s):
 # ---------------------------------------------------------------- the whole registration
 
 def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
-             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None):
+             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None,
+             fit_choice=None):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
     Refused (InputError) before any fitting when the points are too degenerate to fix a pose
     or do not match the CAD's size, and after it when they do not fit the CAD (see
     inspection.checks; ``allow_mismatch`` keeps the result with a warning instead, and
     ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
-    in those messages."""
+    in those messages. ``fit_choice``: an inspection.fitting.FitChoice applied after the ICP."""
     progress = progress or _no_progress
     timing = {}
     xyz = _check_points(pointset)
@@ -475,7 +476,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
                                                          nominal.bbox_corners)
     progress(1.0, "registered: RMS %.4f mm, pose uncertainty %.2f um"
              % (rms, uncertainty * 1000.0))
-    return RegistrationResult(
+    result = RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
         columns=dict(pointset.columns), n_rows_skipped=int(pointset.n_rows_skipped),
@@ -484,7 +485,11 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
         pose_unmeasured=unmeasured, surface_fit=fit_record,
         pose_uncertainty_statistical_mm=float(statistical),
-        pose_uncertainty_includes_rival=includes_rival)
+        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights)
+    if fit_choice is not None:   # hook: inspection.fitting (issue 16)
+        from . import fitting
+        fitting.apply(result, nominal, fit_choice, tolerance)
+    return result
 
 
 def pose_summary(fit, nominal):
@@ -552,6 +557,9 @@ def result_json(result, extra=None):
         "pose_unmeasured": list(result.pose_unmeasured),
         "surface_fit": result.surface_fit,
     }
+    for name in ("fit", "fit_sensitivity"):   # hook: inspection.fitting (issue 16)
+        if getattr(result, name, None) is not None:
+            doc[name] = getattr(result, name)
     if extra:
         doc.update(extra)
     return doc
@@ -639,7 +647,7 @@ def write_register_outputs(out_dir, result, extra=None, output=None):
 
 
 def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),
-                 allow_mismatch=False):
+                 allow_mismatch=False, fit_choice=None, tolerance=PROFILE_TOLERANCE_MM):
     """The `register` command: load, register, write. Returns the RegistrationResult."""
     checks.check_out_dir(out_dir)
     t0 = time.perf_counter()
@@ -649,7 +657,8 @@ def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_fac
     points = load_points(points_path)
     t_pts = time.perf_counter() - t0
     result = register(nominal, points, seed=seed, progress=progress,
-                      allow_mismatch=allow_mismatch, cad_source=cad_path or "the demo blade")
+                      allow_mismatch=allow_mismatch, cad_source=cad_path or "the demo blade",
+                      fit_choice=fit_choice, tolerance=tolerance)
     result.timing_s = dict(load_cad=t_cad, load_points=t_pts, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
     write_register_outputs(out_dir, result)

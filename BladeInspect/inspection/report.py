@@ -25,6 +25,7 @@ from ..core.errors import InputError
 from . import airfoil as airfoil_mod
 from . import airfoil_report
 from . import sections as sections_mod
+from . import fit_report
 from . import verdict as verdict_mod
 from .result import rival_lines
 
@@ -34,8 +35,8 @@ MAX_WHISKERS = 1500
 DPI = 110
 PDF_DPI = 150
 
-PAGE_TITLES = ("Summary", "Deviation map", "Deviation histogram (Table 3)",
-               "Section profile errors (Table 2)")
+PAGE_TITLES = ("Summary", "Decision rule, uncertainty and fit", "Deviation map",
+               "Deviation histogram (Table 3)", "Section profile errors (Table 2)")
 
 
 def _mpl():
@@ -445,10 +446,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
              "<p class='note'>%s; points: %s; CAD: %s</p>" % (
                  stamp, html.escape(result.source or "-"), html.escape(result.cad_source or "-")),
              "<h2>Verdict</h2><p><span class='%s'>%s</span> profile tolerance +-%.3f mm</p>" % (
-                 "pass" if verdict["pass"] else "fail", "PASS" if verdict["pass"] else "FAIL",
+                 "pass" if verdict["pass"] else "fail", fit_report.verdict_word(verdict),
                  tolerance),
              "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in verdict_lines) + "</ul>",
              "<h2>Pose and its uncertainty</h2>", _html_table(["Quantity", "Value"], p_rows)]
+    parts += fit_report.html_parts(result, verdict, _html_table)   # hook: issue 16
     for w in list(result.warnings) + list(table.warnings):
         parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
 
@@ -460,7 +462,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         fig.text(0.06, 0.925, "%s   points: %s" % (stamp, os.path.basename(result.source or "-")),
                  fontsize=8)
         fig.text(0.06, 0.89, "%s  (profile tolerance +-%.3f mm)"
-                 % ("PASS" if verdict["pass"] else "FAIL", tolerance), fontsize=14,
+                 % (fit_report.verdict_word(verdict), tolerance), fontsize=14,
                  color="#2a7d2e" if verdict["pass"] else "#b3261e", weight="bold")
         y = 0.86
         for line in verdict_lines[:24]:
@@ -473,6 +475,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
                      cellLoc="left", colWidths=[0.45, 0.55])
         t.auto_set_font_size(False)
         t.set_fontsize(7.5)
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+
+        fig = fit_report.pdf_page(plt, result, verdict, PDF_DPI)   # hook: issue 16
         pdf.savefig(fig, dpi=PDF_DPI)
         plt.close(fig)
         n_pages += 1
@@ -547,14 +554,18 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
                seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
-               nominal=None, document=True, flip_faces=(), allow_mismatch=False, airfoil=None):
+               nominal=None, document=True, flip_faces=(), allow_mismatch=False, airfoil=None,
+               fit_choice=None, measurement_model=None):
     """Register, tabulate the sections, judge and write result.json, deviations.csv,
     report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
     made in a private folder beside out_dir and moved in only when every one is complete.
     ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
     ``--flip-face`` (cad.orient). ``allow_mismatch``: write the result of a scan that does not
     fit the CAD, with the warning (pipeline.register). ``airfoil``: an inspection.airfoil.Options
-    to add the airfoil characteristics (issue 15; None: none). Returns a summary dict."""
+    to add the airfoil characteristics (issue 15; None: none). ``fit_choice``
+    (inspection.fitting.FitChoice, default least squares and ISO 14253-1) and
+    ``measurement_model`` (inspection.uncertainty) choose the fit and the decision.
+    Returns a summary dict."""
     from . import pipeline
     from .checks import check_out_dir
     check_out_dir(out_dir)
@@ -578,8 +589,15 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PRO
 
     t0 = time.perf_counter()
     progress(0.82, "section table")
+    from . import fitting   # hook: issue 16, the fit, its sensitivity and the decision
+    fit_choice = fit_choice or fitting.FitChoice()
+    runs = fitting.apply(result, nominal, fit_choice, tolerance, all_objectives=True)
     table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance)
+    judge_options = {"measurement_model": measurement_model}
+    verdict = verdict_mod.judge(result, table, tolerance=tolerance,
+                                decision_rule=fit_choice.decision_rule, **judge_options)
+    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, fit_choice,
+                                                 judge_options)
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0

@@ -37,6 +37,11 @@ class RegistrationResult:
     # pose (pipeline.uncertainty_with_rival).
     pose_uncertainty_statistical_mm: Optional[float] = None
     pose_uncertainty_includes_rival: bool = False
+    # The fine ICP's weights (SNR x robust) per point, the fit objective's record and the
+    # fit-sensitivity table (inspection.fitting), written into result.json when present.
+    icp_weights: Optional[np.ndarray] = None
+    fit: Optional[dict] = None
+    fit_sensitivity: Optional[dict] = None
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
@@ -50,6 +55,7 @@ class RegistrationResult:
             self, points_cad=self.points_cad[rows], deviation=self.deviation[rows],
             inlier=self.inlier[rows], closest=self.closest[rows], normal=self.normal[rows],
             face=self.face[rows], snr=None if self.snr is None else self.snr[rows],
+            icp_weights=None if self.icp_weights is None else self.icp_weights[rows],
             columns=columns, deviation_stats=stats.deviation_statistics(self.deviation[rows]))
 
     @property

@@ -17,8 +17,10 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..core.contracts import PROFILE_TOLERANCE_MM
+from ..core import decision as decision_mod
 from ..core.errors import InputError
 from .sections import classify
+from . import uncertainty as uncertainty_mod
 
 SPOT_NEIGHBOURS = 8
 MIN_SPOT_POINTS = 3
@@ -67,10 +69,32 @@ def place_of(table, xyz):
     return k, pct, zone
 
 
+def decided(value, U, tolerance, rule):
+    """core.decision.decide against +-tolerance as JSON: verdict, U_mm, tur. A U that is not
+    finite (a pose direction the points do not measure) proves nothing: not proven."""
+    if not np.isfinite(U):
+        return {"verdict": decision_mod.NOT_PROVEN, "U_mm": None, "tur": 0.0}
+    d = decision_mod.decide(value, U, -tolerance, tolerance, rule=rule)
+    return {"verdict": d.verdict, "U_mm": float(U),
+            "tur": None if d.test_uncertainty_ratio is None or
+            not np.isfinite(d.test_uncertainty_ratio) else float(d.test_uncertainty_ratio)}
+
+
 def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NEIGHBOURS,
-          min_spot_points=MIN_SPOT_POINTS, n_worst=5):
+          min_spot_points=MIN_SPOT_POINTS, n_worst=5, decision_rule="iso14253",
+          measurement_model=None):
     """The verdict as JSON-ready data: overall pass, per-section pass (optical, and CMM when
-    present), the out-of-tolerance spots worst first with their place, and a one-line summary."""
+    present), the out-of-tolerance spots worst first with their place, and a one-line summary.
+
+    Every judged value (each section's worst deviation, each listed spot's worst, and the
+    part's worst inlier under ``part``) also carries its expanded uncertainty U
+    (inspection.uncertainty, ``measurement_model``), the test uncertainty ratio T / U and its
+    verdict under ``decision_rule`` (core.decision: pass, not proven, fail); ``verdict`` is
+    the part's, combined (core.decision.combine) from the sections' and the spots'. ``pass``
+    is True only when that verdict is pass: a "not proven" is never rounded to pass."""
+    if decision_rule not in decision_mod.RULES:
+        raise InputError("--decision-rule: unknown rule '%s' (use %s)"
+                         % (decision_rule, ", ".join(decision_mod.RULES)))
     tolerance = float(tolerance)
     if not np.isfinite(tolerance) or tolerance <= 0:
         raise InputError("tolerance: must be a positive number of mm, got %r" % (tolerance,))
@@ -123,19 +147,48 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
             worst = counted[np.argmax(counted_dev)]
             entry["worst_zone"] = sec.zone[np.flatnonzero(idx == worst)[0]] or None
             entry["worst_deviation_mm"] = float(dev[worst])
+            entry.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
+                result, worst, measurement_model)[0], tolerance, decision_rule))
         if sec.cmm is not None:
             cmm_abs = np.abs(sec.cmm_deviation)
             entry["cmm_max_abs_mm"] = float(cmm_abs.max()) if len(cmm_abs) else None
             entry["cmm_pass"] = bool(len(cmm_abs) > 0 and (cmm_abs <= tolerance).all())
         sections_out.append(entry)
 
-    passed = bool(not spots and all(s["pass"] is not False for s in sections_out))
+    for spot, (_, worst, _) in zip(spot_out, spots):
+        spot.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
+            result, worst, measurement_model)[0], tolerance, decision_rule))
+    # The part's largest deviation among the fit's inliers (what minimax minimises), with its
+    # own U and verdict: reported beside the sections'; the part's verdict is theirs and the
+    # spots' (a defect the robust fit rejected is a spot, not an inlier).
+    judged = np.flatnonzero(np.asarray(result.inlier, dtype=bool))
+    judged = judged[~np.isin(judged, isolated)]
+    part = None
+    if len(judged):
+        worst = judged[np.argmax(np.abs(dev[judged]))]
+        part = {"worst_deviation_mm": float(dev[worst]), "of": "the fit's inliers",
+                "xyz": result.points_cad[worst].tolist()}
+        part.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
+            result, worst, measurement_model)[0], tolerance, decision_rule))
+    decision = decision_mod.combine([s["verdict"] for s in sections_out if "verdict" in s]
+                                    + [s["verdict"] for s in spot_out])
+    passed = bool(not spots and all(s["pass"] is not False for s in sections_out)
+                  and decision in (decision_mod.PASS, None))
     unmeasured = [s["label"] for s in sections_out if s["pass"] is None]
     n_out = int(len(out_idx))
     if passed:
         summary = "PASS: within +-%.3f mm" % tolerance
         if len(isolated):
             summary += " except %d isolated point(s) treated as sensor outliers" % len(isolated)
+    elif decision == decision_mod.NOT_PROVEN:
+        not_proven = [s["label"] for s in sections_out
+                      if s.get("verdict") == decision_mod.NOT_PROVEN]
+        summary = ("NOT PROVEN (%s): a judged deviation lies within its U of +-%.3f mm"
+                   % (decision_rule, tolerance))
+        if not_proven:
+            summary += "; section(s) %s not proven" % ", ".join(not_proven)
+        if spot_out:
+            summary += "; worst %s" % spot_out[0]["text"]
     else:
         failing = [s["label"] for s in sections_out if s["pass"] is False]
         summary = "FAIL: %d spot(s) outside +-%.3f mm" % (len(spots), tolerance)
@@ -157,4 +210,10 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
         "min_spot_points": int(min_spot_points),
         "worst_spots": spot_out,
         "sections": sections_out,
+        "decision_rule": decision_rule,
+        "decision_rule_text": decision_mod.RULE_TEXT[decision_rule],
+        "verdict": decision,
+        "part": part,
+        "measurement_model": (measurement_model
+                              or uncertainty_mod.MeasurementModel()).to_json(),
     }

@@ -1,0 +1,114 @@
+"""The report's decision, uncertainty and fit pages (issue 16): the decision rule, U and the
+test uncertainty ratio of every judged value, the fit used and the fit-sensitivity table."""
+
+import html
+
+from ..core import decision as decision_mod
+from . import fitting
+
+VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
+                decision_mod.FAIL: "FAIL"}
+
+
+def verdict_word(verdict):
+    """PASS, NOT PROVEN or FAIL: the decision rule's verdict, else today's pass/fail."""
+    if verdict.get("verdict") in VERDICT_WORD:
+        return VERDICT_WORD[verdict["verdict"]]
+    return "PASS" if verdict["pass"] else "FAIL"
+
+
+def _u(value):
+    return "-" if value is None else "%.4f" % value
+
+
+def decision_rows(verdict):
+    """(header, rows): each judged value with its U (k = 2), TUR and verdict."""
+    header = ["judged value", "deviation (mm)", "U, k=2 (mm)", "TUR (T/U)", "verdict"]
+    rows = []
+    for s in verdict["sections"]:
+        if "verdict" in s:
+            rows.append(["section %s worst" % s["label"], "%+.4f" % s["worst_deviation_mm"],
+                         _u(s["U_mm"]), _u(s["tur"]), s["verdict"]])
+    for k, spot in enumerate(verdict["worst_spots"]):
+        if "verdict" in spot:
+            rows.append(["spot %d worst" % (k + 1), "%+.4f" % spot["deviation_mm"],
+                         _u(spot["U_mm"]), _u(spot["tur"]), spot["verdict"]])
+    part = verdict.get("part")
+    if part:
+        rows.append(["part worst inlier (reported)", "%+.4f" % part["worst_deviation_mm"],
+                     _u(part["U_mm"]), _u(part["tur"]), part["verdict"]])
+    return header, rows
+
+
+def model_lines(verdict):
+    model = verdict.get("measurement_model") or {}
+    return ["%s: %s" % (k, model[k]) for k in ("noise", "systematic", "pose", "calibration",
+                                               "fit") if k in model]
+
+
+def fit_lines(result):
+    fit = result.fit
+    if not fit:
+        return []
+    lines = ["objective %s, free %s, region weights %s; start: %s"
+             % (fit["objective"], fit["free"] if isinstance(fit["free"], str)
+                else ",".join(fit["free"]), fit.get("weights_by_zone") or "none", fit["start"])]
+    if fit.get("margin_mm") is not None:
+        lines.append("fit to +-%.3f mm: %s, margin %+.4f mm%s"
+                     % (fit["tolerance_mm"], "fits" if fit["fits"] else "does not fit",
+                        fit["margin_mm"], "" if fit["fits"] else
+                        ", least violation %.4f mm" % fit["violation_mm"]))
+    if fit.get("zone_rule"):
+        lines.append("zones: %s %s" % (fit["zone_rule"], fit.get("zone_counts")))
+    return lines
+
+
+def html_parts(result, verdict, table_html):
+    """HTML of the decision and fit sections; ``table_html(header, rows)`` the report's table."""
+    parts = ["<h2>Decision rule and uncertainty</h2>",
+             "<p>%s</p>" % html.escape(verdict.get("decision_rule_text", ""))]
+    header, rows = decision_rows(verdict)
+    parts.append(table_html(header, rows))
+    parts.append("<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in model_lines(verdict))
+                 + "</ul>")
+    lines = fit_lines(result)
+    if lines:
+        parts += ["<h2>Fit</h2>", "<ul>" + "".join("<li>%s</li>" % html.escape(x)
+                                                  for x in lines) + "</ul>"]
+    if result.fit_sensitivity:
+        s = result.fit_sensitivity
+        header, rows = fitting.report_rows(s)
+        largest = s["largest_change"]
+        parts += ["<h2>Fit sensitivity</h2>", table_html(header, rows),
+                  "<p>Largest change: %s, %.4f mm between objectives.%s</p>" % (
+                      html.escape(largest["characteristic"]), largest["change_mm"],
+                      " The verdict depends on the fit." if s["verdict_changes"] else "")
+                  if largest else ""]
+    return parts
+
+
+def pdf_page(plt, result, verdict, dpi):
+    """One A4 page: the decision table, the measurement model, the fit and its sensitivity."""
+    fig = plt.figure(figsize=(8.27, 11.69))
+    fig.text(0.06, 0.95, "Decision rule, uncertainty and fit", fontsize=14, weight="bold")
+    y = 0.92
+    for line in [verdict.get("decision_rule_text", "")] + model_lines(verdict) + \
+            fit_lines(result):
+        fig.text(0.06, y, line, fontsize=7, wrap=True)
+        y -= 0.02
+    header, rows = decision_rows(verdict)
+    ax = fig.add_axes([0.06, 0.5, 0.88, max(0.05, y - 0.52)])
+    ax.axis("off")
+    if rows:
+        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
+        t.auto_set_font_size(False)
+        t.set_fontsize(7)
+    if result.fit_sensitivity:
+        header, rows = fitting.report_rows(result.fit_sensitivity)
+        ax = fig.add_axes([0.06, 0.05, 0.88, 0.4])
+        ax.axis("off")
+        ax.set_title("Fit sensitivity", fontsize=11, loc="left")
+        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
+        t.auto_set_font_size(False)
+        t.set_fontsize(6.5)
+    return fig

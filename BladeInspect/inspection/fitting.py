@@ -1,0 +1,396 @@
+"""The fit objective chosen on the command line (--fit, --free, --weights-by-zone,
+--decision-rule), applied after the robust least-squares ICP, and the fit-sensitivity table.
+
+Every fit starts from the ICP's pose and judges the ICP's inliers with its weights (core.fits,
+"Which points"); only the pose changes. The default (least squares, all six degrees of
+freedom, no region weights) is the ICP's pose itself, unchanged.
+
+Zones of the whole blade (for --weights-by-zone): each point is labelled by its foot point on
+the CAD (its closest CAD point) in the chord frame of the nominal profile cut at the nearest of
+the planes at ZONE_HEIGHTS_PCT of the span (inspection.sections.classify: LE / TE within the
+section table's edge fraction of the chord from either end, else suction or pressure by the
+nearer profile half). Points nearer no profile (beyond the blade's ends) have no zone and
+weight 1.
+"""
+
+import dataclasses
+import time
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from ..core import decision as decision_mod
+from ..core import fits
+from ..core import stats as stats_mod
+from ..core import transforms as tf
+from ..core.errors import InputError
+from . import sections as sections_mod
+
+ENGINE_AXIS = (1.0, 0.0, 0.0)        # CAD +X: the engine axis of a blade modelled along Z
+# Every tenth of the span: one OCC cut each (about 0.2-0.5 s); the chord turns by a tenth of
+# the blade's twist between planes, which moves an LE/TE zone border by a fraction of a mm.
+ZONE_HEIGHTS_PCT = tuple(np.arange(5.0, 100.0, 10.0))
+DEFAULT_OBJECTIVE = "least-squares"
+DATUM = "datum"
+OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM,)
+DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
+
+
+@dataclass
+class FitChoice:
+    """What the user chose: the objective, the free degrees of freedom (text of --free, None
+    for all six), region weights (text of --weights-by-zone), the decision rule."""
+    objective: str = DEFAULT_OBJECTIVE
+    free: Optional[str] = None
+    weights_by_zone: Optional[str] = None
+    decision_rule: str = "iso14253"
+    engine_axis: tuple = ENGINE_AXIS
+    datum_faces: Optional[str] = None
+
+    def __post_init__(self):
+        # Checked before anything is measured or written: a typo must not cost a scan.
+        if self.objective not in OBJECTIVE_NAMES:
+            raise InputError("--fit: unknown objective '%s' (use %s)"
+                             % (self.objective, ", ".join(OBJECTIVE_NAMES)))
+        if self.datum_faces is not None and self.objective != DATUM:
+            raise InputError("--datum-faces: for --fit datum only")
+        if self.objective == DATUM and self.free is not None:
+            raise InputError("--free: a datum reference frame fixes all six degrees of freedom")
+        if self.datum_faces is not None and len(self.datum_faces.split(",")) != 3:
+            raise InputError("--datum-faces: '%s' is not three faces (primary,secondary,"
+                             "tertiary, by index or name)" % self.datum_faces)
+        if self.decision_rule not in decision_mod.RULES:
+            raise InputError("--decision-rule: unknown rule '%s' (use %s)"
+                             % (self.decision_rule, ", ".join(decision_mod.RULES)))
+        if self.free is not None:
+            fits.parse_free(self.free, _axes((0.0, 0.0, 1.0), self.engine_axis))
+        if self.weights_by_zone is not None:
+            if self.objective != "least-squares":
+                raise InputError("--weights-by-zone: region weights apply to --fit "
+                                 "least-squares only, not to %s" % self.objective)
+            self.zone_weights()
+
+    def zone_weights(self):
+        if self.weights_by_zone is None:
+            return None
+        return fits.parse_zone_weights(self.weights_by_zone, zones=sections_mod.ZONES)
+
+    @property
+    def is_icp(self):
+        """The ICP's own pose: nothing to refit."""
+        return (self.objective == "least-squares" and self.free is None
+                and self.weights_by_zone is None)
+
+    def to_json(self):
+        doc = {"objective": self.objective, "free": self.free or "all",
+               "weights_by_zone": self.zone_weights(), "decision_rule": self.decision_rule,
+               "engine_axis": list(self.engine_axis)}
+        if self.objective == DATUM:
+            doc["datum_faces"] = self.datum_faces or ",".join(DATUM_ROLES)
+        return doc
+
+
+def add_arguments(parser):
+    """--fit, --free, --weights-by-zone and --decision-rule on a subcommand."""
+    parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=OBJECTIVE_NAMES,
+                        help="fit objective after the robust least-squares ICP "
+                             "(default least-squares: the ICP's pose)")
+    parser.add_argument("--datum-faces", default=None,
+                        help="--fit datum: primary,secondary,tertiary CAD faces by index or "
+                             "role name (default the CAD's datum_primary,datum_secondary,"
+                             "datum_tertiary)")
+    parser.add_argument("--free", default=None,
+                        help="free degrees of freedom, any of tx,ty,tz,rx,ry,rz and "
+                             "t_stacking,r_stacking,t_engine,r_engine (default all six)")
+    parser.add_argument("--weights-by-zone", default=None,
+                        help="least-squares region weights, e.g. LE=2,TE=2,suction=1,pressure=1")
+    parser.add_argument("--decision-rule", default="iso14253", choices=decision_mod.RULES,
+                        help="iso14253 (pass / not proven / fail, the default) or simple "
+                             "(simple acceptance)")
+
+
+def from_args(args):
+    return FitChoice(objective=args.fit, free=args.free, weights_by_zone=args.weights_by_zone,
+                     decision_rule=args.decision_rule, datum_faces=args.datum_faces)
+
+
+def _axes(stacking, engine):
+    return {"stacking": np.asarray(stacking, dtype=float),
+            "engine": np.asarray(engine, dtype=float)}
+
+
+def free_of(choice, nominal):
+    """The FreeDOF of the choice on this CAD (its stacking axis from sections.span_axis_of)."""
+    if choice.free is None:
+        return None
+    axis, _ = sections_mod.span_axis_of(nominal)
+    return fits.parse_free(choice.free, _axes(axis, choice.engine_axis))
+
+
+def zones_of(result, nominal, edge_fraction=sections_mod.EDGE_FRACTION):
+    """(N,) zone label of every point (module notes: foot point, nearest profile in span)."""
+    from ..cad.sections import cut
+    axis, (lo, hi) = sections_mod.span_axis_of(nominal)
+    foot = np.asarray(result.closest, dtype=float)
+    span = foot @ axis
+    heights = lo + (hi - lo) * np.asarray(ZONE_HEIGHTS_PCT) / 100.0
+    nearest = np.argmin(np.abs(span[:, None] - heights[None, :]), axis=1)
+    labels = np.full(len(foot), "", dtype=object)
+    inside = (span >= lo) & (span <= hi)
+    for k, h in enumerate(heights):
+        sel = np.flatnonzero(inside & (nearest == k))
+        if not len(sel):
+            continue
+        origin = axis * h
+        try:
+            polylines = cut(nominal.shape, origin, axis)
+        except InputError:
+            continue
+        profile = sections_mod._build_profile(nominal, polylines, axis, foot[sel], origin)
+        labels[sel] = sections_mod.classify(profile, foot[sel], edge_fraction)
+    return labels
+
+
+def fit_weights(result):
+    """The ICP's weights of the result's points (SNR x robust), or where the result does not
+    carry them (a restricted view) the SNR of its inliers."""
+    weights = getattr(result, "icp_weights", None)
+    if weights is not None and len(weights) == result.n_points:
+        return np.asarray(weights, dtype=float)
+    snr = np.ones(result.n_points) if result.snr is None else np.asarray(result.snr, float)
+    return np.where(result.inlier, snr, 0.0)
+
+
+@dataclass
+class FitRuns:
+    """The fits made from the ICP pose: {objective: core.fits.FitResult}, None for the ICP's
+    own pose; the starting pose and deviations."""
+    start: np.ndarray
+    start_deviation: np.ndarray
+    runs: dict
+    zone_labels: Optional[np.ndarray]
+    seconds: dict
+
+
+def datum_groups(choice, nominal):
+    """[(name, face indices)] of the primary, secondary and tertiary datum faces."""
+    tokens = [t.strip() for t in (choice.datum_faces or ",".join(DATUM_ROLES)).split(",")]
+    groups = []
+    for token in tokens:
+        if token.isdigit():
+            index = int(token)
+            if index >= len(nominal.faces):
+                raise InputError("--datum-faces: face %d does not exist (the CAD has %d faces)"
+                                 % (index, len(nominal.faces)))
+            groups.append((token, [index]))
+        elif token in nominal.roles:
+            groups.append((token, list(nominal.roles[token])))
+        else:
+            raise InputError("--datum-faces: '%s' is neither a face index nor a face name of "
+                             "this CAD (names: %s)" % (token, ", ".join(sorted(nominal.roles))
+                                                       or "none"))
+    return groups
+
+
+@dataclass
+class DatumRun:
+    """A datum fit: the motion (CAD frame) and the planes it came from."""
+    transform: np.ndarray
+    planes: list
+    distances: np.ndarray          # (N,) every point's deviation at this pose
+    max_abs_deviation: float       # of the inliers, mm
+    margin: Optional[float] = None
+
+    def to_json(self):
+        return {"objective": DATUM, "free": "datum reference frame (all six)",
+                "cad_motion": np.asarray(self.transform).tolist(), "datums": self.planes}
+
+
+def _datum_run(result, nominal, choice):
+    from ..core import datum
+    groups = datum_groups(choice, nominal)
+    measured, cad, planes = [], [], []
+    for order, (name, faces) in zip(datum.ORDER, groups):
+        on_face = np.asarray(result.inlier, bool) & np.isin(result.face, faces)
+        label = "--datum-faces: %s datum %s" % (order, name)
+        measured.append(datum.plane_of(result.points_cad[on_face], label))
+        cad.append(datum.plane_of(nominal.samples.xyz[np.isin(nominal.samples.face, faces)],
+                                  label + " (CAD)"))
+        planes.append({"order": order, "faces": faces, "name": name,
+                       "n_points": measured[-1].n_points,
+                       "flatness_rms_mm": measured[-1].rms_mm,
+                       "cad_flatness_rms_mm": cad[-1].rms_mm})
+    G = datum.datum_pose(measured, cad)
+    distances = nominal.signed_distance(tf.apply_transform(G, result.points_cad)).distance
+    inlier = np.asarray(result.inlier, bool)
+    return DatumRun(transform=G, planes=planes, distances=distances,
+                    max_abs_deviation=float(np.max(np.abs(distances[inlier]))))
+
+
+def _run(objective, result, nominal, choice, tolerance, free, labels, closest):
+    if objective == DATUM:
+        return _datum_run(result, nominal, choice)
+    if objective == "least-squares" and free is None and choice.weights_by_zone is None:
+        return None
+    weights = fit_weights(result)
+    multipliers = None
+    if objective == "least-squares" and choice.weights_by_zone is not None:
+        multipliers = fits.per_zone(labels, choice.zone_weights())
+    lower = upper = None
+    if objective == "tolerance":
+        lower, upper = -float(tolerance), float(tolerance)
+    # The points are already in the CAD frame at the ICP pose: the fit moves them from there.
+    return fits.fit(objective, result.points_cad, closest, np.eye(4), weights, free=free,
+                    multipliers=multipliers, lower=lower, upper=upper,
+                    at_init=(np.asarray(result.deviation), np.asarray(result.normal)))
+
+
+def _tolerance_of_minimax(minimax, tolerance):
+    """The fit to the zone +-T from the minimax fit of the same points: the slack of a point is
+    T - |d|, so the pose of largest smallest slack is the pose of least largest |d| and the
+    margin is T - max |d| (exactly the same problem, solved once)."""
+    margin = float(tolerance) - minimax.max_abs_deviation
+    return dataclasses.replace(minimax, objective="tolerance", margin=margin,
+                               fits=bool(margin >= 0))
+
+
+def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None):
+    """Move ``result`` (in place) to the pose of the chosen fit and record it in result.fit;
+    with ``all_objectives`` also fit every other objective from the same start, for
+    sensitivity(). Returns the FitRuns."""
+    from .pipeline import exact_closest_fn
+    choice = choice or FitChoice()
+    progress = progress or (lambda f, m: None)
+    free = free_of(choice, nominal)
+    labels = zones_of(result, nominal) if choice.weights_by_zone is not None else None
+    closest = exact_closest_fn(nominal)
+    wanted = fits.OBJECTIVES if all_objectives else (choice.objective,)
+    if choice.objective not in wanted:
+        wanted = wanted + (choice.objective,)
+    runs, seconds = {}, {}
+    for objective in wanted:
+        progress(0.0, "fit: %s" % objective)
+        t0 = time.perf_counter()
+        if objective == "tolerance" and runs.get("minimax") is not None:
+            runs[objective] = _tolerance_of_minimax(runs["minimax"], tolerance)
+        else:
+            runs[objective] = _run(objective, result, nominal, choice, tolerance, free,
+                                   labels, closest)
+        seconds[objective] = time.perf_counter() - t0
+    out = FitRuns(start=np.asarray(result.measured_to_cad).copy(),
+                  start_deviation=np.asarray(result.deviation).copy(), runs=runs,
+                  zone_labels=labels, seconds=seconds)
+    chosen = runs[choice.objective]
+    record = dict(choice.to_json(), start="the robust least-squares ICP's pose and inliers",
+                  tolerance_mm=float(tolerance), margin_mm=None, fits=None, violation_mm=None)
+    if labels is not None:
+        names, counts = np.unique(labels.astype(str), return_counts=True)
+        record["zone_rule"] = ("foot point's chord position in the nominal profile at the "
+                               "nearest of %d span planes" % len(ZONE_HEIGHTS_PCT))
+        record["zone_counts"] = {(n or "none"): int(c) for n, c in zip(names, counts)}
+    if chosen is None:
+        record.update(max_abs_deviation_mm=float(np.max(np.abs(
+            result.deviation[result.inlier]))) if result.inlier.any() else None,
+            rms_mm=result.rms_mm, measured_to_cad=out.start.tolist())
+    else:
+        t0 = time.perf_counter()
+        record.update(chosen.to_json())
+        record["measured_to_cad_least_squares"] = out.start.tolist()
+        _move(result, nominal, chosen)
+        if "measured_to_cad" in record:   # core.fits' pose is the motion in the CAD frame
+            record["cad_motion"] = record.pop("measured_to_cad")
+        record["measured_to_cad"] = np.asarray(result.measured_to_cad).tolist()
+        if choice.objective == DATUM:
+            inlier = np.asarray(result.inlier, bool)
+            record.update(max_abs_deviation_mm=float(np.max(np.abs(
+                result.deviation[inlier]))), rms_mm=result.rms_mm)
+        seconds["deviations"] = time.perf_counter() - t0
+    record["timing_s"] = seconds
+    result.fit = record
+    return out
+
+
+def _move(result, nominal, chosen):
+    """The result at the fit's pose: new points, deviations, closest points, statistics."""
+    result.measured_to_cad = chosen.transform @ np.asarray(result.measured_to_cad)
+    result.points_cad = tf.apply_transform(chosen.transform, result.points_cad)
+    dist = nominal.signed_distance(result.points_cad)
+    result.deviation, result.closest = dist.distance, dist.closest
+    result.normal, result.face = dist.normal, dist.face
+    result.deviation_stats = stats_mod.deviation_statistics(dist.distance)
+    inlier = np.asarray(result.inlier, dtype=bool)
+    result.rms_mm = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() \
+        else float("nan")
+
+
+# ---------------------------------------------------------------- sensitivity
+
+def section_worst_characteristics(verdict):
+    """Judged values of a verdict (inspection.verdict.judge): each section's worst deviation
+    and the part's, as [(name, value mm, U mm, verdict)]."""
+    rows = []
+    for sec in verdict["sections"]:
+        if "worst_deviation_mm" in sec:
+            rows.append(("section %s worst deviation" % sec["label"], sec["worst_deviation_mm"],
+                         sec.get("U_mm"), sec.get("verdict")))
+    part = verdict.get("part")
+    if part:
+        rows.append(("part worst deviation", part["worst_deviation_mm"], part["U_mm"],
+                     part["verdict"]))
+    return rows
+
+
+CHARACTERISTICS = (section_worst_characteristics,)
+
+
+def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
+                characteristics=CHARACTERISTICS):
+    """fit_sensitivity: every judged value and the part's verdict under each fit objective,
+    side by side, from the same start and points. ``characteristics``: callables
+    verdict -> [(name, value, U, verdict)] (each section's and the part's worst deviation by
+    default; more, such as airfoil characteristics, append to the list)."""
+    from .verdict import judge
+    t0 = time.perf_counter()
+    judge_options = dict(judge_options or {}, decision_rule=choice.decision_rule)
+    columns = {}
+    for objective, run in runs.runs.items():
+        deviation = runs.start_deviation if run is None else run.distances
+        view = dataclasses.replace(result, deviation=np.asarray(deviation))
+        verdict = judge(view, table, tolerance=tolerance, **judge_options)
+        values = [row for f in characteristics for row in f(verdict)]
+        columns[objective] = {"verdict": verdict["verdict"], "values": values,
+                              "max_abs_deviation_mm": None if run is None
+                              else run.max_abs_deviation,
+                              "margin_mm": None if run is None else run.margin}
+    objectives = list(columns)
+    names = [v[0] for v in columns[objectives[0]]["values"]]
+    rows, largest = [], None
+    for i, name in enumerate(names):
+        cells = {o: {"value_mm": columns[o]["values"][i][1], "U_mm": columns[o]["values"][i][2],
+                     "verdict": columns[o]["values"][i][3]} for o in objectives}
+        values = [c["value_mm"] for c in cells.values()]
+        change = float(max(values) - min(values))
+        rows.append({"characteristic": name, "by_fit": cells, "change_mm": change})
+        if largest is None or change > largest["change_mm"]:
+            largest = {"characteristic": name, "change_mm": change}
+    verdicts = {o: columns[o]["verdict"] for o in objectives}
+    return {"objectives": objectives, "rows": rows, "verdict_by_fit": verdicts,
+            "verdict_changes": len(set(verdicts.values())) > 1,
+            "largest_change": largest,
+            "free": choice.free or "all",
+            "timing_s": dict(runs.seconds, judge=time.perf_counter() - t0)}
+
+
+def report_rows(sensitivity_doc):
+    """(header, rows) of the report's fit-sensitivity table."""
+    objectives = sensitivity_doc["objectives"]
+    header = ["characteristic"] + ["%s (mm, verdict)" % o for o in objectives] + ["change (mm)"]
+    rows = []
+    for row in sensitivity_doc["rows"]:
+        rows.append([row["characteristic"]] + [
+            "%+.4f %s" % (row["by_fit"][o]["value_mm"], row["by_fit"][o]["verdict"] or "")
+            for o in objectives] + ["%.4f" % row["change_mm"]])
+    rows.append(["part verdict"] + [sensitivity_doc["verdict_by_fit"][o] or ""
+                                    for o in objectives] + [""])
+    return header, rows

@@ -1,0 +1,111 @@
+"""The expanded uncertainty U (k = 2) of a judged deviation, from a stated measurement model.
+
+A judged value is the signed deviation of one measured point (a section's worst, the part's
+worst). Its standard uncertainty combines, as independent terms (GUM, root sum of squares):
+
+- noise: the sensor's random error of that reading, sigma(SNR) of rig.sensor.SensorModel
+  (its sigma at SNR_ref scaled by sqrt(SNR_ref / SNR)); sigma_ref when the point has no SNR;
+- systematic: the sensor's stated accuracy taken as a bias of unknown sign, a rectangular
+  distribution of half-width ``accuracy``: accuracy / sqrt(3);
+- pose: the registration's pose covariance Sigma (result.pose_covariance, 6x6 [t mm, w rad]
+  about result.center) propagated to the point along its normal: J Sigma J^T with
+  J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c);
+- calibration: the rig calibration's own uncertainty at the part, when a RIG.json stating one
+  is given (``calibration_uncertainty_mm``); otherwise the term is not included and the model
+  says so;
+- fit: the pose covariance above is that of the least-squares fit of the same points; under a
+  Chebyshev objective (minimax, tolerance) it states what the measurement determines, not that
+  estimator's own, larger scatter, which is not included (core.fits, "Covariance").
+"""
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from ..core.errors import InputError
+from ..rig.sensor import SensorModel
+
+COVERAGE_FACTOR = 2.0
+
+
+@dataclass
+class MeasurementModel:
+    sensor: SensorModel = field(default_factory=SensorModel)
+    calibration_mm: Optional[float] = None     # 1 sigma at the part, from RIG.json
+    calibration_source: Optional[str] = None
+
+    def to_json(self):
+        return {
+            "k": COVERAGE_FACTOR,
+            "noise": "sensor sigma(SNR): %.4g mm at SNR %g, times sqrt(SNR_ref / SNR)"
+                     % (self.sensor.sigma_ref, self.sensor.snr_ref),
+            "systematic_mm": self.systematic_mm,
+            "systematic": "stated accuracy %.4g mm as a rectangular bias: accuracy / sqrt(3)"
+                          % self.sensor.accuracy,
+            "pose": "pose covariance propagated along the normal, J S J^T, J = [n, (p-c) x n]",
+            "calibration_mm": self.calibration_mm,
+            "calibration": ("from %s" % self.calibration_source if self.calibration_mm
+                            is not None else "not included (no RIG.json stating the "
+                            "calibration's uncertainty)"),
+            "fit": "the least-squares pose covariance of the same free degrees of freedom; a "
+                   "Chebyshev fit's own scatter is not included",
+        }
+
+    @property
+    def systematic_mm(self):
+        return float(self.sensor.accuracy / np.sqrt(3.0))
+
+
+def model_from_rig_file(path, sensor=None):
+    """The measurement model with the calibration term of a RIG.json (None: not included)."""
+    sensor = sensor or SensorModel()
+    if path is None:
+        return MeasurementModel(sensor=sensor)
+    if not os.path.isfile(path):
+        raise InputError("%s: rig file not found" % path)
+    try:
+        with open(path) as fh:
+            data = json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise InputError("%s: not a readable JSON rig file (%s)" % (path, exc))
+    value = data.get("calibration_uncertainty_mm") if isinstance(data, dict) else None
+    if value is not None:
+        value = float(value)
+        if not np.isfinite(value) or value < 0:
+            raise InputError("%s: calibration_uncertainty_mm must be a finite number >= 0"
+                             % path)
+    return MeasurementModel(sensor=sensor, calibration_mm=value,
+                            calibration_source=path if value is not None else None)
+
+
+def standard_terms(result, index, model=None):
+    """{term: (n,) standard uncertainty in mm} of the deviations of the points ``index``."""
+    model = model or MeasurementModel()
+    index = np.atleast_1d(np.asarray(index, dtype=int))
+    n = len(index)
+    if result.snr is None:
+        noise = np.full(n, model.sensor.sigma_ref)
+    else:
+        snr = np.asarray(result.snr, dtype=float)[index]
+        noise = np.where(snr > 0, model.sensor.sigma(np.where(snr > 0, snr, 1.0)), np.inf)
+    normal = np.asarray(result.normal, dtype=float)[index]
+    arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
+    J = np.hstack([normal, np.cross(arm, normal)])
+    cov = np.asarray(result.pose_covariance, dtype=float)
+    with np.errstate(invalid="ignore"):
+        pose_var = np.einsum("ij,jk,ik->i", J, cov, J) if np.all(np.isfinite(cov)) \
+            else np.full(n, np.inf)
+    terms = {"noise_mm": noise, "systematic_mm": np.full(n, model.systematic_mm),
+             "pose_mm": np.sqrt(np.maximum(pose_var, 0.0))}
+    if model.calibration_mm is not None:
+        terms["calibration_mm"] = np.full(n, model.calibration_mm)
+    return terms
+
+
+def expanded_uncertainty(result, index, model=None):
+    """(n,) U = k * the combined standard uncertainty of the points' deviations (mm)."""
+    terms = standard_terms(result, index, model)
+    return COVERAGE_FACTOR * np.sqrt(sum(t ** 2 for t in terms.values()))
