@@ -33,7 +33,7 @@ import Part
 
 from ..core import bspline
 from ..core.errors import InputError
-from ..core.trim import _csr, _pairs
+from ..core.trim import csr, bucket_pairs
 from .nominal import point_in_domain
 
 # Directions closer than this (in unit-vector components) share one projection plane.
@@ -246,7 +246,7 @@ class _RayGrid:
         cx = i0[owner, 0] + local % nx[owner]
         cy = i0[owner, 1] + local // nx[owner]
         keep = held[cx, cy]
-        self.table = _csr(cx[keep] * g + cy[keep], owner[keep], g * g)
+        self.table = csr(cx[keep] * g + cy[keep], owner[keep], g * g)
         self.triangle_id = cand
         depth = _along(V, direction)[tess.triangles[cand]]
         self.plane_map = _plane_maps(tri2[cand], depth)
@@ -271,7 +271,7 @@ class _TriangleGrid:
         self.g = _grid_size(len(tess.triangles))
         self.cell = np.maximum((self.ghi - self.glo) / self.g, 1e-12)
         owner, cells = self.cells_of(lo2, hi2, tri2)
-        self.table = _csr(cells, owner, self.g * self.g)
+        self.table = csr(cells, owner, self.g * self.g)
 
     def segment_cells(self, a, b):
         """(owner, flat cell) of the cells each segment a-b (in the plane) crosses, sorted by
@@ -434,7 +434,7 @@ def _first_hits_group(tess, grid, origins, dirs, t0, t1, planar):
     step = max(1, PAIR_CHUNK // 8)
     for s in range(0, len(ray_owner), step):
         owner = ray_owner[s:s + step]
-        q, tri = _pairs(ray_cell[s:s + step], *grid.table)
+        q, tri = bucket_pairs(ray_cell[s:s + step], *grid.table)
         r = owner[q]
         for c in range(0, len(r), PAIR_CHUNK):
             rr, tt = r[c:c + PAIR_CHUNK], tri[c:c + PAIR_CHUNK]

@@ -14,15 +14,16 @@ import numpy as np
 SEGMENTS_PER_BIN = 8
 
 
-def _csr(bin_ids, item_ids, n_bins):
+def csr(bin_ids, item_ids, n_bins):
+    """Items bucketed by bin: (start, count per bin, items ordered by bin), for bucket_pairs."""
     order = np.argsort(bin_ids, kind="stable")
     counts = np.bincount(bin_ids, minlength=n_bins)
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
     return starts, counts, item_ids[order]
 
 
-def _pairs(query_bins, starts, counts, members):
-    """(query index, member) for every member of each query's bin."""
+def bucket_pairs(query_bins, starts, counts, members):
+    """(query index, member) for every member of each query's bin of a csr table."""
     cnt = counts[query_bins]
     q = np.repeat(np.arange(len(query_bins)), cnt)
     first = np.repeat(starts[query_bins], cnt)
@@ -48,7 +49,7 @@ class TrimDomain:
         r1 = self._index(hi[:, 1], 1)
         rows_seg = np.repeat(k, r1 - r0 + 1)
         rows = np.concatenate([np.arange(s, e + 1) for s, e in zip(r0, r1)])
-        self._rows = _csr(rows, rows_seg, self.shape[1])
+        self._rows = csr(rows, rows_seg, self.shape[1])
         # Cells of each segment's box dilated by one cell, for the distance.
         c0u, c1u = self._index(lo[:, 0], 0) - 1, self._index(hi[:, 0], 0) + 1
         c0v, c1v = self._index(lo[:, 1], 1) - 1, self._index(hi[:, 1], 1) + 1
@@ -60,7 +61,7 @@ class TrimDomain:
                                  indexing="ij")
             cells.append((uu * self.shape[1] + vv).ravel())
             ids.append(np.full(cells[-1].size, i))
-        self._cells = _csr(np.concatenate(cells), np.concatenate(ids), self.shape[0] * self.shape[1])
+        self._cells = csr(np.concatenate(cells), np.concatenate(ids), self.shape[0] * self.shape[1])
         self.reach = float(self.cell.min())
 
     def _index(self, x, axis):
@@ -74,7 +75,7 @@ class TrimDomain:
         # Even-odd count of crossings of the ray from each point towards +u.
         row = self._index(uv[:, 1], 1)
         in_rows = (uv[:, 1] >= self.origin[1]) & (uv[:, 1] < self.origin[1] + self.shape[1] * self.cell[1])
-        q, s = _pairs(np.where(in_rows, row, 0), *self._rows)
+        q, s = bucket_pairs(np.where(in_rows, row, 0), *self._rows)
         keep = in_rows[q]
         q, s = q[keep], s[keep]
         ay, by = a[s, 1], b[s, 1]
@@ -90,7 +91,7 @@ class TrimDomain:
         iv = ((uv[:, 1] - self.origin[1]) / self.cell[1]).astype(int)
         in_grid = (iu >= 0) & (iu < self.shape[0]) & (iv >= 0) & (iv < self.shape[1])
         cell = np.where(in_grid, iu * self.shape[1] + iv, 0)
-        q, s = _pairs(cell, *self._cells)
+        q, s = bucket_pairs(cell, *self._cells)
         keep = in_grid[q]
         q, s = q[keep], s[keep]
         if len(q):
