@@ -105,15 +105,10 @@ def _subsample(n, k, rng):
 def _sample_closest_fn(nominal):
     """Closest point on the nominal's dense samples, point-to-plane distance to the sample's
     tangent plane: good to the sample spacing's curvature error, enough to rank candidates."""
-    from scipy.spatial import cKDTree
-    tree = getattr(nominal, "_coarse_tree", None)
-    if tree is None:
-        tree = cKDTree(nominal.samples.xyz)
-        nominal._coarse_tree = tree
     xyz, nrm = nominal.samples.xyz, nominal.samples.normal
 
     def closest(points):
-        _, idx = tree.query(points)
+        idx = nominal.nearest_sample(points)
         normal = nrm[idx]
         dist = np.einsum("ij,ij->i", points - xyz[idx], normal)
         return points - dist[:, None] * normal, normal, dist
