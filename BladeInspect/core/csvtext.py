@@ -63,9 +63,16 @@ def fixed_matrix(values, decimals):
         # |scaled - exact| <= |scaled| 2^-53: a half that close may round either way.
         near_half = np.abs(np.abs(scaled - np.floor(scaled)) - 0.5) <= np.abs(scaled) * 2.0 ** -50
         python = ~(np.abs(scaled) < _EXACT_LIMIT) | near_half
+    finite = np.isfinite(values)
     magnitude = np.abs(np.where(python, 0.0, nearest)).astype(np.int64)
     out = _digits_matrix(magnitude, np.signbit(values) & ~python, decimals)
-    return _patched(out, python, lambda v: fmt % v, values)
+    # NaN (whatever its sign bit) and the infinities print as these words.
+    for word, rows in (("nan", np.isnan(values)), ("inf", values == np.inf),
+                       ("-inf", values == -np.inf)):
+        if rows.any():
+            out = _widened(out, len(word))
+            out[rows] = _field([word], out.shape[1])[0]
+    return _patched(out, python & finite, lambda v: fmt % v, values)
 
 
 def integer_matrix(values):
@@ -83,15 +90,21 @@ def string_matrix(strings):
 
 
 def _patched(out, rows_mask, fmt, values):
+    """``out`` with the rows of ``rows_mask`` replaced by fmt(value), widened if need be."""
     rows = np.flatnonzero(rows_mask)
     if len(rows) == 0:
         return out
     strings = [fmt(float(v)) for v in values[rows]]
-    width = max(out.shape[1], max(len(s) for s in strings))
-    if width > out.shape[1]:
-        out = np.concatenate([np.zeros((len(out), width - out.shape[1]), np.uint8), out], axis=1)
-    out[rows] = _field(strings, width)
+    out = _widened(out, max(len(s) for s in strings))
+    out[rows] = _field(strings, out.shape[1])
     return out
+
+
+def _widened(out, width):
+    """``out`` with NUL columns in front so that it is at least ``width`` wide."""
+    if width <= out.shape[1]:
+        return out
+    return np.concatenate([np.zeros((len(out), width - out.shape[1]), np.uint8), out], axis=1)
 
 
 def csv_rows(matrices):
