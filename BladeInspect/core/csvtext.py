@@ -34,10 +34,10 @@ def _digits_matrix(magnitude, negative, decimals):
     point = 1 if decimals else 0
     width = 1 + k_max + point + decimals
     out = np.zeros((n, width), np.uint8)
-    rest = magnitude.copy()
+    rest = magnitude
     for j in range(decimals):
-        out[:, width - 1 - j] = _ZERO + rest % 10
-        rest //= 10
+        rest, digit = np.divmod(rest, 10)
+        out[:, width - 1 - j] = _ZERO + digit
     if decimals:
         out[:, width - 1 - decimals] = ord(".")
     # Integer digits: as many as the whole part has, at least one.
@@ -45,9 +45,8 @@ def _digits_matrix(magnitude, negative, decimals):
     for i in range(1, k_max):
         k += whole >= 10 ** i
     for i in range(k_max):
-        col = width - 1 - decimals - point - i
-        out[:, col] = np.where(i < k, _ZERO + rest % 10, 0)
-        rest //= 10
+        rest, digit = np.divmod(rest, 10)
+        out[:, width - 1 - decimals - point - i] = np.where(i < k, _ZERO + digit, 0)
     rows = np.flatnonzero(negative)
     out[rows, width - 1 - decimals - point - k[rows]] = ord("-")
     return out
