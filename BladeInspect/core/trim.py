@@ -31,6 +31,13 @@ def bucket_pairs(query_bins, starts, counts, members):
     return q, members[first + offset]
 
 
+def _ranges(starts, counts):
+    """(owner, value): for each i, counts[i] entries owner i with values starts[i] + 0, 1, ..."""
+    owner = np.repeat(np.arange(len(counts)), counts)
+    return owner, starts[owner] + np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts,
+                                                                    counts)
+
+
 class TrimDomain:
     def __init__(self, segments):
         """segments: (K, 2, 2) boundary pieces in (u, v)."""
@@ -43,25 +50,20 @@ class TrimDomain:
         self.cell = span / g
         self.origin = lo.min(axis=0) - self.cell          # one dilation cell on each side
         self.shape = (g + 2, g + 2)
-        k = np.arange(len(self.segments))
         # Rows (v bands) each segment crosses, for the even-odd count.
         r0 = self._index(lo[:, 1], 1)
         r1 = self._index(hi[:, 1], 1)
-        rows_seg = np.repeat(k, r1 - r0 + 1)
-        rows = np.concatenate([np.arange(s, e + 1) for s, e in zip(r0, r1)])
+        rows_seg, rows = _ranges(r0, r1 - r0 + 1)
         self._rows = csr(rows, rows_seg, self.shape[1])
         # Cells of each segment's box dilated by one cell, for the distance.
         c0u, c1u = self._index(lo[:, 0], 0) - 1, self._index(hi[:, 0], 0) + 1
         c0v, c1v = self._index(lo[:, 1], 1) - 1, self._index(hi[:, 1], 1) + 1
         c0u, c0v = np.maximum(c0u, 0), np.maximum(c0v, 0)
         c1u, c1v = np.minimum(c1u, self.shape[0] - 1), np.minimum(c1v, self.shape[1] - 1)
-        ids, cells = [], []
-        for i in range(len(k)):
-            uu, vv = np.meshgrid(np.arange(c0u[i], c1u[i] + 1), np.arange(c0v[i], c1v[i] + 1),
-                                 indexing="ij")
-            cells.append((uu * self.shape[1] + vv).ravel())
-            ids.append(np.full(cells[-1].size, i))
-        self._cells = csr(np.concatenate(cells), np.concatenate(ids), self.shape[0] * self.shape[1])
+        nv = c1v - c0v + 1
+        ids, local = _ranges(np.zeros_like(c0u), (c1u - c0u + 1) * nv)
+        cells = (c0u[ids] + local // nv[ids]) * self.shape[1] + c0v[ids] + local % nv[ids]
+        self._cells = csr(cells, ids, self.shape[0] * self.shape[1])
         self.reach = float(self.cell.min())
 
     def _index(self, x, axis):
