@@ -154,5 +154,49 @@ class RaycastKernel(unittest.TestCase):
             raycast.check_rays(np.zeros((2, 3)), np.ones((3, 3)))
 
 
+def star_segments(rng, n=1500, lobes=7):
+    """A non-convex closed star in (u, v), stretched 1:40 like a blade side's parameters,
+    its segments in shuffled order and random direction."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    r = 1.0 + 0.4 * np.sin(lobes * t)
+    p = np.column_stack([r * np.cos(t), 40.0 * r * np.sin(t)])
+    seg = np.stack([p, np.roll(p, -1, axis=0)], axis=1)
+    flip = rng.random(n) < 0.5
+    seg[flip] = seg[flip][:, ::-1]
+    return seg[rng.permutation(n)]
+
+
+def brute_force(seg, q):
+    """Even-odd count over every segment and the distance to every segment."""
+    a, b = seg[:, 0][None], seg[:, 1][None]
+    p = q[:, None]
+    straddle = (a[..., 1] > p[..., 1]) != (b[..., 1] > p[..., 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = a[..., 0] + (p[..., 1] - a[..., 1]) * (b[..., 0] - a[..., 0]) / (b[..., 1] - a[..., 1])
+    inside = np.count_nonzero(straddle & (p[..., 0] < x), axis=1) % 2 == 1
+    ab, ap = b - a, p - a
+    t = np.clip(np.sum(ap * ab, axis=2) / np.sum(ab * ab, axis=2), 0.0, 1.0)
+    d = np.linalg.norm(ap - t[..., None] * ab, axis=2).min(axis=1)
+    return inside, d
+
+
+class TrimDomainQueries(unittest.TestCase):
+    def test_against_every_segment(self):
+        rng = np.random.default_rng(9)
+        seg = star_segments(rng)
+        dom = TrimDomain(seg)
+        vertices = seg[:, 0]
+        q = np.vstack([rng.uniform([-1.6, -64], [1.6, 64], (1500, 2)),
+                       vertices[:300], vertices[:300] + [0.0, 1e-12],
+                       vertices[:300] + rng.normal(0, 1e-3, (300, 2))])
+        inside, dist = dom.query(q)
+        want_inside, want_dist = brute_force(seg, q)
+        np.testing.assert_array_equal(inside, want_inside)
+        near = want_dist < dom.reach
+        np.testing.assert_allclose(dist[near], want_dist[near], rtol=0, atol=1e-12)
+        self.assertTrue(np.all(dist[~near] == dom.reach))
+        self.assertTrue(np.all(dist <= dom.reach))
+
+
 if __name__ == "__main__":
     unittest.main()

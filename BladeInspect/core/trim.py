@@ -3,15 +3,19 @@ vectorised over many parameter pairs.
 
 The boundary is a soup of segments (the face's discretised trimming curves, in any order and
 direction); inside is decided by the even-odd rule on a ray towards +u. Segments are bucketed
-in a uniform grid so each query meets only the few segments near it: rows of the grid for the
-crossing count, cells dilated by one cell for the distance, which is therefore exact up to one
-cell size and reported as that cell size beyond (a valid lower bound, all callers need).
+in a uniform grid so each query meets only the few segments near it: cells dilated by one cell
+for the distance, which is therefore exact up to one cell size and reported as that cell size
+beyond (a valid lower bound, all callers need); for the crossing count, finer v bands of their
+own (every segment that straddles a point's v is in that point's band, so the count is exact
+whatever the bands; finer bands just pair each point with fewer segments).
 """
 
 import numpy as np
 
 # Target number of segments per grid row / column.
 SEGMENTS_PER_BIN = 8
+# Most rows of the crossing count's own bands.
+MAX_ROWS = 8192
 
 
 def csr(bin_ids, item_ids, n_bins):
@@ -50,11 +54,15 @@ class TrimDomain:
         self.cell = span / g
         self.origin = lo.min(axis=0) - self.cell          # one dilation cell on each side
         self.shape = (g + 2, g + 2)
-        # Rows (v bands) each segment crosses, for the even-odd count.
-        r0 = self._index(lo[:, 1], 1)
-        r1 = self._index(hi[:, 1], 1)
+        # v bands each segment crosses, for the even-odd count (one spare band each side).
+        n_bands = int(np.clip(len(self.segments) // SEGMENTS_PER_BIN, g, MAX_ROWS))
+        self.band = span[1] / n_bands
+        self.band_origin = lo[:, 1].min() - self.band
+        self.n_bands = n_bands + 2
+        r0 = self._band(lo[:, 1])
+        r1 = self._band(hi[:, 1])
         rows_seg, rows = _ranges(r0, r1 - r0 + 1)
-        self._rows = csr(rows, rows_seg, self.shape[1])
+        self._rows = csr(rows, rows_seg, self.n_bands)
         # Cells of each segment's box dilated by one cell, for the distance.
         c0u, c1u = self._index(lo[:, 0], 0) - 1, self._index(hi[:, 0], 0) + 1
         c0v, c1v = self._index(lo[:, 1], 1) - 1, self._index(hi[:, 1], 1) + 1
@@ -66,6 +74,9 @@ class TrimDomain:
         self._cells = csr(cells, ids, self.shape[0] * self.shape[1])
         self.reach = float(self.cell.min())
 
+    def _band(self, v):
+        return np.clip(((v - self.band_origin) / self.band).astype(int), 0, self.n_bands - 1)
+
     def _index(self, x, axis):
         return np.clip(((x - self.origin[axis]) / self.cell[axis]).astype(int), 0, self.shape[axis] - 1)
 
@@ -75,8 +86,9 @@ class TrimDomain:
         n = len(uv)
         a, b = self.segments[:, 0], self.segments[:, 1]
         # Even-odd count of crossings of the ray from each point towards +u.
-        row = self._index(uv[:, 1], 1)
-        in_rows = (uv[:, 1] >= self.origin[1]) & (uv[:, 1] < self.origin[1] + self.shape[1] * self.cell[1])
+        row = self._band(uv[:, 1])
+        in_rows = ((uv[:, 1] >= self.band_origin)
+                   & (uv[:, 1] < self.band_origin + self.n_bands * self.band))
         q, s = bucket_pairs(np.where(in_rows, row, 0), *self._rows)
         keep = in_rows[q]
         q, s = q[keep], s[keep]
