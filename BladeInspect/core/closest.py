@@ -76,7 +76,6 @@ def point_in_domain(domain, uv):
     return domain.index.query(uv)
 
 
-
 class FaceSet:
     """The CAD's faces as arrays: per face its SurfaceData, FaceDomain and whether its outward
     side is -(Su x Sv); the samples on all faces and a k-d tree over their points."""
