@@ -58,8 +58,8 @@ def main(seed=67):
     after = load_nominal(step)
     t_load = time.perf_counter() - t0
     t0 = time.perf_counter()
-    orient.face_sides(after.shape, after.faces, after.surfaces, after._domains,
-                      after._reversed)
+    orient.face_sides(after.shape, after.faces, after.surfaces, after.domains,
+                      after.reversed)
     t_rule = time.perf_counter() - t0
     undo = [s.index for s in after.face_sides if s.flip]
     before = load_nominal(step, flip_faces=undo)

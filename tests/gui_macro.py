@@ -319,7 +319,7 @@ def run():
 
 def _active_panel():
     from BladeInspect.gui import taskpanels
-    return active_panel((taskpanels._Panel, taskpanels.RegistrationPanel))
+    return active_panel((taskpanels.FormPanel, taskpanels.RegistrationPanel))
 
 
 class _FakePoints:

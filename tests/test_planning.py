@@ -127,7 +127,7 @@ class TestPlanErrors(unittest.TestCase):
         spot = np.array([[0.0, 0.0, 0.0], [100.0, 0.0, 0.0]])
         # A blade point 42 mm above the first spot, 15 mm beside its beam: under the body.
         samples = np.array([[15.0, 0.0, 42.0], [100.0, 30.0, 0.0]])
-        clear = planning._body_clear(samples, spot, 44.0)
+        clear = planning.body_clear(samples, spot, 44.0)
         self.assertEqual(clear.tolist(), [False, True])
 
 

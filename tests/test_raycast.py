@@ -14,6 +14,7 @@ import FreeCAD
 import Part
 
 from BladeInspect.cad import raycast
+from BladeInspect.core import raycast as ray_kernel
 from BladeInspect.cad.nominal import nominal_from_shape
 from tests.test_distance import twisted_blade
 
@@ -71,7 +72,7 @@ class TwistedBladeAgainstOCC(unittest.TestCase):
         grids = self.nominal._tessellation._grids
         self.assertEqual(len(grids), 0)
         self.assert_first_hits(o, d, t, face, nrm)
-        with mock.patch.object(raycast, "FEW_RAYS_PER_TRIANGLE", 0):
+        with mock.patch.object(ray_kernel, "FEW_RAYS_PER_TRIANGLE", 0):
             kept = self.nominal.raycast(o[::-1], d[::-1])
         self.assertEqual(len(grids), 1)
         again = self.nominal.raycast(o, d)
@@ -129,7 +130,7 @@ class ClosedForms(unittest.TestCase):
         z = rng.uniform(1.0, 19.0, n)
         o = b[:, None] * side - 30.0 * d + np.column_stack([np.zeros(n), np.zeros(n), z])
         jumps = []
-        original = raycast._other_root
+        original = ray_kernel._other_root
 
         def other_root(*args):
             starts = original(*args)
@@ -137,7 +138,7 @@ class ClosedForms(unittest.TestCase):
             return starts
         # Some of these rays' Newton lands on the far root first: the jump to the near one
         # (not OCC) must then find the entry root.
-        with mock.patch.object(raycast, "_other_root", other_root), \
+        with mock.patch.object(ray_kernel, "_other_root", other_root), \
                 mock.patch.object(raycast, "_occ_ray", side_effect=AssertionError("OCC used")):
             t, face, nrm = nominal.raycast(o, d)
         self.assertGreater(sum(jumps), 0)
@@ -166,16 +167,16 @@ class ClosedForms(unittest.TestCase):
         np.testing.assert_allclose(t1, 20.0, atol=1e-12)
         np.testing.assert_allclose(t2, 17.0, atol=1e-12)
 
-    @mock.patch.object(raycast, "FEW_RAYS_PER_TRIANGLE", 0)
+    @mock.patch.object(ray_kernel, "FEW_RAYS_PER_TRIANGLE", 0)
     def test_grid_cache_is_bounded(self):
         nominal = nominal_from_shape(Part.makeSphere(5.0))
         rng = np.random.default_rng(37)
-        for _ in range(raycast.MAX_CACHED_GRIDS + 4):
+        for _ in range(ray_kernel.MAX_CACHED_GRIDS + 4):
             d = unit(rng.normal(size=3))
             o = -20.0 * d + np.zeros((3, 3))
             t, _, _ = nominal.raycast(o, np.tile(d, (3, 1)))
             np.testing.assert_allclose(t, 15.0, atol=1e-9)
-        self.assertEqual(len(nominal._tessellation._grids), raycast.MAX_CACHED_GRIDS)
+        self.assertEqual(len(nominal._tessellation._grids), ray_kernel.MAX_CACHED_GRIDS)
 
 
 if __name__ == "__main__":

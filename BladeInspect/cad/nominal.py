@@ -7,32 +7,25 @@ spheres, surfaces of revolution and offsets become exact rational B-splines, and
 trimming curves are carried into the new parameterisation. ``Surface.toBSpline()`` is not
 used: for analytic surfaces it is an approximation (degree 14 for a cylinder, ~1e-10 off).
 
-Fast path of ``signed_distance``: a k-d tree over the samples gives, for each point, the nearby
-faces and a start (u, v) on each; Newton on every candidate face (vectorised per face), the
-smallest distance wins. A candidate is only trusted when Newton converged to a point inside
-the face's trimmed domain, away from its boundary; a point whose winner lies on a face edge
-(clamped at the parameter box) or that a doubtful candidate might beat goes to OCC
-(``Shape.distToShape``), point by point. The fraction that did is reported.
+Fast path of ``signed_distance``: core.closest (a k-d tree over the samples, Newton on the
+candidate faces); a point it cannot decide goes to OCC (``Shape.distToShape``), point by
+point. The fraction that did is reported.
 """
 
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
-from typing import Optional
-
 import numpy as np
-from scipy.spatial import cKDTree
 
 import FreeCAD
 import Part
 
 from ..core import bspline
 from ..core.bspline import SurfaceData
+from ..core.closest import DistanceResult, FaceDomain, FaceSet, Samples, point_in_domain
 from ..core.errors import InputError
+from ..core.raycast import Tessellation
 from ..core.trim import TrimDomain
 from .orient import face_sides, side_warnings
+from .raycast import cast, face_meshes
 
-# Number of nearest samples whose faces become Newton candidates for a point.
-K_CANDIDATES = 8
 # Samples per face and per direction at least, whatever the spacing.
 MIN_SAMPLES_PER_SIDE = 12
 # Total samples aimed at when no spacing is given.
@@ -42,47 +35,6 @@ PCURVE_SAMPLES = 400
 MAX_PCURVE_SAMPLES = 25600
 # Aimed chord error of the discretised trimming curves, relative to the parameter range.
 CHORD_TARGET = 1e-6
-# Relative cosine above which the gradient at a bound means "the minimum lies outside".
-CLAMP_COSINE = 1e-7
-# Newton results farther than this from the nearest sample's distance are distrusted (mm).
-SAMPLE_SLACK = 1e-9
-# Points per chunk in signed_distance (bounds the (chunk, K) candidate arrays).
-POINT_CHUNK = 32768
-# Threads for the numpy fast path.
-THREADS = 2
-
-
-@dataclass
-class Samples:
-    xyz: np.ndarray        # (M, 3) points on the faces, inside their trimmed domains
-    normal: np.ndarray     # (M, 3) outward unit normals
-    face: np.ndarray       # (M,) face index
-    uv: np.ndarray         # (M, 2) parameters on that face's SurfaceData
-    weight: np.ndarray     # (M,) area each sample stands for (mm^2)
-
-
-@dataclass
-class DistanceResult:
-    closest: np.ndarray    # (N, 3) closest points on the CAD
-    face: np.ndarray       # (N,) index into Nominal.faces
-    uv: np.ndarray         # (N, 2) parameters of the closest point on that face's SurfaceData
-    normal: np.ndarray     # (N, 3) outward unit normal there (at an edge: the direction p - c, signed)
-    distance: np.ndarray   # (N,) signed distance, + outside material / on the normal's side
-    fallback: Optional[np.ndarray] = None   # (N,) True where OCC decided
-
-    @property
-    def fallback_fraction(self):
-        if self.fallback is None or len(self.fallback) == 0:
-            return 0.0
-        return float(np.count_nonzero(self.fallback)) / len(self.fallback)
-
-
-@dataclass
-class FaceDomain:
-    """A face's trimmed domain in its SurfaceData's (u, v)."""
-    index: Optional[TrimDomain]      # the discretised boundary, or None for the whole box
-    margin: float                    # uv distance to the boundary below which we do not decide
-    planar_scale: Optional[float]    # length per parameter unit when the face is a plane
 
 
 def _flat_knots(knots, mults):
@@ -177,15 +129,6 @@ def _face_domain(nface, surf, planar):
     return FaceDomain(TrimDomain(segments), margin, planar_scale)
 
 
-def point_in_domain(domain, uv):
-    """(inside (N,) bool, boundary distance (N,) in uv, exact below domain.index.reach and
-    capped there) of parameter pairs against a face's domain."""
-    n = len(uv)
-    if domain.index is None:
-        return np.ones(n, bool), np.full(n, np.inf)
-    return domain.index.query(uv)
-
-
 def _extent(surf, n=9):
     """Rough lengths of the face along u and along v (longest iso-curve of an n x n grid)."""
     u = np.linspace(*surf.u_range, n)
@@ -211,14 +154,35 @@ class Nominal:
         self.roles = roles
         # cad.orient.FaceSide per face: how its outward side was decided
         self.face_sides = face_sides
+        # The faces as arrays for the numeric kernels (core.closest, core.raycast).
+        self.face_set = FaceSet(surfaces, domains, reversed_, samples)
         self._nurbs_faces = nurbs_faces
-        self._domains = domains
-        self._reversed = np.asarray(reversed_, bool)
-        self._tree = cKDTree(samples.xyz)
         self._solids = list(shape.Solids)
         self._face_compound = Part.makeCompound(faces)
         self._edge_faces = None
         self._tessellation = None
+
+    @property
+    def domains(self):
+        """core.closest.FaceDomain per face: its trimmed domain in its SurfaceData's (u, v)."""
+        return self.face_set.domains
+
+    @property
+    def reversed(self):
+        """(F,) bool per face: its outward normal is -(Su x Sv)."""
+        return self.face_set.reversed
+
+    def nearest_sample(self, points):
+        """Index into ``samples`` of each (N, 3) point's nearest sample."""
+        return self.face_set.nearest_sample(points)
+
+    def tessellation(self, deflection):
+        """core.raycast.Tessellation of the faces at this chord deflection (mm), kept until a
+        cast asks for another one (its per-direction grids are reused across casts)."""
+        if self._tessellation is None or self._tessellation.deflection != deflection:
+            self._tessellation = Tessellation(self.face_set, face_meshes(self.faces, deflection),
+                                              deflection)
+        return self._tessellation
 
     @property
     def cad_faces(self):
@@ -235,141 +199,10 @@ class Nominal:
     def signed_distance(self, points):
         """Exact signed distance of (N,3) points to the CAD faces -> DistanceResult."""
         points = _as_points(points, "signed_distance: points")
-        n = len(points)
-        out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
-                             np.empty((n, 3)), np.empty(n), np.zeros(n, bool))
-        starts = range(0, n, POINT_CHUNK)
-        work = lambda s: self._signed_distance_chunk(points[s:s + POINT_CHUNK], out, s)
-        # numpy releases the GIL in its array loops: chunks on two threads use both cores.
+        out, hard = self.face_set.closest(points)
         # OCC is only called afterwards, from this thread.
-        if len(starts) > 1:
-            with ThreadPoolExecutor(max_workers=THREADS) as pool:
-                hard = list(pool.map(work, starts))
-        else:
-            hard = [work(s) for s in starts]
-        hard = np.concatenate(hard) if hard else np.zeros(0, int)
         if len(hard):
             self._occ_into(points[hard], out, hard, solid_test=False)
-        return out
-
-    def _signed_distance_chunk(self, points, out, offset):
-        n = len(points)
-        k = min(K_CANDIDATES, len(self.samples.xyz))
-        sample_dist, idx = self._tree.query(points, k=k)
-        if k == 1:
-            sample_dist, idx = sample_dist[:, None], idx[:, None]
-        faces = self.samples.face[idx]
-        # First occurrence of each face in a point's k nearest samples (nearest sample first).
-        first = np.ones_like(faces, dtype=bool)
-        for j in range(1, k):
-            first[:, j] = np.all(faces[:, j:j + 1] != faces[:, :j], axis=1)
-        pi, cj = np.nonzero(first)
-        pf = faces[pi, cj]
-        start = self.samples.uv[idx[pi, cj]]
-        m = len(pi)
-        dist = np.full(m, np.inf)
-        lower = np.full(m, np.inf)       # a lower bound of the candidate's true face distance
-        trusted = np.zeros(m, bool)
-        on_edge = np.zeros(m, bool)
-        converged_pair = np.zeros(m, bool)
-        closest = np.empty((m, 3))
-        uv = np.empty((m, 2))
-        normal = np.empty((m, 3))
-        for f in np.unique(pf):
-            sel = np.flatnonzero(pf == f)
-            surf = self.surfaces[f]
-            p = points[pi[sel]]
-            u, v, S, Su, Sv, conv = bspline.project(surf, p, start[sel, 0], start[sel, 1])
-            r = S - p
-            d = np.linalg.norm(r, axis=1)
-            clamped = self._clamped(surf, u, v, r, Su, Sv, d)
-            nrm = np.cross(Su, Sv)
-            nlen = np.linalg.norm(nrm, axis=1)
-            degenerate = nlen <= 1e-12 * np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1) + 1e-300
-            nrm /= np.where(nlen > 0, nlen, 1.0)[:, None]
-            if self._reversed[f]:
-                nrm = -nrm
-            inside, bdist = point_in_domain(self._domains[f], np.column_stack([u, v]))
-            decided = bdist > self._domains[f].margin
-            ok = conv & inside & decided & ~degenerate
-            dist[sel], closest[sel], uv[sel, 0], uv[sel, 1], normal[sel] = d, S, u, v, nrm
-            trusted[sel] = ok
-            on_edge[sel] = clamped
-            converged_pair[sel] = conv
-            low = np.where(conv, d, 0.0)
-            dom = self._domains[f]
-            if dom.planar_scale is not None:
-                # On a plane the trimmed face is at least as far as the in-plane gap to its
-                # boundary, beside the height above the plane.
-                gap = np.where(inside, 0.0, np.maximum(bdist - dom.margin, 0.0)) * dom.planar_scale
-                low = np.where(conv, np.hypot(d, gap), 0.0)
-            lower[sel] = low
-        # Per point: the best trusted candidate; doubtful candidates must not be able to beat it.
-        best_d = np.full(n, np.inf)
-        np.minimum.at(best_d, pi[trusted], dist[trusted])
-        is_best = trusted & (dist == best_d[pi])
-        best = np.full(n, -1)
-        best[pi[is_best]] = np.flatnonzero(is_best)
-        has_best = best >= 0
-        bp = np.where(has_best[pi], best[pi], 0)
-        # On an edge: the face across it reaches the same closest point (clamped there too, or,
-        # for a plane trimmed by that edge, the point lies in its plane). Such a partner is no
-        # threat, and the two outward normals together give the sign (their sum is the edge's
-        # pseudo-normal, which is right for any point whose closest point is on the edge).
-        planar = np.array([d.planar_scale is not None for d in self._domains])[pf]
-        partner = (has_best[pi] & on_edge[bp] & (np.arange(m) != bp) & converged_pair
-                   & ((on_edge & (np.linalg.norm(closest - closest[bp], axis=1) < 1e-7))
-                      | (planar & (np.abs(np.einsum("ij,ij->i", closest[bp] - closest, normal))
-                                   < 1e-9))))
-        threat = ~trusted & ~partner & (lower < best_d[pi] - 1e-12)
-        need = np.zeros(n, bool)
-        need[pi[threat]] = True
-        need |= ~has_best
-        n_partner = np.bincount(pi[partner], minlength=n)
-        partner_normal = np.zeros((n, 3))
-        np.add.at(partner_normal, pi[partner], normal[partner])
-        good = ~need
-        edge = np.zeros(n, bool)
-        edge[good] = on_edge[best[good]]
-        need |= edge & (n_partner != 1)
-        need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
-        good = ~need
-        b = best[good]
-        rows = offset + np.flatnonzero(good)
-        c = closest[b]
-        nrm = normal[b].copy()
-        e = edge[good]
-        pseudo = nrm + np.where(e[:, None], partner_normal[good], 0.0)
-        diff = points[good] - c
-        sign = np.where(np.einsum("ij,ij->i", diff, pseudo) < 0, -1.0, 1.0)
-        if e.any():
-            # At an edge the distance runs along p - c, not along either face's normal.
-            de = np.maximum(dist[b][e], 1e-300)
-            nrm[e] = sign[e, None] * diff[e] / de[:, None]
-        out.closest[rows] = c
-        out.face[rows] = pf[b]
-        out.uv[rows] = uv[b]
-        out.normal[rows] = nrm
-        out.distance[rows] = sign * dist[b]
-        out.fallback[rows] = False
-        return offset + np.flatnonzero(need)
-
-    @staticmethod
-    def _clamped(surf, u, v, r, Su, Sv, d):
-        """True where the foot point sits on the parameter box with the distance still falling
-        outward: the closest point of the face is on its boundary edge."""
-        (u0, u1), (v0, v1) = surf.u_range, surf.v_range
-        gu = np.einsum("ij,ij->i", r, Su)
-        gv = np.einsum("ij,ij->i", r, Sv)
-        tu = CLAMP_COSINE * d * np.linalg.norm(Su, axis=1)
-        tv = CLAMP_COSINE * d * np.linalg.norm(Sv, axis=1)
-        eu = 1e-12 * (u1 - u0)
-        ev = 1e-12 * (v1 - v0)
-        out = np.zeros(len(u), bool)
-        if not surf.closed_u:
-            out |= ((u <= u0 + eu) & (gu > tu)) | ((u >= u1 - eu) & (gu < -tu))
-        if not surf.closed_v:
-            out |= ((v <= v0 + ev) & (gv > tv)) | ((v >= v1 - ev) & (gv < -tv))
         return out
 
     # ------------------------------------------------------------------ OCC reference
@@ -393,17 +226,7 @@ class Nominal:
             out.distance[row] = d
             out.fallback[row] = True
         # Parameters on our SurfaceData: project the exact closest points (they are on face f).
-        faces = out.face[rows]
-        for f in np.unique(faces):
-            sel = rows[faces == f]
-            _, idx = self._tree.query(out.closest[sel], k=1)
-            start = self.samples.uv[idx]
-            same = self.samples.face[idx] == f
-            if not np.all(same):
-                start = np.where(same[:, None], start, [[np.mean(self.surfaces[f].u_range),
-                                                          np.mean(self.surfaces[f].v_range)]])
-            u, v, _, _ = bspline.project_points(self.surfaces[f], out.closest[sel], start[:, 0], start[:, 1])
-            out.uv[sel] = np.column_stack([u, v])
+        out.uv[rows] = self.face_set.parameters_of(out.closest, out.face, rows)
 
     def _occ_point(self, p, solid_test=True):
         """(signed distance, face, closest point, normal) of one point by OCC. The sign comes
@@ -495,8 +318,7 @@ class Nominal:
     def raycast(self, origins, directions, deflection=None):
         """First hit of each ray o + t d (t >= 0) on the CAD faces -> (t (N,) NaN on a miss,
         face (N,) -1 on a miss, outward normal (N,3)). Directions need not be unit: t is in
-        units of |d| (mm for unit directions). See cad.raycast for the method."""
-        from .raycast import cast
+        units of |d| (mm for unit directions). See core.raycast for the method."""
         return cast(self, origins, directions, deflection)
 
 
@@ -552,7 +374,7 @@ def nominal_from_shape(shape, roles=None, sample_spacing=None, flip_faces=()):
     Faces outside a closed solid are turned outward by cad.orient's rule (``flip_faces``:
     indices whose side the user reverses); ``Nominal.face_sides`` says how each was decided.
     The faces the Nominal keeps (and, for a shape without solids, its shape) carry the
-    decided orientations, so the fast path (``_reversed``), OCC's ``normalAt`` in the fallback
+    decided orientations, so the fast path (``reversed``), OCC's ``normalAt`` in the fallback
     and the ray caster all see the same outward side.
     """
     if shape is None or shape.isNull() or len(shape.Faces) == 0:

@@ -104,7 +104,7 @@ def horn(target, source, weights=None):
     return R, ct - R @ cs
 
 
-def _snr_weights(snr, n):
+def snr_weights(snr, n):
     if snr is None:
         return np.ones(n)
     snr = np.asarray(snr, dtype=float)
@@ -354,7 +354,7 @@ def icp(points, snr, closest_fn, init, options=None):
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 7:
         raise InputError("icp: need at least 7 points of shape (N, 3), got %s"
                          % (points.shape,))
-    a = _snr_weights(snr, len(points))
+    a = snr_weights(snr, len(points))
     neighbourhoods = (Neighbourhoods(points, options.defect_neighbours)
                       if 0 < options.defect_neighbours < len(points) else None)
     T = np.array(init, dtype=float)

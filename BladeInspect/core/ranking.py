@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .icp import MAD_TO_SIGMA, ICPOptions, _snr_weights
+from .icp import MAD_TO_SIGMA, ICPOptions, snr_weights
 
 # Vuong statistic above which the best candidate is taken as decided. Under exact equivalence
 # z is the |N(0,1)| of the better of two: it exceeds 4 once in 16,000 registrations, so a
@@ -60,7 +60,7 @@ def standardised(distances, snr, options=None):
     distance is not finite."""
     options = options or ICPOptions()
     d = np.asarray(distances, dtype=float)
-    a = _snr_weights(snr, len(d))
+    a = snr_weights(snr, len(d))
     z = np.abs(d) * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2))
     return np.where(np.isfinite(z), z, np.inf)
 

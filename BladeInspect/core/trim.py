@@ -3,31 +3,43 @@ vectorised over many parameter pairs.
 
 The boundary is a soup of segments (the face's discretised trimming curves, in any order and
 direction); inside is decided by the even-odd rule on a ray towards +u. Segments are bucketed
-in a uniform grid so each query meets only the few segments near it: rows of the grid for the
-crossing count, cells dilated by one cell for the distance, which is therefore exact up to one
-cell size and reported as that cell size beyond (a valid lower bound, all callers need).
+in a uniform grid so each query meets only the few segments near it: cells dilated by one cell
+for the distance, which is therefore exact up to one cell size and reported as that cell size
+beyond (a valid lower bound, all callers need); for the crossing count, finer v bands of their
+own (every segment that straddles a point's v is in that point's band, so the count is exact
+whatever the bands; finer bands just pair each point with fewer segments).
 """
 
 import numpy as np
 
 # Target number of segments per grid row / column.
 SEGMENTS_PER_BIN = 8
+# Most rows of the crossing count's own bands.
+MAX_ROWS = 8192
 
 
-def _csr(bin_ids, item_ids, n_bins):
+def csr(bin_ids, item_ids, n_bins):
+    """Items bucketed by bin: (start, count per bin, items ordered by bin), for bucket_pairs."""
     order = np.argsort(bin_ids, kind="stable")
     counts = np.bincount(bin_ids, minlength=n_bins)
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
     return starts, counts, item_ids[order]
 
 
-def _pairs(query_bins, starts, counts, members):
-    """(query index, member) for every member of each query's bin."""
+def bucket_pairs(query_bins, starts, counts, members):
+    """(query index, member) for every member of each query's bin of a csr table."""
     cnt = counts[query_bins]
     q = np.repeat(np.arange(len(query_bins)), cnt)
     first = np.repeat(starts[query_bins], cnt)
     offset = np.arange(len(q)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
     return q, members[first + offset]
+
+
+def _ranges(starts, counts):
+    """(owner, value): for each i, counts[i] entries owner i with values starts[i] + 0, 1, ..."""
+    owner = np.repeat(np.arange(len(counts)), counts)
+    return owner, starts[owner] + np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts,
+                                                                    counts)
 
 
 class TrimDomain:
@@ -42,26 +54,28 @@ class TrimDomain:
         self.cell = span / g
         self.origin = lo.min(axis=0) - self.cell          # one dilation cell on each side
         self.shape = (g + 2, g + 2)
-        k = np.arange(len(self.segments))
-        # Rows (v bands) each segment crosses, for the even-odd count.
-        r0 = self._index(lo[:, 1], 1)
-        r1 = self._index(hi[:, 1], 1)
-        rows_seg = np.repeat(k, r1 - r0 + 1)
-        rows = np.concatenate([np.arange(s, e + 1) for s, e in zip(r0, r1)])
-        self._rows = _csr(rows, rows_seg, self.shape[1])
+        # v bands each segment crosses, for the even-odd count (one spare band each side).
+        n_bands = int(np.clip(len(self.segments) // SEGMENTS_PER_BIN, g, MAX_ROWS))
+        self.band = span[1] / n_bands
+        self.band_origin = lo[:, 1].min() - self.band
+        self.n_bands = n_bands + 2
+        r0 = self._band(lo[:, 1])
+        r1 = self._band(hi[:, 1])
+        rows_seg, rows = _ranges(r0, r1 - r0 + 1)
+        self._rows = csr(rows, rows_seg, self.n_bands)
         # Cells of each segment's box dilated by one cell, for the distance.
         c0u, c1u = self._index(lo[:, 0], 0) - 1, self._index(hi[:, 0], 0) + 1
         c0v, c1v = self._index(lo[:, 1], 1) - 1, self._index(hi[:, 1], 1) + 1
         c0u, c0v = np.maximum(c0u, 0), np.maximum(c0v, 0)
         c1u, c1v = np.minimum(c1u, self.shape[0] - 1), np.minimum(c1v, self.shape[1] - 1)
-        ids, cells = [], []
-        for i in range(len(k)):
-            uu, vv = np.meshgrid(np.arange(c0u[i], c1u[i] + 1), np.arange(c0v[i], c1v[i] + 1),
-                                 indexing="ij")
-            cells.append((uu * self.shape[1] + vv).ravel())
-            ids.append(np.full(cells[-1].size, i))
-        self._cells = _csr(np.concatenate(cells), np.concatenate(ids), self.shape[0] * self.shape[1])
+        nv = c1v - c0v + 1
+        ids, local = _ranges(np.zeros_like(c0u), (c1u - c0u + 1) * nv)
+        cells = (c0u[ids] + local // nv[ids]) * self.shape[1] + c0v[ids] + local % nv[ids]
+        self._cells = csr(cells, ids, self.shape[0] * self.shape[1])
         self.reach = float(self.cell.min())
+
+    def _band(self, v):
+        return np.clip(((v - self.band_origin) / self.band).astype(int), 0, self.n_bands - 1)
 
     def _index(self, x, axis):
         return np.clip(((x - self.origin[axis]) / self.cell[axis]).astype(int), 0, self.shape[axis] - 1)
@@ -72,9 +86,10 @@ class TrimDomain:
         n = len(uv)
         a, b = self.segments[:, 0], self.segments[:, 1]
         # Even-odd count of crossings of the ray from each point towards +u.
-        row = self._index(uv[:, 1], 1)
-        in_rows = (uv[:, 1] >= self.origin[1]) & (uv[:, 1] < self.origin[1] + self.shape[1] * self.cell[1])
-        q, s = _pairs(np.where(in_rows, row, 0), *self._rows)
+        row = self._band(uv[:, 1])
+        in_rows = ((uv[:, 1] >= self.band_origin)
+                   & (uv[:, 1] < self.band_origin + self.n_bands * self.band))
+        q, s = bucket_pairs(np.where(in_rows, row, 0), *self._rows)
         keep = in_rows[q]
         q, s = q[keep], s[keep]
         ay, by = a[s, 1], b[s, 1]
@@ -90,7 +105,7 @@ class TrimDomain:
         iv = ((uv[:, 1] - self.origin[1]) / self.cell[1]).astype(int)
         in_grid = (iu >= 0) & (iu < self.shape[0]) & (iv >= 0) & (iv < self.shape[1])
         cell = np.where(in_grid, iu * self.shape[1] + iv, 0)
-        q, s = _pairs(cell, *self._cells)
+        q, s = bucket_pairs(cell, *self._cells)
         keep = in_grid[q]
         q, s = q[keep], s[keep]
         if len(q):

@@ -64,10 +64,7 @@ def show_result(title, text):
     if progress.SHOW_DIALOGS and FreeCAD.GuiUp:
         box = QtGui.QMessageBox(QtGui.QMessageBox.Information, "BladeInspect: " + title, text,
                                 QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
-        box.setModal(False)
-        box.finished.connect(lambda *_: progress._open_boxes.remove(box))
-        progress._open_boxes.append(box)
-        box.show()
+        progress.show_modeless(box)
 
 
 def output_folder(doc, kind):
@@ -96,7 +93,7 @@ def _show_table(title, table, note):
 
 # ---------------------------------------------------------------- task panels
 
-class InspectPanel(taskpanels._Panel):
+class InspectPanel(taskpanels.FormPanel):
     """Nominal section heights, tolerance, seed and the rig calibration file."""
     title = "Inspect"
 
@@ -106,8 +103,8 @@ class InspectPanel(taskpanels._Panel):
         self.heights = QtGui.QLineEdit(", ".join("%g" % h
                                                  for h in contracts.SECTION_HEIGHTS_PCT))
         self.heights.setToolTip("Nominal sections to measure, % of the span from hub to tip")
-        self.tolerance = taskpanels._spin(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm")
-        self.seed = taskpanels._spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.tolerance = taskpanels.spin_box(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm")
+        self.seed = taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
         self.seed.setToolTip("Fixture pose of the simulated rig and the registration's sampling")
         self.rig_file = QtGui.QLineEdit(LAST_RIG_FILE[0] or "")
         self.rig_file.setToolTip("RIG.json from Calibrate; empty: the nominal kinematics")
@@ -137,9 +134,9 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
     def __init__(self, on_accept):
         from ..measurement.calibration import DEFAULT_DIAMETER
         super().__init__(on_accept)
-        self.diameter = taskpanels._spin(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
-        self.offset = taskpanels._spin(0.0, 0.0, 10.0, 3, "mm")
-        self.tilt = taskpanels._spin(0.0, 0.0, 5.0, 3, "deg")
+        self.diameter = taskpanels.spin_box(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
+        self.offset = taskpanels.spin_box(0.0, 0.0, 10.0, 3, "mm")
+        self.tilt = taskpanels.spin_box(0.0, 0.0, 5.0, 3, "deg")
         self.layout.addRow("Sphere diameter", self.diameter)
         self.layout.addRow("Axis offset (simulated)", self.offset)
         self.layout.addRow("Axis tilt (simulated)", self.tilt)
@@ -161,18 +158,18 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
         return True
 
 
-class SimulatePanel(taskpanels._Panel):
+class SimulatePanel(taskpanels.FormPanel):
     """The simulation test bed's options (inspection.simulate.simulate_measurement)."""
     title = "Simulation test bed"
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.points = taskpanels._spin(20000, 10, 2000000)
+        self.points = taskpanels.spin_box(20000, 10, 2000000)
         self.noise = QtGui.QComboBox()
         self.noise.addItems(["uniform", "normal"])
-        self.outliers = taskpanels._spin(0.0, 0.0, 0.5, 3)
-        self.seed = taskpanels._spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.outliers = taskpanels.spin_box(0.0, 0.0, 0.5, 3)
+        self.seed = taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
         self.layout.addRow("Surface points", self.points)
         self.layout.addRow("Measurement error", self.noise)
         self.layout.addRow("Outlier fraction", self.outliers)

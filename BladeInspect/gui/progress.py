@@ -25,16 +25,22 @@ def busy():
     return bool(_busy)
 
 
+def show_modeless(box):
+    """Show a message box without blocking; it is kept referenced until closed (else Python
+    collects it and it vanishes)."""
+    box.setModal(False)
+    box.finished.connect(lambda *_: _open_boxes.remove(box))
+    _open_boxes.append(box)
+    box.show()
+
+
 def report_error(title, text):
     MESSAGES.append((title, text))
     FreeCAD.Console.PrintError("BladeInspect: %s: %s\n" % (title, text))
     if SHOW_DIALOGS and FreeCAD.GuiUp:
         box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "BladeInspect: " + title, text,
                                 QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
-        box.setModal(False)
-        box.finished.connect(lambda *_: _open_boxes.remove(box))
-        _open_boxes.append(box)
-        box.show()
+        show_modeless(box)
 
 
 class StatusProgress:

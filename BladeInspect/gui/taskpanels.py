@@ -11,7 +11,7 @@ from ..app import settings
 from ..inspection.result import rival_lines
 
 
-def _spin(value, minimum, maximum, decimals=3, suffix=""):
+def spin_box(value, minimum, maximum, decimals=3, suffix=""):
     if isinstance(value, int) and not isinstance(value, bool):
         box = QtGui.QSpinBox()
         box.setRange(int(minimum), int(maximum))
@@ -26,7 +26,7 @@ def _spin(value, minimum, maximum, decimals=3, suffix=""):
     return box
 
 
-class _Panel:
+class FormPanel:
     title = ""
 
     def __init__(self):
@@ -39,7 +39,7 @@ class _Panel:
         return True
 
 
-class DemoBladePanel(_Panel):
+class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
     title = "Demo blade"
 
@@ -54,7 +54,7 @@ class DemoBladePanel(_Panel):
             value = getattr(defaults, field.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 continue
-            box = _spin(value, -1e4, 1e4)
+            box = spin_box(value, -1e4, 1e4)
             self.boxes[field.name] = box
             self.layout.addRow(field.name.replace("_", " "), box)
 
@@ -69,7 +69,7 @@ class DemoBladePanel(_Panel):
         return True
 
 
-class ConnectRigPanel(_Panel):
+class ConnectRigPanel(FormPanel):
     """Simulated rig, or a serial port picked from the ports pyserial finds."""
     title = "Connect rig"
 
@@ -82,7 +82,7 @@ class ConnectRigPanel(_Panel):
         self.port.setEditable(True)
         for port in self._ports():
             self.port.addItem(port)
-        self.seed = _spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
         self.layout.addRow("Rig", self.kind)
         self.layout.addRow("Port", self.port)
         self.layout.addRow("Seed (simulated)", self.seed)
@@ -114,23 +114,23 @@ class ConnectRigPanel(_Panel):
         return True
 
 
-class ScanPanel(_Panel):
+class ScanPanel(FormPanel):
     """Scan parameters (the scan strategy's options), defaults from the preferences."""
     title = "Scan"
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.sections = _spin(settings.value("Sections"), 1, 200)
-        self.spacing = _spin(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm")
+        self.sections = spin_box(settings.value("Sections"), 1, 200)
+        self.spacing = spin_box(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm")
         self.spacing.setToolTip("Distance between sections; 0 spreads them over the span")
-        self.point_spacing = _spin(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm")
-        self.sides = _spin(settings.value("Sides"), 1, 2)
+        self.point_spacing = spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm")
+        self.sides = spin_box(settings.value("Sides"), 1, 2)
         self.sides.setToolTip("2 turns the part over to scan the other side")
-        self.epsilon = _spin(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm")
+        self.epsilon = spin_box(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm")
         self.epsilon.setToolTip("Rescan a section until every point is within this distance "
                                 "of the sensor's standoff")
-        self.seed = _spin(settings.value("Seed"), 0, 2 ** 31 - 1)
+        self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
         self.layout.addRow("Sections", self.sections)
         self.layout.addRow("Section spacing", self.spacing)
         self.layout.addRow("Point spacing", self.point_spacing)

@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from .. import __version__, NAME
+from ..core import csvtext
 from ..core import icp as icp_mod
 from ..core import pca as pca_mod
 from ..core import ranking
@@ -105,15 +106,10 @@ def _subsample(n, k, rng):
 def _sample_closest_fn(nominal):
     """Closest point on the nominal's dense samples, point-to-plane distance to the sample's
     tangent plane: good to the sample spacing's curvature error, enough to rank candidates."""
-    from scipy.spatial import cKDTree
-    tree = getattr(nominal, "_coarse_tree", None)
-    if tree is None:
-        tree = cKDTree(nominal.samples.xyz)
-        nominal._coarse_tree = tree
     xyz, nrm = nominal.samples.xyz, nominal.samples.normal
 
     def closest(points):
-        _, idx = tree.query(points)
+        idx = nominal.nearest_sample(points)
         normal = nrm[idx]
         dist = np.einsum("ij,ij->i", points - xyz[idx], normal)
         return points - dist[:, None] * normal, normal, dist
@@ -570,28 +566,22 @@ def _write_deviations_csv(path, result):
             result.deviation]
     header = ["x", "y", "z", "deviation_mm", "snr", "inlier"]
     snr = result.snr if result.snr is not None else np.full(result.n_points, np.nan)
-    cols += [snr, result.inlier.astype(float)]
-    fmts = ["%.6f"] * 4 + ["%.3f", "%d"]
+    # Byte matrices per column (core.csvtext): what "%.6f", "%.3f" and "%d" print, unformatted
+    # one value at a time.
+    text = [csvtext.fixed_matrix(c, 6) for c in cols] + [csvtext.fixed_matrix(snr, 3),
+                                                          csvtext.integer_matrix(result.inlier)]
     for name, values in result.columns.items():
         values = np.asarray(values)
         if name in header or len(values) != result.n_points:
             continue
         header.append(name)
         if values.dtype.kind in "fc":
-            cols.append(values)
-            fmts.append("%.6g")
+            text.append(csvtext.string_matrix(np.char.mod("%.6g", values)))
         else:
-            cols.append(values.astype(str))
-            fmts.append("%s")
-    # One formatted string per column, joined row-wise: several times faster than savetxt.
-    text_cols = [np.char.mod(f, c) if f != "%s" else c for f, c in zip(fmts, cols)]
-    rows = text_cols[0].astype(object)
-    for c in text_cols[1:]:
-        rows = rows + "," + c.astype(object)
-    with open(path, "w") as fh:
-        fh.write(",".join(header) + "\n")
-        fh.write("\n".join(rows.tolist()))
-        fh.write("\n")
+            text.append(csvtext.string_matrix(values.astype(str)))
+    with open(path, "wb") as fh:
+        fh.write((",".join(header) + "\n").encode("utf-8"))
+        fh.write(csvtext.csv_rows(text))
 
 
 class AtomicOutput:

@@ -19,8 +19,8 @@ from scipy.ndimage import binary_dilation
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
 from ..rig.kinematics import RigKinematics
-from .planning import (ANGLES, COVERAGE_MARGIN_DEG, _blade_faces, _body_clear,
-                       _expected_snr, _incidence_table, plan_json)
+from .planning import (ANGLES, COVERAGE_MARGIN_DEG, blade_faces, body_clear,
+                       expected_snr, incidence_table, plan_json)
 
 DEFAULT_PITCH_MM = 0.1
 # Along a line: 0.25 mm steps give the paper's ~269,000 points on a 70 x 50 x 20 mm blade at
@@ -150,17 +150,17 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
     usable = np.cos(np.radians(0.5 * float(sensor.coverage_deg) - COVERAGE_MARGIN_DEG))
 
     s = nominal.samples
-    faces = np.asarray(_blade_faces(nominal))
+    faces = np.asarray(blade_faces(nominal))
     on_blade = np.isin(s.face, faces)
     samples_t = tf.apply_transform(cad_to_table, s.xyz)
     normals_t = s.normal[on_blade] @ cad_to_table[:3, :3].T
     if angles_deg is None:
-        angles = _even_angles(_incidence_table(normals_t, ANGLES, kinematics), int(n_angles))
+        angles = _even_angles(incidence_table(normals_t, ANGLES, kinematics), int(n_angles))
     else:
         angles = np.unique(np.mod(np.asarray(angles_deg, dtype=float), 360.0))
         if len(angles) == 0 or not np.all(np.isfinite(angles)):
             raise InputError("complete scan angles: expected finite rotary angles")
-    cos_samples = _incidence_table(normals_t, angles, kinematics)
+    cos_samples = incidence_table(normals_t, angles, kinematics)
     best_sample = np.argmax(cos_samples, axis=0)
 
     # Lines span the blade faces along machine Y at every angle (the axis may lean off Y).
@@ -194,13 +194,13 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         blade_hit = hit & np.isin(face, faces)
         info["dropped_off_blade"] += int(np.count_nonzero(hit & ~blade_hit))
         n_t = np.asarray(normal, dtype=float) @ cad_to_table[:3, :3].T
-        cos_here = _incidence_table(n_t, angles, kinematics)
+        cos_here = incidence_table(n_t, angles, kinematics)
         best = blade_hit & (np.argmax(cos_here, axis=0) == ai)
         info["dropped_not_best"] += int(np.count_nonzero(blade_hit & ~best))
         seen = best & (cos_here[ai] >= usable)
         info["dropped_coverage"] += int(np.count_nonzero(best & ~seen))
         spot = lens_m[seen] - np.outer(t[seen], [0.0, 0.0, 1.0])
-        clear = _body_clear(all_m, spot, standoff)
+        clear = body_clear(all_m, spot, standoff)
         info["dropped_body"] += int(np.count_nonzero(~clear))
         keep = np.flatnonzero(seen)[clear]
         spot = spot[clear]
@@ -231,7 +231,7 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         pitch_mm=pitch, spacing_mm=spacing, angles_deg=np.asarray(angles, dtype=float),
         line_y=line_y, line=cat["line"], angle_deg=cat["angle"], stage_xyz=cat["stage"],
         target_cad=cat["target"], normal_cad=cat["normal"], face=cat["face"],
-        incidence_deg=incidence, expected_snr=_expected_snr(sensor, np.radians(incidence)),
+        incidence_deg=incidence, expected_snr=expected_snr(sensor, np.radians(incidence)),
         passes=passes, table_to_cad=table_to_cad, standoff_mm=standoff, info=info)
 
 

@@ -136,7 +136,7 @@ class Plan:
 
 # ---------------------------------------------------------------- geometry helpers
 
-def _blade_faces(nominal):
+def blade_faces(nominal):
     """Faces that make the airfoil: the roles when known, else every non-planar face (the
     hub and tip caps of a blade are planes)."""
     roles = nominal.roles or {}
@@ -154,7 +154,7 @@ def span_axis_of(nominal, span_axis=None):
     it. Default: the longest principal axis of the blade faces' area-weighted
     samples, pointing from the hub towards the tip when the CAD marks them."""
     s = nominal.samples
-    mask = np.isin(s.face, _blade_faces(nominal))
+    mask = np.isin(s.face, blade_faces(nominal))
     xyz, w = s.xyz[mask], s.weight[mask]
     if span_axis is None:
         axes = pca.principal_axes(xyz, w)
@@ -281,7 +281,7 @@ def _surface_normals(nominal, points):
 
 # ---------------------------------------------------------------- angles
 
-def _incidence_table(normals_table, angles_deg, kinematics):
+def incidence_table(normals_table, angles_deg, kinematics):
     """cos(incidence) of every normal at every candidate angle, (A, K): the machine normal's
     Z component after turning the table by the angle."""
     cosines = np.empty((len(angles_deg), len(normals_table)))
@@ -318,7 +318,7 @@ def _beam_rays(table_to_cad, kinematics, angle_deg, spot_machine, standoff):
     return origins, np.tile(down, (len(origins), 1))
 
 
-def _body_clear(samples_machine, spot_machine, standoff):
+def body_clear(samples_machine, spot_machine, standoff):
     """The sensor body, a cylinder about the beam from just below the lens upwards, must hold
     none of the blade's samples. The samples' highest z per cell of a 2D grid, spread over a
     disc of the body's radius (grown by a cell's diagonal, so the test errs on the safe side),
@@ -341,7 +341,7 @@ def _body_clear(samples_machine, spot_machine, standoff):
     return highest < spot_machine[:, 2] + standoff - BODY_CLEARANCE_MM
 
 
-def _expected_snr(sensor, incidence_rad):
+def expected_snr(sensor, incidence_rad):
     """The sensor model's noise-free SNR at the range centre and the planned incidence."""
     return np.asarray(sensor.snr(np.full(len(incidence_rad), sensor.standoff), incidence_rad),
                       dtype=float)
@@ -374,7 +374,7 @@ class _SectionWork:
         self.target, self.normal, self.contours = target, normal, contours
         cad_to_table = tf.invert_transform(table_to_cad)
         self.target_t = tf.apply_transform(cad_to_table, target)
-        self.cosines = _incidence_table(normal @ cad_to_table[:3, :3].T, ANGLES, kinematics)
+        self.cosines = incidence_table(normal @ cad_to_table[:3, :3].T, ANGLES, kinematics)
         self.chosen = []
         self.score = np.full(self.cosines.shape, -np.inf)
         self.beam_length = np.full(self.cosines.shape, np.nan)
@@ -399,7 +399,7 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
             o, d = _beam_rays(table_to_cad, kinematics, a, spot, standoff)
             if row not in samples_m:
                 samples_m[row] = kinematics.machine_point_of_table(samples_table, a)
-            clear = _body_clear(samples_m[row], spot, standoff)
+            clear = body_clear(samples_m[row], spot, standoff)
             requests.append((work, row, cand, clear))
             origins.append(o)
             directions.append(d)
@@ -443,7 +443,7 @@ def _finish_section(work, kinematics, sensor, limits):
         index=work.index, height_pct=work.height, plane_point=work.plane_point,
         plane_normal=work.axis.copy(), target_cad=work.target, normal_cad=work.normal,
         angle_deg=angle, stage_xyz=stage, expected_standoff_mm=work.beam_length[rows, idx],
-        incidence_deg=incidence, expected_snr=_expected_snr(sensor, np.radians(incidence)))
+        incidence_deg=incidence, expected_snr=expected_snr(sensor, np.radians(incidence)))
 
 
 def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=None,

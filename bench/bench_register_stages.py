@@ -1,0 +1,132 @@
+"""Stage times of the whole `register` command (load CAD, load points, coarse, fine, deviations,
+write) at the paper's 269,158 points on three blades in one run (issue 14's speed target):
+
+- the built-in demo blade;
+- NASA Rotor 67 lofted from its section table (../shared/data/blades/nasa_rotor67);
+- a third-party-like STEP: the demo blade's B-spline sides, run past hub and tip, cut by a
+  hub that is a trimmed surface of revolution (a revolved arc) and a tip that is a trimmed
+  cylinder about the same engine axis, written to STEP and read back (built here, not kept).
+
+    scripts/fcpython bench/bench_register_stages.py [--points 269158] [--seed 14]
+        [--save FILE.npz] [--compare FILE.npz]
+
+``--save`` keeps each blade's pose and deviations; ``--compare`` prints the largest pose
+difference (mm at the CAD's bounding-box corners) and deviation difference against such a
+file (a revision before a change against one after it).
+"""
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from BladeInspect.core import transforms as tf
+from BladeInspect.core.pointio import write_points_csv
+from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.simulate import simulate_measurement
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROTOR67 = os.path.join(HERE, "..", "..", "shared", "data", "blades", "nasa_rotor67",
+                       "rotor67geometry.dat")
+PAPER_POINTS = 269158
+# The third-party blade: engine axis along x, this far below the demo blade's hub (mm).
+HUB_RADIUS = 120.0
+# How far the sides run past the caps before they are cut (mm).
+OVERRUN = 4.0
+
+
+def write_revolved_cap_step(path):
+    """The demo blade cut by a revolved hub and a cylindrical tip, as a STEP file."""
+    import Part
+    import FreeCAD
+    from BladeInspect.cad.demo_blade import BladeParams, make_demo_blade
+
+    span = BladeParams().span
+    long_params = BladeParams(span=span + 2 * OVERRUN)
+    blade = make_demo_blade(long_params).shape
+    blade.translate(FreeCAD.Vector(0, 0, -OVERRUN))
+    # The annulus between hub and tip in the (x, r) half-plane, revolved about the x axis
+    # through (0, 0, -HUB_RADIUS): the hub line is an arc (a surface of revolution that is no
+    # cylinder or cone), the tip a straight line (a cylinder).
+    lo = blade.BoundBox
+    x0, x1 = lo.XMin - 10.0, lo.XMax + 10.0
+    axis_z = -HUB_RADIUS
+    r_hub, r_tip = HUB_RADIUS, HUB_RADIUS + span
+    sag = 1.5
+    p = lambda x, r: FreeCAD.Vector(x, 0.0, axis_z + r)
+    hub = Part.Arc(p(x0, r_hub), p(0.5 * (x0 + x1), r_hub - sag), p(x1, r_hub)).toShape()
+    wire = Part.Wire([hub, Part.LineSegment(p(x1, r_hub), p(x1, r_tip)).toShape(),
+                      Part.LineSegment(p(x1, r_tip), p(x0, r_tip)).toShape(),
+                      Part.LineSegment(p(x0, r_tip), p(x0, r_hub)).toShape()])
+    annulus = Part.Face(wire).revolve(FreeCAD.Vector(0, 0, axis_z), FreeCAD.Vector(1, 0, 0), 360)
+    cut = blade.common(Part.Solid(annulus) if annulus.ShapeType != "Solid" else annulus)
+    solids = cut.Solids
+    if len(solids) != 1:
+        raise RuntimeError("third-party blade: the cut gave %d solids" % len(solids))
+    solids[0].exportStep(path)
+    return path
+
+
+def blades(tmp):
+    out = [("demo blade", None)]
+    if os.path.exists(ROTOR67):
+        out.append(("Rotor 67", ROTOR67))
+    else:
+        print("Rotor 67 skipped: %s not found" % ROTOR67)
+    out.append(("third-party STEP", write_revolved_cap_step(os.path.join(tmp, "blade.step"))))
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--points", type=int, default=PAPER_POINTS)
+    ap.add_argument("--seed", type=int, default=14)
+    ap.add_argument("--save")
+    ap.add_argument("--compare")
+    args = ap.parse_args(argv)
+    print("load average %.2f %.2f %.2f on %d cores" % (os.getloadavg() + (os.cpu_count(),)))
+    tmp = tempfile.mkdtemp(prefix="bench-stages-")
+    saved, reference = {}, (dict(np.load(args.compare)) if args.compare else None)
+    try:
+        for k, (name, cad) in enumerate(blades(tmp)):
+            nominal = pipeline.load_nominal(cad)
+            if cad is not None and cad.endswith(".step"):
+                kinds = sorted({type(f.Surface).__name__ for f in
+                                __import__("Part").read(cad).Faces})
+                print("%s: faces %s" % (name, ", ".join(kinds)))
+            ps, _, _, _ = simulate_measurement(nominal, n_points=args.points, section_heights=(),
+                                               outlier_fraction=0.02, seed=args.seed)
+            points = os.path.join(tmp, "points%d.csv" % k)
+            write_points_csv(points, ps.xyz, {"snr": ps.snr})
+            out = os.path.join(tmp, "out%d" % k)
+            t0 = time.perf_counter()
+            result = pipeline.run_register(cad, points, out, seed=args.seed)
+            total = time.perf_counter() - t0
+            print("%-17s %d points: register %.2f s (%s)"
+                  % (name, len(ps.xyz), total,
+                     ", ".join("%s %.2f" % kv for kv in result.timing_s.items())), flush=True)
+            key = "b%d" % k
+            saved[key + "_pose"] = result.measured_to_cad
+            saved[key + "_dev"] = result.deviation
+            saved[key + "_corners"] = nominal.bbox_corners
+            if reference is not None and key + "_pose" in reference:
+                pose_diff = tf.corner_displacement(result.measured_to_cad,
+                                                   reference[key + "_pose"],
+                                                   nominal.bbox_corners)
+                dev = reference[key + "_dev"]
+                dev_diff = (float(np.max(np.abs(result.deviation - dev)))
+                            if dev.shape == result.deviation.shape else float("nan"))
+                print("%-17s against %s: pose differs by %.3g mm at the worst corner, "
+                      "deviations by at most %.3g mm" % (name, args.compare, pose_diff, dev_diff))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if args.save:
+        np.savez(args.save, **saved)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
