@@ -21,8 +21,10 @@ import numpy as np
 
 from ..core import colormap
 from ..core.errors import InputError
+from . import pipeline
 from . import sections as sections_mod
 from . import verdict as verdict_mod
+from .checks import check_out_dir
 from .result import rival_lines
 
 # Enough points for a faithful picture; more only costs time and PDF size.
@@ -410,9 +412,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
     """report.html and report.pdf for a registration, its section table and verdict. Written
     into ``output`` (an open pipeline.AtomicOutput) when given, else atomically into out_dir.
     Returns {'html': name, 'pdf': name, 'pdf_pages': count}."""
-    from .pipeline import AtomicOutput
     if output is None:
-        with AtomicOutput(out_dir) as out:
+        with pipeline.AtomicOutput(out_dir) as out:
             return write_report(out_dir, result, nominal, sections, verdict, tolerance,
                                 output=out, magnification=magnification, title=title)
     plt, _, _ = _mpl()
@@ -534,20 +535,15 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.DEFAULT_TOLERANCE,
                seed=0, progress=None, heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT,
-               nominal=None, document=True, flip_faces=(), allow_mismatch=False):
-    """Register, tabulate the sections, judge and write result.json, deviations.csv,
-    report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
-    made in a private folder beside out_dir and moved in only when every one is complete.
-    ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
-    ``--flip-face`` (cad.orient). ``allow_mismatch``: write the result of a scan that does not
-    fit the CAD, with the warning (pipeline.register). Returns a summary dict."""
-    from . import pipeline
-    from .checks import check_out_dir
+               nominal=None, document=None, flip_faces=(), allow_mismatch=False):
+    """Register, then write_result_report: result.json, deviations.csv, report.html,
+    report.pdf and inspection.FCStd into out_dir, all or nothing. ``nominal`` skips loading
+    the CAD (a batch loads it once); ``flip_faces`` as ``--flip-face`` (cad.orient).
+    ``allow_mismatch``: write the result of a scan that does not fit the CAD, with the warning
+    (pipeline.register). ``document``: as for write_result_report. Returns a summary dict."""
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
-    tolerance = float(tolerance)
-    if not np.isfinite(tolerance) or tolerance <= 0:
-        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    tolerance = _check_tolerance(tolerance)
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
@@ -563,7 +559,26 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
                                cad_source=cad_path or "the demo blade")
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
+    return write_result_report(result, nominal, out_dir, cmm_data=cmm_data,
+                               tolerance=tolerance, progress=progress, heights_pct=heights_pct,
+                               document=document, cad_path=cad_path)
 
+
+def write_result_report(result, nominal, out_dir, cmm_data=None,
+                        tolerance=verdict_mod.DEFAULT_TOLERANCE, progress=None,
+                        heights_pct=sections_mod.DEFAULT_HEIGHTS_PCT, document=None,
+                        cad_path=None):
+    """The `report` files of a registration already made (a RegistrationResult, e.g. a
+    document's Registration): tabulate the sections, judge, and write result.json,
+    deviations.csv, report.html, report.pdf and inspection.FCStd into out_dir, all or nothing:
+    the files are made in a private folder beside out_dir and moved in only when every one is
+    complete. ``cmm_data``: sections.read_cmm's table, or None. ``document``: the writer of
+    inspection.FCStd (app.document.write_inspection_document, which this layer cannot import),
+    or None for no document. ``cad_path``: the CAD file of the nominal (None: the demo blade).
+    Returns a summary dict."""
+    check_out_dir(out_dir)
+    progress = progress or (lambda f, m: None)
+    tolerance = _check_tolerance(tolerance)
     t0 = time.perf_counter()
     progress(0.82, "section table")
     table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
@@ -577,9 +592,8 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
         if document:
             t0 = time.perf_counter()
             progress(0.95, "FreeCAD document")
-            from .document import write_inspection_document
-            write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
-                                      tolerance=tolerance, verdict=verdict, cad_path=cad_path)
+            document(out.path("inspection.FCStd"), nominal, result, table,
+                     tolerance=tolerance, verdict=verdict, cad_path=cad_path)
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance},
@@ -588,3 +602,10 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=verdict_mod.D
     return {"out_dir": os.path.abspath(out_dir), "result": result, "sections": table,
             "verdict": verdict, "files": sorted(os.listdir(out_dir)),
             "pdf_pages": files["pdf_pages"]}
+
+
+def _check_tolerance(tolerance):
+    tolerance = float(tolerance)
+    if not np.isfinite(tolerance) or tolerance <= 0:
+        raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
+    return tolerance

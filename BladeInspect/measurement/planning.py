@@ -197,7 +197,7 @@ def nominal_section(nominal, plane_point, plane_normal, spacing):
     """Points every ``spacing`` mm along the CAD's cut by the plane, each exactly on the CAD and
     on the plane, with outward normals, in contour order. Returns (points, normals, contours),
     contours a list of (first index, end index, closed). InputError when the plane misses."""
-    from ..cad.sections import cut
+    from ..cad.sections import cut   # cad/ needs FreeCAD; measurement/ imports without it
     n = np.asarray(plane_normal, dtype=float)
     n = n / np.linalg.norm(n)
     o = np.asarray(plane_point, dtype=float)
