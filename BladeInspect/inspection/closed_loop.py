@@ -330,7 +330,7 @@ class _SectionsPhase:
     """Steps 3-4: the nominal sections planned from the CAD and scanned; one re-plan when the
     pose moved enough to matter for the planned points."""
     name = "planned"                # points.csv's phase column and the checkpoint's phase
-    done_key, records_key = "paths_done", "paths"
+    done_key = "paths_done"         # the checkpoint's count of units scanned
     scan_share, register_share = 0.25, 0.2
     attempts = 2
     plan_timing = ("plan", "replan")
@@ -411,7 +411,7 @@ class _RasterPhase:
     (measurement.complete) from the blind pose; Table 2 at the nominal planes takes the raster
     points within its band of each."""
     name = "complete"
-    done_key, records_key = "passes_done", "passes"
+    done_key = "passes_done"
     scan_share, register_share = 0.15, 0.1
     attempts = 1
     plan_timing = ("plan",)
