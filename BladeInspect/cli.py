@@ -22,6 +22,8 @@ from .core import contracts
 from .core.errors import Cancelled, DeviceError, InputError
 
 EXIT_BAD_INPUT = 2
+# Each command imports its pipeline where it runs: FreeCAD, scipy and matplotlib load only for
+# a command that uses them, so --help and a bad argument answer at once.
 
 
 class Progress:
@@ -39,6 +41,14 @@ class Progress:
         self.last, self.last_message = now, message
         self.stream.write("[%3d%%] %s\n" % (round(100 * max(0.0, min(1.0, fraction))), message))
         self.stream.flush()
+
+
+def _document_writer():
+    """The writer of inspection.FCStd that the pipeline functions take (app/ sits above
+    them). Imported here, not at the top: it loads FreeCAD, which --help and a bad argument
+    do not need."""
+    from .app.document import write_inspection_document
+    return write_inspection_document
 
 
 def _seed(value):
@@ -267,7 +277,8 @@ def cmd_demo(args):
     scan, reconstruction, PCA, SNR-weighted ICP, CAD-planned scan of the nominal sections,
     report; then the pose judged against the simulator's truth."""
     from .inspection.closed_loop import run_inspect
-    summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress())
+    summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress(),
+                          document=_document_writer())
     result = summary["result"]
     _print_result(result, args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
@@ -353,7 +364,8 @@ def cmd_report(args, cad=None, points=None):
                          tolerance=args.tolerance, seed=args.seed, progress=Progress(),
                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
                          airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
-                         measurement_model=_model(args), **options)
+                         measurement_model=_model(args), document=_document_writer(),
+                         **options)
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -368,7 +380,7 @@ def cmd_batch(args):
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
                         allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args),
-                        fit_choice=_fit_choice(args))
+                        fit_choice=_fit_choice(args), document=_document_writer())
     sys.stdout.write("%s\n" % summary["message"])
 
 
@@ -381,7 +393,7 @@ def cmd_inspect(args):
                           resume=args.resume, flip_faces=args.flip_face,
                           allow_mismatch=args.allow_mismatch,
                           airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
-                          measurement_model=_model(args))
+                          measurement_model=_model(args), document=_document_writer())
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 

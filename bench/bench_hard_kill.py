@@ -31,6 +31,7 @@ from bench.bench_inspect_resume import pose, read, start_simrig, stop  # noqa: E
 
 
 def in_process(out, seed, heights, journal=True):
+    from BladeInspect.app.document import write_inspection_document
     from BladeInspect.inspection.closed_loop import run_inspect
     from BladeInspect.inspection.pipeline import load_nominal
     from BladeInspect.measurement import journal as journal_mod
@@ -49,7 +50,7 @@ def in_process(out, seed, heights, journal=True):
     try:
         start = time.perf_counter()
         run_inspect(None, out, rig=rig, nominal=nominal, seed=seed, section_heights=heights,
-                    document=True)
+                    document=write_inspection_document)
         return time.perf_counter() - start, rig.pass_index, spent[0]
     finally:
         journal_mod.JournaledRig._append = append

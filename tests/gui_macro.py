@@ -165,9 +165,26 @@ def run():
     @step("report of the registration")
     def _():
         reg, nominal = state["reg"], state["nominal"]
+        import tempfile
         from BladeInspect.core import transforms as tf
+        from BladeInspect.inspection import pipeline
         out = os.path.join(OUT, "report")
-        summary = commands.BY_NAME["BladeInspect_Report"].report(reg, out)
+        # The report is of the stored Registration: registering again would be a second,
+        # possibly different answer; and it leaves nothing in the temporary folder.
+        registrations = []
+        register = pipeline.register
+        pipeline.register = lambda *a, **k: registrations.append(a) or register(*a, **k)
+        private_tmp = os.path.join(OUT, "report-tmp")
+        os.makedirs(private_tmp, exist_ok=True)
+        tempdir, tempfile.tempdir = tempfile.tempdir, private_tmp
+        try:
+            summary = commands.BY_NAME["BladeInspect_Report"].report(reg, out)
+        finally:
+            pipeline.register = register
+            tempfile.tempdir = tempdir
+        check("report does not register again", not registrations, len(registrations))
+        check("report leaves no temporary files", os.listdir(private_tmp) == [],
+              os.listdir(private_tmp))
         check("report written", summary is not None and
               os.path.exists(os.path.join(out, "result.json")),
               (progress.MESSAGES[-1:], progress.LAST_TRACEBACK[0]))
@@ -176,6 +193,19 @@ def run():
                 T = np.array(json.load(fh)["measured_to_cad"])
             check("report's pose is the document's", tf.corner_displacement(
                 T, objects.matrix_array(reg.MeasuredToCad), nominal.bbox_corners) < 1e-4)
+            doc_path = os.path.join(out, "inspection.FCStd")
+            check("report's document written", os.path.exists(doc_path))
+            saved = FreeCAD.openDocument(doc_path, hidden=True)
+            try:
+                files = [getattr(o, "SourceFile", "") for o in saved.Objects]
+                check("report's document points at no temporary file",
+                      not any(f and (f.startswith(private_tmp) or
+                                     os.path.basename(os.path.dirname(f)).startswith(
+                                         "bladeinspect-report-")) for f in files), files)
+            finally:
+                FreeCAD.closeDocument(saved.Name)
+            FreeCAD.setActiveDocument(reg.Document.Name)
+            Gui.setActiveDocument(reg.Document.Name)
 
     @step("clear the imported measurement's objects")
     def _():

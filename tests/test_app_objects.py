@@ -173,7 +173,6 @@ class TestReconstruction(DocumentCase):
                 self.assertLess(d, 1e-7)
 
     def test_recomputes_when_the_measurement_changes(self):
-        import types
         rng = np.random.default_rng(8)
         first, second = self._curves(rng), self._curves(rng, shift=5.0)
         calls = []
@@ -181,12 +180,10 @@ class TestReconstruction(DocumentCase):
         def fake_reconstruct(pointset):
             calls.append(len(pointset.xyz))
             return FakeReconstruction(second)
-        module = types.ModuleType("BladeInspect.cad.loft")
-        module.reconstruct = fake_reconstruct
-        import sys
-        saved_module = sys.modules.get("BladeInspect.cad.loft")
+        from BladeInspect.cad import loft
+        saved_reconstruct = loft.reconstruct
         saved_pointset_of = objects.pointset_of
-        sys.modules["BladeInspect.cad.loft"] = module
+        loft.reconstruct = fake_reconstruct
         objects.pointset_of = lambda obj: FakePointSet(np.reshape(obj.Coordinates, (-1, 3)))
         try:
             meas = objects.make_measurement(self.doc, FakePointSet(np.vstack(first)))
@@ -200,10 +197,7 @@ class TestReconstruction(DocumentCase):
             self.assertTrue(all(y > 2.5 for y in ys), ys)   # the shifted curves are stored
         finally:
             objects.pointset_of = saved_pointset_of
-            if saved_module is None:
-                del sys.modules["BladeInspect.cad.loft"]
-            else:
-                sys.modules["BladeInspect.cad.loft"] = saved_module
+            loft.reconstruct = saved_reconstruct
 
 
 class TestRegistration(DocumentCase):

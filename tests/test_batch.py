@@ -7,6 +7,7 @@ import unittest
 
 import numpy as np
 
+from BladeInspect.app.document import write_inspection_document
 from BladeInspect.cad.demo_blade import BladeParams
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
@@ -51,7 +52,9 @@ class BatchTest(unittest.TestCase):
         with open(os.path.join(cls.scans, "notes.md"), "w") as fh:
             fh.write("not a point file\n")
         cls.out = os.path.join(cls.tmp, "lot")
-        cls.lot = B.run_batch(None, cls.scans, cls.out, workers=2)
+        # Two worker processes: the document writer must pickle to them.
+        cls.lot = B.run_batch(None, cls.scans, cls.out, workers=2,
+                              document=write_inspection_document)
         cls.summary = read_summary(os.path.join(cls.out, "summary.csv"))
 
     @classmethod
@@ -120,7 +123,8 @@ class BatchTest(unittest.TestCase):
         try:
             self.assertTrue(cluster.scheduler_address.startswith("tcp://127.0.0.1:"))
             out = os.path.join(self.tmp, "lot_dask")
-            B.run_batch(None, self.scans, out, scheduler=cluster.scheduler_address)
+            B.run_batch(None, self.scans, out, scheduler=cluster.scheduler_address,
+                        document=write_inspection_document)
         finally:
             cluster.close()
         dask_rows = read_summary(os.path.join(out, "summary.csv"))

@@ -168,9 +168,12 @@ class TestInspectComplete(unittest.TestCase):
                                error_field=cls.bump, seed=SEED)
         cls.tmp = tempfile.mkdtemp(prefix="bi-complete-")
         cls.out = os.path.join(cls.tmp, "out")
+        cls.plans_seen = []     # (plan, rig passes run when it was shown)
         cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=cls.nominal,
                                   complete=True, pitch=INSPECT_PITCH, seed=SEED, document=False,
                                   section_heights=HEIGHTS,
+                                  on_plan=lambda plan: cls.plans_seen.append(
+                                      (plan, cls.rig.pass_index)),
                                   scan_options={"n_sections": 5, "point_spacing": 0.25,
                                                 "probe_spacing": 1.0})
         with open(os.path.join(cls.out, "scan.json")) as fh:
@@ -193,6 +196,16 @@ class TestInspectComplete(unittest.TestCase):
         n_complete = int(np.count_nonzero(points.columns["phase"] == "complete"))
         self.assertEqual(n_complete, self.scan_json["phases"]["complete"]["points"])
         self.assertEqual(len(self.result_json["sections"]), len(HEIGHTS))
+
+    def test_on_plan_sees_the_raster_before_it_is_scanned(self):
+        """on_plan is called with --complete too (it was once silently ignored there): once,
+        with the plan that was scanned, before its first pass."""
+        self.assertEqual(len(self.plans_seen), 1)
+        plan, passes_before = self.plans_seen[0]
+        self.assertIs(plan, self.summary["plan"])
+        raster_passes = len(self.scan_json["phases"]["complete"]["passes"])
+        self.assertGreater(raster_passes, 0)
+        self.assertEqual(passes_before + raster_passes, self.rig.pass_index)
 
     def test_times_reported(self):
         phase = self.scan_json["phases"]["complete"]

@@ -12,6 +12,7 @@ import warnings
 
 import numpy as np
 
+from BladeInspect.app.document import write_inspection_document
 from BladeInspect.cad.demo_blade import BladeParams
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
@@ -160,7 +161,8 @@ class RunReportTest(unittest.TestCase):
         np.savetxt(cls.points_path, measured, delimiter=",", header="x,y,z", comments="",
                    fmt="%.9f")
         cls.out = os.path.join(cls.tmp, "out")
-        cls.summary = R.run_report(None, cls.points_path, cls.out, nominal=cls.nominal)
+        cls.summary = R.run_report(None, cls.points_path, cls.out, nominal=cls.nominal,
+                                   document=write_inspection_document)
 
     @classmethod
     def tearDownClass(cls):

@@ -7,6 +7,7 @@ import numpy as np
 import FreeCAD
 
 from ..core.errors import InputError
+from ..inspection.sections import read_cmm, section_table
 from . import objects
 
 PLAN_GROUP = "Planned paths"
@@ -84,7 +85,6 @@ def cmm_section_table(registration, cmm_path):
     """Table 2 of a Registration with the CMM file's columns beside the optical ones. For an
     inspection, at its nominal sections from the planned points only; for any other
     registration, the sections the section analysis would choose."""
-    from ..inspection.sections import read_cmm, section_table
     if registration.Nominal is None:
         raise InputError("%s: no nominal linked" % registration.Label)
     cmm = read_cmm(cmm_path)

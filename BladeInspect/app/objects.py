@@ -27,7 +27,15 @@ import numpy as np
 import FreeCAD
 
 from ..core.contracts import json_default
+from ..cad import demo_blade, loft
+from ..cad.load import load_shape
+from ..cad.nominal import nominal_from_shape
+from ..cad.rotor67 import make_rotor67_blade
+from ..core import colourmap
 from ..core.errors import InputError
+from ..core.pointio import PointSet
+from ..inspection import pipeline
+from ..inspection.result import RegistrationResult
 
 _view_provider_hook = None
 
@@ -164,11 +172,10 @@ class DemoBlade(_Proxy):
     Type = "BladeInspect::DemoBlade"
 
     def add_properties(self, obj):
-        from ..cad.demo_blade import BladeParams
         kinds = {float: "App::PropertyFloat", int: "App::PropertyInteger",
                  bool: "App::PropertyBool"}
-        defaults = BladeParams()
-        for field in dataclasses.fields(BladeParams):
+        defaults = demo_blade.BladeParams()
+        for field in dataclasses.fields(demo_blade.BladeParams):
             value = getattr(defaults, field.name)
             kind = kinds.get(type(value))
             if kind is None:
@@ -180,13 +187,12 @@ class DemoBlade(_Proxy):
              "Face indices of each role (suction, pressure, leading_edge, ...)", read_only=True)
 
     def params(self, obj):
-        from ..cad.demo_blade import BladeParams
-        names = [f.name for f in dataclasses.fields(BladeParams)]
-        return BladeParams(**{n: getattr(obj, n) for n in names if n in obj.PropertiesList})
+        names = [f.name for f in dataclasses.fields(demo_blade.BladeParams)]
+        return demo_blade.BladeParams(**{n: getattr(obj, n) for n in names
+                                         if n in obj.PropertiesList})
 
     def execute(self, obj):
-        from ..cad.demo_blade import make_demo_blade
-        model = make_demo_blade(self.params(obj))
+        model = demo_blade.make_demo_blade(self.params(obj))
         obj.Shape = model.shape
         obj.FaceRoles = _roles_to_map(model.roles)
 
@@ -213,12 +219,10 @@ class CadModel(_Proxy):
             return
         if path.lower().endswith(".dat"):
             # A blade section table (NASA Rotor 67 format), lofted into faces with roles.
-            from ..cad.rotor67 import make_rotor67_blade
             model = make_rotor67_blade(path)
             obj.Shape = model.shape
             obj.FaceRoles = _roles_to_map(model.roles)
         else:
-            from ..cad.load import load_shape
             obj.Shape = load_shape(path)
             obj.FaceRoles = {}
         obj.LoadedSignature = signature
@@ -230,7 +234,6 @@ _NOMINAL_CACHE = {}
 def nominal_of(obj):
     """The pipeline's Nominal of a document object's shape (any Part feature; face roles from
     its FaceRoles when it has them). Cached by shape content: building one samples every face."""
-    from ..cad.nominal import nominal_from_shape
     shape = obj.Shape
     if shape.isNull() or not shape.Faces:
         raise InputError("%s: the nominal has no faces" % obj.Label)
@@ -304,8 +307,7 @@ class Measurement(_Proxy):
         if obj.SourceFile and os.path.exists(obj.SourceFile):
             signature = _file_signature(obj.SourceFile)
             if signature != obj.LoadedSignature:
-                from ..inspection.pipeline import load_points
-                store_pointset(obj, load_points(obj.SourceFile))
+                store_pointset(obj, pipeline.load_points(obj.SourceFile))
                 obj.LoadedSignature = signature
         elif obj.SourceFile:
             raise InputError("%s: no such point file" % obj.SourceFile)
@@ -338,7 +340,6 @@ def store_pointset(obj, pointset):
 
 def pointset_of(obj):
     """The PointSet a Measurement holds, exactly as it was stored."""
-    from ..core.pointio import PointSet
     xyz = np.asarray(obj.Coordinates, dtype=float).reshape(-1, 3)
     snr = np.asarray(obj.SNR, dtype=float) if len(obj.SNR) else None
     columns = {}
@@ -399,8 +400,7 @@ class Reconstruction(_Proxy):
         signature = self.signature(obj)
         if signature == obj.InputSignature and not obj.Shape.isNull():
             return
-        from ..cad.loft import reconstruct
-        store_reconstruction(obj, reconstruct(pointset_of(obj.Measurement)))
+        store_reconstruction(obj, loft.reconstruct(pointset_of(obj.Measurement)))
         obj.InputSignature = signature
 
 
@@ -511,8 +511,8 @@ class Registration(_Proxy):
         signature = self.signature(obj)
         if not signature or signature == obj.InputSignature:
             return
-        from ..inspection.pipeline import register
-        result = register(nominal_of(obj.Nominal), pointset_of(obj.Measurement), seed=obj.Seed)
+        result = pipeline.register(nominal_of(obj.Nominal), pointset_of(obj.Measurement),
+                                   seed=obj.Seed)
         store_registration(obj, result)
         obj.InputSignature = signature
 
@@ -592,7 +592,6 @@ class DeviationMap(_Proxy):
         _add(obj, "App::PropertyInteger", "NPoints", g, "Points shown", read_only=True)
 
     def execute(self, obj):
-        from ..core import colourmap
         if obj.Registration is None:
             raise InputError("%s: no registration linked" % obj.Label)
         if obj.Limit <= 0:
@@ -627,7 +626,6 @@ def registration_result(obj, nominal):
     """The pipeline's RegistrationResult of a Registration object, for the stages after it
     (sections, reports). The closest points, normals and faces are not stored in the document;
     they are the nominal's exact signed distance of the stored points."""
-    from ..inspection.result import RegistrationResult
     points, deviation, inlier = registration_points(obj)
     dist = nominal.signed_distance(points)
     columns = {}

@@ -10,8 +10,15 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from ..app import objects, settings
+from ..app.document import write_inspection_document
+from ..cad.loft import reconstruct
 from ..core.errors import InputError
+from ..inspection.pipeline import load_points, register
+from ..inspection.report import section_rows, write_result_report
+from ..inspection.sections import section_table
+from ..measurement.scan import open_rig, scan_to_dir
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
+from .preferences import PreferencesPage
 from .session import RIG
 
 # Marks the command texts for translation (FreeCAD translates them in the command's context).
@@ -192,8 +199,6 @@ class ConnectRig(_Command):
         FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
 
     def connect(self, spec, seed):
-        from ..measurement.scan import open_rig
-
         def job(p):
             nominal_obj = find_nominal()
             if spec == "sim" and nominal_obj is None:
@@ -222,8 +227,6 @@ class Scan(_Command):
         FreeCADGui.Control.showDialog(taskpanels.ScanPanel(self.scan))
 
     def scan(self, options):
-        from ..measurement.scan import scan_to_dir
-        from ..inspection.pipeline import load_points
         doc = active_document()
         out_dir = scan_folder(doc)
 
@@ -290,7 +293,6 @@ class Reconstruct(_Command):
         self.reconstruct(find_input((objects.Measurement.Type,)))
 
     def reconstruct(self, measurement):
-        from ..cad.loft import reconstruct
         doc = measurement.Document
 
         def job(p):
@@ -321,7 +323,6 @@ class Register(_Command):
             self.show(obj)
 
     def register(self, measurement, nominal_obj, seed=None):
-        from ..inspection.pipeline import register
         doc = measurement.Document
         seed = settings.value("Seed") if seed is None else seed
 
@@ -396,7 +397,6 @@ class SectionAnalysis(_Command):
     def analyse(self, registration):
         """The section table of a registration (inspection.sections), its nominal profiles added
         to the document; None when it failed (reported)."""
-        from ..inspection.sections import section_table
         doc = registration.Document
 
         def job(p):
@@ -418,7 +418,6 @@ class SectionAnalysis(_Command):
 
     @staticmethod
     def show(table):
-        from ..inspection.report import section_rows
         header, rows = section_rows(table)
         FreeCADGui.Control.closeDialog()
         FreeCADGui.Control.showDialog(taskpanels.TablePanel(
@@ -443,27 +442,24 @@ class Report(_Command):
                 open_in_browser(html)
 
     def report(self, registration, out_dir):
-        from ..inspection.report import run_report
-        from ..core.pointio import write_points_csv
+        """The `report` files of the registration as the document holds it (no second
+        registration, nothing written outside out_dir)."""
+        nominal_obj = registration.Nominal
+        cad_path = getattr(nominal_obj, "SourceFile", "") or None
+        # inspection.FCStd rebuilds the nominal from its CAD file, or as the demo blade; a shape
+        # that is neither has no file the document could point at, so it gets no document.
+        is_demo = objects.proxy_type(nominal_obj) == objects.DemoBlade.Type
+        writer = write_inspection_document if cad_path or is_demo else None
 
         def job(p):
-            work = tempfile.mkdtemp(prefix="bladeinspect-report-")
-            cad_path = getattr(registration.Nominal, "SourceFile", "")
-            if not cad_path:
-                cad_path = os.path.join(work, "nominal.brep")
-                registration.Nominal.Shape.exportBrep(cad_path)
-            points_path = registration.Measurement.SourceFile
-            if not points_path:
-                ps = objects.pointset_of(registration.Measurement)
-                points_path = os.path.join(work, "points.csv")
-                columns = dict(ps.columns)
-                if ps.snr is not None:
-                    columns["snr"] = ps.snr
-                write_points_csv(points_path, ps.xyz, columns)
-            return run_report(cad_path, points_path, out_dir,
-                              tolerance=settings.value("ToleranceMm"),
-                              seed=registration.Seed, progress=p,
-                              nominal=objects.nominal_of(registration.Nominal))
+            if registration.Proxy.signature(registration) != registration.InputSignature:
+                registration.recompute()    # the inputs changed since it was stored
+            nominal = objects.nominal_of(nominal_obj)
+            result = objects.registration_result(registration, nominal)
+            result.cad_source = cad_path or "built-in demo blade"
+            return write_result_report(result, nominal, out_dir,
+                                       tolerance=settings.value("ToleranceMm"), progress=p,
+                                       document=writer, cad_path=cad_path)
         doc = registration.Document
         try:
             return progress.run("Report", job)
@@ -495,7 +491,6 @@ for _command in COMMANDS:
 
 
 def register_preferences():
-    from .preferences import PreferencesPage
     # The preferences dialog shows a group's icon by the name "preferences-<group>".
     FreeCADGui.addIconPath(resources.ICON_DIR)
     FreeCADGui.addPreferencePage(PreferencesPage, "BladeInspect")

@@ -17,6 +17,11 @@ from PySide import QtGui
 from ..app import loop, objects, settings
 from ..core import contracts
 from ..core.errors import InputError
+from ..core.pointio import read_points
+from ..inspection.closed_loop import run_inspect
+from ..inspection.report import section_rows
+from ..inspection.simulate import run_simulation
+from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from . import commands, progress, taskpanels
 from .session import RIG
 
@@ -83,7 +88,6 @@ def _hide_measured_frame(measurement):
 
 
 def _show_table(title, table, note):
-    from ..inspection.report import section_rows
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
     FreeCADGui.Control.closeDialog()
@@ -132,7 +136,6 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
     title = "Calibrate rig"
 
     def __init__(self, on_accept):
-        from ..measurement.calibration import DEFAULT_DIAMETER
         super().__init__(on_accept)
         self.diameter = taskpanels.spin_box(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
         self.offset = taskpanels.spin_box(0.0, 0.0, 10.0, 3, "mm")
@@ -217,8 +220,6 @@ class Inspect(commands._Command):
         """run_inspect on the nominal with the connected rig (else the simulated one); the plan
         drawn as it is made; the points, registration, deviation map and section profiles
         added. Returns run_inspect's summary with the new objects under "objects", or None."""
-        from ..core.pointio import read_points
-        from ..inspection.closed_loop import run_inspect
         doc = nominal_obj.Document
         out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
 
@@ -311,7 +312,6 @@ class Calibrate(commands._Command):
 
     def calibrate(self, out_path, rig_spec="sim", sphere_diameter=None, seed=0,
                   **simulated_errors):
-        from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
         if rig_spec != "sim" and RIG.connected and RIG.spec == rig_spec:
             # The calibration opens the port itself; the scan session would hold it busy.
             RIG.disconnect()
@@ -386,7 +386,6 @@ class Simulate(commands._Command):
     def simulate(self, seed=0, **options):
         """run_simulation on the document's nominal, else a new demo blade; adds the simulated
         measurement, its registration and deviation map. Returns (report, registration)."""
-        from ..inspection.simulate import run_simulation
         doc = commands.active_document()
 
         def job(p):

@@ -8,6 +8,7 @@ import FreeCADGui
 from PySide import QtGui
 
 from ..app import settings
+from ..cad.demo_blade import BladeParams
 from ..inspection.result import rival_lines
 
 
@@ -45,7 +46,6 @@ class DemoBladePanel(FormPanel):
 
     def __init__(self, on_accept):
         super().__init__()
-        from ..cad.demo_blade import BladeParams
         self.on_accept = on_accept
         self.params_type = BladeParams
         self.boxes = {}

@@ -6,6 +6,7 @@ import FreeCADGui
 
 from ..app import objects
 from . import legend, resources
+from .taskpanels import RegistrationPanel
 
 
 class ViewProvider:
@@ -65,7 +66,6 @@ class ViewProviderRegistration(ViewProvider):
     def setEdit(self, vobj, mode=0):
         if mode != 0:
             return None
-        from .taskpanels import RegistrationPanel
         FreeCADGui.Control.showDialog(RegistrationPanel(vobj.Object))
         return True
 

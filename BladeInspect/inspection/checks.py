@@ -25,6 +25,7 @@ from ..core.errors import InputError
 from ..core import pca as pca_mod
 from ..rig.sensor import SensorModel
 from ..core.contracts import PROFILE_TOLERANCE_MM
+from .sections import span_axis_of
 
 # The sensor's error bound at the reference SNR (docs/contracts.md: accuracy < 6 um). A cloud whose
 # spread (standard deviation) in some direction is within it has no extent there, only noise:
@@ -165,7 +166,6 @@ _NAMED_AXIS_COSINE = 0.95
 def part_axes(nominal):
     """Named axes of the part in the CAD frame: its span (sections.span_axis_of), then the
     other two principal axes of its surface, chord-wise and across the chord."""
-    from .sections import span_axis_of
     span = span_axis_of(nominal)[0]
     axes = pca_mod.principal_axes(nominal.samples.xyz, nominal.samples.weight).axes
     others = [a - (a @ span) * span for a in axes.T]

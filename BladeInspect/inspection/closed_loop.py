@@ -22,7 +22,7 @@ points.csv up to the last completed blind section, planned section or raster pas
 and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in DIR/.checkpoint while the loop runs
-(_Checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
+(inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
 depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
 checkpoint's fields.
@@ -30,7 +30,6 @@ checkpoint's fields.
 
 import json
 import os
-import shutil
 import time
 
 import numpy as np
@@ -38,10 +37,20 @@ import numpy as np
 from ..core import contracts
 from ..core import transforms as tf
 from ..core.errors import Cancelled, DeviceError, InputError
-from ..core.pointio import PointSet, read_points, write_points_csv
-from ..measurement.journal import JOURNAL_FILE, JournaledRig
-from ..measurement.scan import POINTS_FILE, RECORD_FILE, check_same_rig, write_record
+from ..core import stats as stats_mod
+from ..core.pointio import PointSet, write_points_csv
+from ..measurement import scan as scan_mod
+from ..measurement.complete import check_step, plan_complete, scan_complete
+from ..measurement.planning import plan_sections
+from ..rig.kinematics import RigKinematics
 from . import airfoil as airfoil_mod
+from . import pipeline
+from . import sections as sections_mod
+from . import verdict as verdict_mod
+from .checkpoint import LIVE_FOLDER, Checkpoint, inspection_identity, save_plan, start_or_resume
+from .checks import unmeasured_warning
+from .report import write_report
+from .result import RegistrationResult
 
 EPSILON_MM = 2.0
 # The planned points must lie within 0.01 mm of their nominal planes: a pose that moves them by
@@ -53,16 +62,6 @@ MIN_READ_FRACTION = 0.9
 # A resumed inspection registers its blind points again; they must land where they did
 # (the same numbers give the same pose, up to rounding far below this).
 RESUME_POSE_TOLERANCE_MM = 1e-6
-# While an inspection is unfinished, scan.json holds the loop's state under this key.
-CHECKPOINT = "inspection"
-# What a checkpoint is made of; scan.json last, since it marks the folder as one.
-CHECKPOINT_FILES = ("plan.json", POINTS_FILE, RECORD_FILE)
-# While an inspection runs, its checkpoint grows in this folder inside DIR: what a kill -9 or a
-# power cut leaves, and what --resume continues in place.
-LIVE_FOLDER = ".checkpoint"
-# What a finished inspection adds; none of them may stand beside a checkpoint.
-RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf",
-                "inspection.FCStd")
 
 
 def _no_progress(fraction, message):
@@ -152,21 +151,16 @@ def _result_of_all(nominal, blind, blind_sections, later, phase, xyz, snr, fit, 
 def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
     """A RegistrationResult for points registered by a fine ICP from a known start, built the
     way pipeline.register builds its own."""
-    from ..core import stats as stats_mod
-    from .pipeline import uncertainty_with_rival
-    from .result import RegistrationResult
     points_cad = tf.apply_transform(fit.transform, pointset.xyz)
     dist = nominal.signed_distance(points_cad)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
-    from .pipeline import pose_summary
-    from .checks import unmeasured_warning
-    covariance, statistical, unmeasured = pose_summary(fit, nominal)
+    covariance, statistical, unmeasured = pipeline.pose_summary(fit, nominal)
     if unmeasured:
         warnings = [w for w in warnings if w != unmeasured_warning(unmeasured)]
         warnings.append(unmeasured_warning(unmeasured))
-    uncertainty, includes_rival = uncertainty_with_rival(statistical, fit.transform, coarse,
-                                                         nominal.bbox_corners)
+    uncertainty, includes_rival = pipeline.uncertainty_with_rival(statistical, fit.transform,
+                                                                  coarse, nominal.bbox_corners)
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face,
@@ -201,7 +195,7 @@ def _pointset(xyz, snr, columns, source):
 def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SECTION_HEIGHTS_PCT,
                 complete=False, pitch=0.1, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
                 seed=0, rig_file=None,
-                progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=True,
+                progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=None,
                 scan_options=None, on_plan=None, resume=False, flip_faces=(),
                 allow_mismatch=False, airfoil=None, fit_choice=None, measurement_model=None):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
@@ -214,31 +208,18 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     blind scan that does not fit the CAD, with the warning (pipeline.register). ``airfoil``: an
     inspection.airfoil.Options to add the airfoil characteristics (issue 15; None: none).
     ``fit_choice``, ``measurement_model``: the fit and the decision, as for `report`.
-    Returns a summary dict. The result files appear in out_dir together, or none: on a
+    ``document``: the writer of inspection.FCStd (app.document.write_inspection_document, which
+    this layer cannot import), or None for no document. Returns a summary dict.
+    The result files appear in out_dir together, or none: on a
     DeviceError, a cancel or a KeyboardInterrupt out_dir holds the checkpoint instead
     (points.csv, plan.json, scan.json)."""
-    from ..measurement import scan as scan_mod
-    from ..rig.kinematics import RigKinematics
-    from ..measurement.planning import plan_sections
-    if on_plan is not None:
-        plan_only = plan_sections
-
-        def plan_sections(*args, **kwargs):
-            plan = plan_only(*args, **kwargs)
-            on_plan(plan)
-            return plan
-    from . import pipeline
-    from . import sections as sections_mod
-    from . import verdict as verdict_mod
-    from .report import write_report
     progress = progress or _no_progress
     if not out_dir:
         raise InputError("--out: a folder is required")
     heights = contracts.section_heights(section_heights)
     tolerance = contracts.profile_tolerance(tolerance)
     if complete:
-        from ..measurement.complete import _check_step
-        pitch = _check_step(pitch, "--pitch")
+        pitch = check_step(pitch, "--pitch")
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
     if scan_options is not None or not resume:
         scan_options = dict(scan_options or {})
@@ -248,36 +229,28 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     if nominal is None:
         nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
     kinematics = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
-    identity = _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics,
-                         scan_options)
+    identity = inspection_identity(nominal, seed, heights, complete, pitch, epsilon,
+                                   kinematics, scan_options)
     opened = rig is None
     if opened:
         rig = scan_mod.open_rig(rig_spec, nominal=nominal, seed=seed, kinematics=kinematics)
     timing["load"] = time.perf_counter() - t0
     try:
         with pipeline.AtomicOutput(out_dir) as out:
-            checkpoint = _Checkpoint(os.path.join(os.path.abspath(out_dir), LIVE_FOLDER),
-                                     out_dir, identity, rig, resume)
+            checkpoint = Checkpoint(os.path.join(os.path.abspath(out_dir), LIVE_FOLDER),
+                                    out_dir, identity, rig, resume)
             scan_options = dict(checkpoint.identity["scan_options"] or {})
             register_options = {"allow_mismatch": allow_mismatch, "tolerance": tolerance,
                                 "cad_source": cad_path or "the demo blade"}
             judge_options = {"fit_choice": fit_choice,   # hook: issue 16
                              "measurement_model": measurement_model}
+            phase_of = _RasterPhase if complete else _SectionsPhase
+            phase = phase_of(nominal, checkpoint.rig, kinematics, epsilon, pitch)
             try:
-                if complete:
-                    summary = _complete_loop(nominal, checkpoint.rig, kinematics, heights,
-                                             seed, epsilon, cmm_data, tolerance, pitch, out,
-                                             checkpoint, timing, progress, document,
-                                             scan_options, cad_path or "built-in demo blade",
-                                             register_options, judge_options,
-                                             airfoil=airfoil)
-                else:
-                    summary = _loop(nominal, checkpoint.rig, kinematics, heights, seed, epsilon,
-                                    cmm_data, tolerance, out, checkpoint, timing, progress,
-                                    plan_sections, scan_mod, pipeline, sections_mod,
-                                    verdict_mod, write_report, document, scan_options,
-                                    cad_path or "built-in demo blade", register_options,
-                                    judge_options, airfoil=airfoil)
+                summary = _loop(phase, nominal, checkpoint.rig, kinematics, heights, seed,
+                                cmm_data, tolerance, out, checkpoint, timing, progress,
+                                document, scan_options, cad_path or "built-in demo blade",
+                                register_options, on_plan, judge_options, airfoil)
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
@@ -296,7 +269,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
 
 
 def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-                 scan_mod, pipeline, scan_share, register_share, **register_options):
+                 scan_share, register_share, **register_options):
     """The blind section scan into the checkpoint and its registration: nothing is known of
     the pose yet, so only what the sensor reads is used. A resumed inspection continues an
     interrupted blind scan (scan_to_dir's own resume) or reads the finished one back.
@@ -336,78 +309,64 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
     return record, blind, blind_rig_s, first
 
 
-def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, out,
-          checkpoint, timing, progress, plan_sections, scan_mod, pipeline, sections_mod,
-          verdict_mod, write_report, document, scan_options, cad_label, register_options,
-          judge_options=None, airfoil=None):
-    # 1-2. blind section scan and its registration
-    resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "planned" else None
-    scan_record, blind, blind_rig_s, first = _blind_stage(
-        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-        scan_mod, pipeline, scan_share=0.25, register_share=0.2, **register_options)
-    n_blind = len(blind.xyz)
-    blind_sections = _blind_column(blind, "section", n_blind)
-    # Planned sections are numbered after the blind ones, so a `report` of points.csv by its
-    # section column keeps them apart.
-    first_planned = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() \
-        else 0
-    state = _start_or_resume(checkpoint, rig, resumed, {
-        "phase": "planned", "attempt": 0, "plan_pose": first.measured_to_cad.tolist(),
-        "paths_done": 0, "sections_done": [], "paths": [], "replans": []})
-    state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
-                 blind_points=n_blind, blind_rig_s=blind_rig_s,
-                 blind_points_bytes=state.get("blind_points_bytes", state["points_bytes"]))
-    checkpoint.save(state, scan_record)
+# ---------------------------------------------------------------- the phases after the blind scan
+# The loop (_loop) measures one phase after the blind scan: it plans from the blind pose, scans
+# the plan unit by unit (a path's section, a raster pass), each completed unit appended to the
+# checkpoint, registers everything, and may plan again from the better pose. A phase says how
+# to plan, how to scan and judge its units, and what it adds to scan.json and result.json.
 
-    # 3-4. plan, scan, ICP on everything; one re-plan if the pose moved enough to matter
-    span_axis, _ = sections_mod.span_axis_of(nominal)
-    for attempt in range(int(state["attempt"]), 2):
-        pose = np.asarray(state["plan_pose"], dtype=float)
-        t0 = time.perf_counter()
+class _SectionsPhase:
+    """Steps 3-4: the nominal sections planned from the CAD and scanned; one re-plan when the
+    pose moved enough to matter for the planned points."""
+    name = "planned"                # points.csv's phase column and the checkpoint's phase
+    done_key = "paths_done"         # the checkpoint's count of units scanned
+    scan_share, register_share = 0.25, 0.2
+    attempts = 2
+    plan_timing = ("plan", "replan")
+    scan_timing = ("planned_scan", "replanned_scan")
+    fit_timing = ("register_all", "register_all_again")
+    fit_progress = 0.75
+    source = "inspect: blind and planned scans"
+    title = "BladeInspect inspection (CAD-planned sections)"
+
+    def __init__(self, nominal, rig, kinematics, epsilon, pitch):
+        self.nominal, self.rig, self.kinematics, self.epsilon = nominal, rig, kinematics, epsilon
+
+    def fresh_state(self, pose):
+        return {"phase": self.name, "attempt": 0, "plan_pose": pose.tolist(),
+                "paths_done": 0, "sections_done": [], "paths": [], "replans": []}
+
+    def started(self, state):
+        # A re-plan drops the planned rows: points.csv goes back to its blind rows.
+        state.update(blind_points_bytes=state.get("blind_points_bytes", state["points_bytes"]))
+
+    def plan(self, pose, attempt, heights, span_axis, progress):
         progress(0.45 + 0.05 * attempt, "planning the nominal sections from the CAD")
-        plan = plan_sections(nominal, pose, heights, rig.sensor, rig.limits,
-                             span_axis=span_axis, kinematics=kinematics)
-        timing["plan" if attempt == 0 else "replan"] = time.perf_counter() - t0
-        _save_plan(plan, checkpoint)
-        # Sections measured before an interruption are read back; this run's are kept too.
-        earlier = checkpoint.rows("planned") if state["paths_done"] else None
-        session = []
+        return plan_sections(self.nominal, pose, heights, self.rig.sensor, self.rig.limits,
+                             span_axis=span_axis, kinematics=self.kinematics)
 
-        def section_done(n_paths, rows, records):
-            xyz, snr, section, angle, _ = rows
-            session.append((xyz, snr, first_planned + section, angle))
-            checkpoint.append_rows(*session[-1], "planned")
-            state["paths_done"] = n_paths
-            state["sections_done"] = state["sections_done"] + [int(records[-1]["section"])]
-            state["paths"] = state["paths"] + records
-            state["points_bytes"] = checkpoint.points_bytes()
-            state["pass_index"] = getattr(rig, "pass_index", None)
-            checkpoint.save(state, scan_record)
+    def scan(self, plan, attempt, first, on_unit, progress):
+        scan_plan(self.rig, plan, self.kinematics,
+                  lambda f, m: progress(0.5 + 0.1 * attempt + 0.1 * f, m), first_path=first,
+                  on_section=lambda n, rows, records: on_unit(n, rows[:4], records))
 
-        t0 = time.perf_counter()
-        scan_plan(rig, plan, kinematics,
-                  lambda f, m: progress(0.5 + 0.1 * attempt + 0.1 * f, m),
-                  first_path=int(state["paths_done"]), on_section=section_done)
-        timing["planned_scan" if attempt == 0 else "replanned_scan"] = time.perf_counter() - t0
-        planned = _measured_rows(earlier, session)
-        n_planned = len(planned[0])
-        agreement = _plan_agreement(plan, n_planned, state["paths"], epsilon)
-        if agreement:
-            raise InputError(agreement)
-        t0 = time.perf_counter()
-        xyz = np.vstack([blind.xyz, planned[0]])
-        snr = np.concatenate([blind.snr, planned[1]])
-        fit = pipeline.fine_register(xyz, snr, nominal, pose,
-                                     progress=lambda f, m: progress(0.75, m))
-        timing["register_all" if attempt == 0 else "register_all_again"] = \
-            time.perf_counter() - t0
+    @staticmethod
+    def record_unit(state, records):
+        state["sections_done"] = state["sections_done"] + [int(records[-1]["section"])]
+        state["paths"] = state["paths"] + records
+
+    def agreement(self, plan, n_read, state):
+        return _plan_agreement(plan, n_read, state["paths"], self.epsilon)
+
+    def again(self, state, plan, pose, fit, n_read, attempt, checkpoint):
+        """Whether to plan again from the pose ``fit`` found (the state made ready for it)."""
         targets = np.vstack([s.target_cad for s in plan.sections])
         moved = pose_change_mm(pose, fit.transform, targets)
         state["replans"] = state["replans"] + [
-            {"pose_change_mm": moved, "threshold_mm": REPLAN_FRACTION * epsilon,
-             "n_planned": plan.n_points, "n_measured": n_planned}]
-        if moved <= REPLAN_FRACTION * epsilon or attempt == 1:
-            break
+            {"pose_change_mm": moved, "threshold_mm": REPLAN_FRACTION * self.epsilon,
+             "n_planned": plan.n_points, "n_measured": n_read}]
+        if moved <= REPLAN_FRACTION * self.epsilon or attempt == self.attempts - 1:
+            return False
         # The re-plan measures the nominal sections again from the better pose; the first
         # pass's rows are replaced, as the uninterrupted loop replaces them.
         checkpoint.truncate_points(state["blind_points_bytes"])
@@ -415,56 +374,214 @@ def _loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance,
         state.update(attempt=attempt + 1, plan_pose=np.asarray(fit.transform).tolist(),
                      paths_done=0, sections_done=[], paths=[],
                      points_bytes=state["blind_points_bytes"])
+        return True
+
+    @staticmethod
+    def sections_json(table, plan):
+        return _sections_json(table, plan)
+
+    def scan_json(self, plan, n_read, state, rig_s, timing):
+        return {"points": n_read, "paths": state["paths"], "rig_s": rig_s}
+
+    @staticmethod
+    def add_to_record(record, state):
+        record["replans"] = state["replans"]
+
+    def result_json(self, plan, n_read, state, rig_s, timing):
+        return {"replans": state["replans"], "n_points_by_phase": {"blind": None,
+                                                                    self.name: n_read}}
+
+    def summary(self, plan, state, rig_s, timing):
+        return {"replans": state["replans"]}
+
+
+class _RasterPhase:
+    """`inspect --complete` (paper 4.3): the whole blade rastered every ``pitch`` mm
+    (measurement.complete) from the blind pose; Table 2 at the nominal planes takes the raster
+    points within its band of each."""
+    name = "complete"
+    done_key = "passes_done"
+    scan_share, register_share = 0.15, 0.1
+    attempts = 1
+    plan_timing = ("plan",)
+    scan_timing = ("complete_scan",)
+    fit_timing = ("register_all",)
+    fit_progress = 0.65
+    source = "inspect --complete: blind and complete scans"
+
+    def __init__(self, nominal, rig, kinematics, epsilon, pitch):
+        self.nominal, self.rig, self.kinematics, self.epsilon = nominal, rig, kinematics, epsilon
+        self.pitch = pitch
+        self.title = "BladeInspect inspection (complete scan, pitch %g mm)" % pitch
+
+    def fresh_state(self, pose):
+        return {"phase": self.name, "plan_pose": pose.tolist(), "passes_done": 0, "passes": []}
+
+    def started(self, state):
+        pass
+
+    def plan(self, pose, attempt, heights, span_axis, progress):
+        progress(0.25, "planning the complete raster from the CAD")
+        return plan_complete(self.nominal, pose, self.rig.sensor, self.rig.limits,
+                             pitch=self.pitch, kinematics=self.kinematics)
+
+    def scan(self, plan, attempt, first, on_unit, progress):
+        scan_complete(self.rig, plan, self.kinematics, lambda f, m: progress(0.3 + 0.3 * f, m),
+                      first_pass=first,
+                      on_pass=lambda n, rows, record: on_unit(n, rows, [record]))
+
+    @staticmethod
+    def record_unit(state, records):
+        state["passes"] = state["passes"] + records
+
+    def agreement(self, plan, n_read, state):
+        worst = (max((r["max_standoff_error_mm"] or 0.0) for r in state["passes"]) if n_read
+                 else np.inf)
+        if n_read < MIN_READ_FRACTION * plan.n_points or worst > self.epsilon:
+            return ("inspect --complete: the raster does not find the blade where the "
+                    "blind scan's registration put it (%d of %d planned points read, "
+                    "standoff off by up to %.2f mm)" % (n_read, plan.n_points, worst))
+        return None
+
+    def again(self, state, plan, pose, fit, n_read, attempt, checkpoint):
+        return False
+
+    @staticmethod
+    def sections_json(table, plan):
+        return [dict(sec.to_json(), height_pct=sec.height_pct,
+                     plane={"point": sec.origin.tolist(), "normal": sec.normal.tolist()})
+                for sec in table.sections]
+
+    def scan_json(self, plan, n_read, state, rig_s, timing):
+        return {"points": n_read, "planned_points": plan.n_points,
+                "pitch_mm": plan.pitch_mm, "angles_deg": plan.angles_deg.tolist(),
+                "passes": state["passes"], "rig_s": rig_s,
+                "simulated_s": timing["complete_scan"],
+                "sensor_rate_s": n_read / float(self.rig.sensor.rate_hz)}
+
+    @staticmethod
+    def add_to_record(record, state):
+        pass
+
+    def result_json(self, plan, n_read, state, rig_s, timing):
+        return {"n_points_by_phase": {"blind": None, self.name: n_read},
+                "complete": {"pitch_mm": plan.pitch_mm, "rig_s": rig_s,
+                             "simulated_s": timing["complete_scan"]}}
+
+    def summary(self, plan, state, rig_s, timing):
+        return {"complete_rig_s": rig_s, "complete_simulated_s": timing["complete_scan"]}
+
+
+def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, out, checkpoint,
+          timing, progress, document, scan_options, cad_label, register_options, on_plan,
+          judge_options=None, airfoil=None):
+    """The inspection after opening: the blind stage, then ``phase`` planned from its pose,
+    scanned unit by unit into the checkpoint, ICP on every point (and the phase's re-plan),
+    Table 2 at the nominal sections, the verdict and the result files in ``out``."""
+    # 1-2. blind section scan and its registration
+    resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == phase.name else None
+    scan_record, blind, blind_rig_s, first = _blind_stage(
+        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
+        scan_share=phase.scan_share, register_share=phase.register_share, **register_options)
+    n_blind = len(blind.xyz)
+    blind_sections = _blind_column(blind, "section", n_blind)
+    # The units measured after the blind scan are numbered after its sections, so a `report`
+    # of points.csv by its section column keeps them apart.
+    first_unit = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() \
+        else 0
+    state = start_or_resume(checkpoint, rig, resumed, phase.fresh_state(first.measured_to_cad))
+    state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
+                 blind_points=n_blind, blind_rig_s=blind_rig_s)
+    phase.started(state)
+    checkpoint.save(state, scan_record)
+
+    # 3-4. plan, scan, ICP on everything; again from the better pose if the phase says so
+    span_axis, _ = sections_mod.span_axis_of(nominal)
+    for attempt in range(int(state.get("attempt", 0)), phase.attempts):
+        pose = np.asarray(state["plan_pose"], dtype=float)
+        t0 = time.perf_counter()
+        plan = phase.plan(pose, attempt, heights, span_axis, progress)
+        timing[phase.plan_timing[attempt]] = time.perf_counter() - t0
+        if on_plan is not None:
+            on_plan(plan)
+        save_plan(plan, checkpoint)
+        # Units measured before an interruption are read back; this run's are kept too.
+        earlier = checkpoint.rows(phase.name) if state[phase.done_key] else None
+        session = []
+
+        def unit_done(n_units, rows, records):
+            xyz, snr, unit, angle = rows
+            session.append((xyz, snr, first_unit + unit, angle))
+            checkpoint.append_rows(*session[-1], phase.name)
+            state[phase.done_key] = n_units
+            phase.record_unit(state, records)
+            state["points_bytes"] = checkpoint.points_bytes()
+            state["pass_index"] = getattr(rig, "pass_index", None)
+            checkpoint.save(state, scan_record)
+
+        t0 = time.perf_counter()
+        phase.scan(plan, attempt, int(state[phase.done_key]), unit_done, progress)
+        timing[phase.scan_timing[attempt]] = time.perf_counter() - t0
+        measured = _measured_rows(earlier, session)
+        n_measured = len(measured[0])
+        agreement = phase.agreement(plan, n_measured, state)
+        if agreement:
+            raise InputError(agreement)
+        t0 = time.perf_counter()
+        xyz = np.vstack([blind.xyz, measured[0]])
+        snr = np.concatenate([blind.snr, measured[1]])
+        fit = pipeline.fine_register(xyz, snr, nominal, pose,
+                                     progress=lambda f, m: progress(phase.fit_progress, m))
+        timing[phase.fit_timing[attempt]] = time.perf_counter() - t0
+        if not phase.again(state, plan, pose, fit, n_measured, attempt, checkpoint):
+            break
         checkpoint.save(state, scan_record)
-    replans = state["replans"]
-    path_records = state["paths"]
+    rig_s = checkpoint.rig_s()
 
     # 5. results at the nominal sections
     t0 = time.perf_counter()
-    columns, result = _result_of_all(nominal, blind, blind_sections, planned, "planned", xyz,
-                                     snr, fit, first, timing, cad_label,
-                                     "inspect: blind and planned scans")
-    table, verdict = _judge_after_blind(result, nominal, n_blind, n_planned, heights,
-                                        span_axis, cmm_data, tolerance, sections_mod,
-                                        verdict_mod, **(judge_options or {}))
+    columns, result = _result_of_all(nominal, blind, blind_sections, measured, phase.name, xyz,
+                                     snr, fit, first, timing, cad_label, phase.source)
+    # planned_rows drops the section column (raster lines are not the nominal planes), so the
+    # table takes the points within its band of each plane.
+    table, verdict = _judge_after_blind(result, nominal, n_blind, n_measured, heights,
+                                        span_axis, cmm_data, tolerance, **(judge_options or {}))
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
     t0 = time.perf_counter()
-    rig_s = checkpoint.rig_s()
     write_points_csv(out.path("points.csv"), xyz, {"snr": snr, **columns})
     plan.to_json(out.path("plan.json"))
     scan_record["phases"] = {
-        "blind": {"points": n_blind, "summary": dict(scan_record),
-                  "rig_s": blind_rig_s},
-        "planned": {"points": n_planned, "paths": path_records, "rig_s": rig_s - blind_rig_s}}
-    scan_record["replans"] = replans
+        "blind": {"points": n_blind, "summary": dict(scan_record), "rig_s": blind_rig_s},
+        phase.name: phase.scan_json(plan, n_measured, state, rig_s - blind_rig_s, timing)}
+    phase.add_to_record(scan_record, state)
     with open(out.path("scan.json"), "w") as fh:
         json.dump(scan_record, fh, indent=1, default=contracts.json_default)
     files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
-                         title="BladeInspect inspection (CAD-planned sections)")
+                         title=phase.title)
     if document:
-        from .document import write_inspection_document
-        write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
-                                  tolerance=tolerance)
+        document(out.path("inspection.FCStd"), nominal, result, table, tolerance=tolerance)
     timing["write"] = time.perf_counter() - t0
     result.timing_s = timing
-    extra = {"sections": _sections_json(table, plan),
-             "section_table": table.to_json(),
+    extra = {"sections": phase.sections_json(table, plan), "section_table": table.to_json(),
              "verdict": verdict, "tolerance_mm": tolerance,
              "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
-             "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
-             "replans": replans,
-             "n_points_by_phase": {"blind": n_blind, "planned": n_planned},
-             "rig_time_s": rig_s, **airfoil_mod.extras_of(table)}  # issue 15 hook
+             "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist()}
+    extra.update(phase.result_json(plan, n_measured, state, rig_s - blind_rig_s, timing))
+    extra["n_points_by_phase"]["blind"] = n_blind
+    extra["rig_time_s"] = rig_s
+    extra.update(airfoil_mod.extras_of(table))  # issue 15 hook
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
-    return {"result": result, "blind_result": first, "plan": plan, "sections": table,
-            "verdict": verdict, "replans": replans, "files": files,
-            "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
-            "pose_uncertainty_mm": result.pose_uncertainty_mm}
+    summary = {"result": result, "blind_result": first, "plan": plan, "sections": table,
+               "verdict": verdict}
+    summary.update(phase.summary(plan, state, rig_s - blind_rig_s, timing))
+    summary.update(files=files, uncertainty_after_blind_mm=first.pose_uncertainty_mm,
+                   pose_uncertainty_mm=result.pose_uncertainty_mm)
+    return summary
 
 
 def _measured_rows(earlier, session):
@@ -481,45 +598,8 @@ def _measured_rows(earlier, session):
         np.concatenate([np.asarray(p[k], dtype=float) for p in parts]) for k in (1, 2, 3))
 
 
-def _start_or_resume(checkpoint, rig, resumed, fresh):
-    """The phase's state: ``fresh`` with where the points file and the rig's pass numbering
-    stand now, or the checkpoint's ``resumed`` state with both put back to where it stood."""
-    if resumed is None:
-        return dict(fresh, points_bytes=checkpoint.points_bytes(),
-                    pass_index=getattr(rig, "pass_index", None))
-    state = dict(resumed)
-    checkpoint.truncate_points(state["points_bytes"])
-    _continue_pass_numbering(rig, state)
-    checkpoint.rig.resume(state.get("journal_passes"))
-    return state
-
-
-def _continue_pass_numbering(rig, state):
-    """The next pass is numbered as in the interrupted run: a simulated rig's noise stream per
-    pass, so a resumed run measures what the uninterrupted one would have."""
-    if state.get("pass_index") is not None and hasattr(rig, "set_pass_index"):
-        rig.set_pass_index(state["pass_index"])
-
-
-def _save_plan(plan, checkpoint):
-    """plan.json of the checkpoint. One already there is the plan being scanned when the run
-    was interrupted (a re-plan removes the first): the plan made again from the saved pose
-    must be that one, so the rest of its sections is scanned as the interrupted run would."""
-    text = plan.to_json()
-    path = checkpoint.path("plan.json")
-    if os.path.exists(path):
-        with open(path) as fh:
-            if fh.read() != text:
-                raise InputError("--resume: the plan made again from the saved pose differs "
-                                 "from the checkpoint's plan.json (another rig or software)")
-        return
-    with open(path, "w") as fh:
-        fh.write(text)
-
-
 def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm_data,
-                       tolerance, sections_mod, verdict_mod, fit_choice=None,
-                       measurement_model=None):
+                       tolerance, fit_choice=None, measurement_model=None):
     """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
     indexed back into the whole result, and the verdict on every point; the result moved to
     the pose of ``fit_choice`` first (inspection.fitting), its fit sensitivity recorded."""
@@ -544,359 +624,3 @@ def _blind_column(pointset, name, n):
     if values is None:
         return np.full(n, np.nan)
     return np.asarray(values, dtype=float)
-
-
-def _complete_loop(nominal, rig, kinematics, heights, seed, epsilon, cmm_data, tolerance, pitch,
-                   out, checkpoint, timing, progress, document, scan_options, cad_label,
-                   register_options, judge_options=None, airfoil=None):
-    """`inspect --complete` (paper 4.3): the blind scan and its registration as in _loop, then
-    the whole blade rastered every ``pitch`` mm (measurement.complete) from that pose, ICP on every
-    point, and Table 2 at the nominal planes from the raster points within 0.25 mm of each."""
-    from ..measurement import scan as scan_mod
-    from ..measurement.complete import plan_complete, scan_complete
-    from . import pipeline
-    from . import sections as sections_mod
-    from . import verdict as verdict_mod
-    from .report import write_report
-    resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == "complete" else None
-    scan_record, blind, blind_rig_s, first = _blind_stage(
-        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-        scan_mod, pipeline, scan_share=0.15, register_share=0.1, **register_options)
-    n_blind = len(blind.xyz)
-    blind_sections = _blind_column(blind, "section", n_blind)
-    first_line = int(np.nanmax(blind_sections) + 1) if np.isfinite(blind_sections).any() else 0
-    state = _start_or_resume(checkpoint, rig, resumed, {
-        "phase": "complete", "plan_pose": first.measured_to_cad.tolist(),
-        "passes_done": 0, "passes": []})
-    state.update(blind_measured_to_cad=np.asarray(first.measured_to_cad).tolist(),
-                 blind_points=n_blind, blind_rig_s=blind_rig_s)
-    checkpoint.save(state, scan_record)
-
-    t0 = time.perf_counter()
-    progress(0.25, "planning the complete raster from the CAD")
-    pose = np.asarray(state["plan_pose"], dtype=float)
-    plan = plan_complete(nominal, pose, rig.sensor, rig.limits, pitch=pitch,
-                         kinematics=kinematics)
-    timing["plan"] = time.perf_counter() - t0
-    _save_plan(plan, checkpoint)
-    # Passes measured before an interruption are read back; this run's are kept too.
-    earlier = checkpoint.rows("complete") if state["passes_done"] else None
-    session = []
-
-    def pass_done(n_passes, rows, record):
-        xyz, snr, line, angle = rows
-        session.append((xyz, snr, first_line + line, angle))
-        checkpoint.append_rows(*session[-1], "complete")
-        state["passes_done"] = n_passes
-        state["passes"] = state["passes"] + [record]
-        state["points_bytes"] = checkpoint.points_bytes()
-        state["pass_index"] = getattr(rig, "pass_index", None)
-        checkpoint.save(state, scan_record)
-
-    t0 = time.perf_counter()
-    scan_complete(rig, plan, kinematics, lambda f, m: progress(0.3 + 0.3 * f, m),
-                  first_pass=int(state["passes_done"]), on_pass=pass_done)
-    timing["complete_scan"] = time.perf_counter() - t0
-    complete_rig_s = checkpoint.rig_s() - blind_rig_s
-    pass_records = state["passes"]
-    raster = _measured_rows(earlier, session)
-    n_read = len(raster[0])
-    worst = max((r["max_standoff_error_mm"] or 0.0) for r in pass_records) if n_read else np.inf
-    if n_read < MIN_READ_FRACTION * plan.n_points or worst > epsilon:
-        raise InputError("inspect --complete: the raster does not find the blade where the "
-                         "blind scan's registration put it (%d of %d planned points read, "
-                         "standoff off by up to %.2f mm)" % (n_read, plan.n_points, worst))
-
-    t0 = time.perf_counter()
-    xyz = np.vstack([blind.xyz, raster[0]])
-    snr = np.concatenate([blind.snr, raster[1]])
-    fit = pipeline.fine_register(xyz, snr, nominal, pose,
-                                 progress=lambda f, m: progress(0.65, m))
-    timing["register_all"] = time.perf_counter() - t0
-
-    t0 = time.perf_counter()
-    columns, result = _result_of_all(nominal, blind, blind_sections, raster, "complete", xyz,
-                                     snr, fit, first, timing, cad_label,
-                                     "inspect --complete: blind and complete scans")
-    span_axis, _ = sections_mod.span_axis_of(nominal)
-    # planned_rows drops the section column (raster lines are not the nominal planes), so the
-    # table takes the points within its band of each plane.
-    table, verdict = _judge_after_blind(result, nominal, n_blind, n_read, heights,
-                                        span_axis, cmm_data, tolerance, sections_mod,
-                                        verdict_mod, **(judge_options or {}))
-    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
-        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
-    timing["sections"] = time.perf_counter() - t0
-
-    progress(0.85, "writing the report")
-    t0 = time.perf_counter()
-    write_points_csv(out.path("points.csv"), xyz, {"snr": snr, **columns})
-    plan.to_json(out.path("plan.json"))
-    scan_record["phases"] = {
-        "blind": {"points": n_blind, "summary": dict(scan_record), "rig_s": blind_rig_s},
-        "complete": {"points": n_read, "planned_points": plan.n_points,
-                     "pitch_mm": plan.pitch_mm, "angles_deg": plan.angles_deg.tolist(),
-                     "passes": pass_records, "rig_s": complete_rig_s,
-                     "simulated_s": timing["complete_scan"],
-                     "sensor_rate_s": n_read / float(rig.sensor.rate_hz)}}
-    with open(out.path("scan.json"), "w") as fh:
-        json.dump(scan_record, fh, indent=1, default=contracts.json_default)
-    files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
-                         title="BladeInspect inspection (complete scan, pitch %g mm)" % pitch)
-    if document:
-        from .document import write_inspection_document
-        write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
-                                  tolerance=tolerance)
-    timing["write"] = time.perf_counter() - t0
-    result.timing_s = timing
-    sections_doc = [dict(sec.to_json(), height_pct=sec.height_pct,
-                         plane={"point": sec.origin.tolist(), "normal": sec.normal.tolist()})
-                    for sec in table.sections]
-    extra = {"sections": sections_doc, "section_table": table.to_json(), "verdict": verdict,
-             "tolerance_mm": tolerance,
-             "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
-             "blind_measured_to_cad": np.asarray(first.measured_to_cad).tolist(),
-             "n_points_by_phase": {"blind": n_blind, "complete": n_read},
-             "complete": {"pitch_mm": plan.pitch_mm, "rig_s": complete_rig_s,
-                          "simulated_s": timing["complete_scan"]},
-             "rig_time_s": checkpoint.rig_s(), **airfoil_mod.extras_of(table)}  # issue 15 hook
-    pipeline.write_register_outputs(None, result, extra=extra, output=out)
-    progress(1.0, verdict["summary"])
-    return {"result": result, "blind_result": first, "plan": plan, "sections": table,
-            "verdict": verdict, "files": files,
-            "uncertainty_after_blind_mm": first.pose_uncertainty_mm,
-            "pose_uncertainty_mm": result.pose_uncertainty_mm,
-            "complete_rig_s": complete_rig_s, "complete_simulated_s": timing["complete_scan"]}
-
-
-# ---------------------------------------------------------------- checkpoint and resume
-
-class _Checkpoint:
-    """What an inspection has measured so far, kept in DIR/LIVE_FOLDER while it runs:
-    points.csv and scan.json grow one completed blind section at a time (measurement.scan.scan_to_dir's
-    own checkpoint), then one completed planned section or raster pass at a time; plan.json is
-    the plan being scanned; readings.journal holds every pass since (``rig``: the rig,
-    journaled). scan.json's CHECKPOINT entry says where the loop stands from the first write
-    on, so whatever a kill leaves can be resumed. A DeviceError or a cancel moves the three
-    files into DIR (keep); ``resume`` continues the live folder in place when a kill left one,
-    else starts from a copy of the files in DIR."""
-
-    def __init__(self, folder, out_dir, identity, rig, resume):
-        self.folder = folder
-        self.out_dir = os.path.abspath(out_dir)
-        self.state = None
-        self.in_place = False
-        self._created_dir = not os.path.exists(self.out_dir)
-        self._earlier_rig_s = 0.0
-        live = _live_checkpoint(self.path(RECORD_FILE))
-        record_path = os.path.join(self.out_dir, RECORD_FILE)
-        if not resume:
-            try:
-                saved = live or _saved_checkpoint(record_path)
-            except InputError:
-                saved = None    # not a checkpoint: a fresh run replaces it, as any old file
-            if saved is not None:
-                raise InputError("--out %s: holds an interrupted inspection (use --resume to "
-                                 "continue it, or another folder)" % out_dir)
-            self.identity = identity
-            self._start(rig, copy_from=None)
-            return
-        saved = live if live is not None else _saved_checkpoint(record_path)
-        if saved is None:
-            raise InputError("--resume: %s holds no interrupted inspection to continue"
-                             % out_dir)
-        self.identity = _same_identity(saved.get("options"), identity, out_dir)
-        source = self.path(RECORD_FILE) if live is not None else record_path
-        with open(source) as fh:
-            check_same_rig(json.load(fh), rig, identity["seed"], source)
-        self.state = saved
-        self._earlier_rig_s = float(saved.get("rig_s", 0.0))
-        self.in_place = live is not None
-        self._start(rig, copy_from=None if self.in_place else self.out_dir)
-
-    def _start(self, rig, copy_from):
-        """The live folder (a fresh one, the files of ``copy_from`` copied in, or the one a
-        kill left) and the journaled rig writing into it."""
-        if not self.in_place:
-            shutil.rmtree(self.folder, ignore_errors=True)   # a kill before its first record
-            os.makedirs(self.folder)
-            if copy_from is not None:
-                # scan.json last and whole: it is what makes the folder a checkpoint.
-                for name in CHECKPOINT_FILES:
-                    if os.path.exists(os.path.join(copy_from, name)):
-                        _durable_copy(os.path.join(copy_from, name), self.path(name))
-        self.rig = JournaledRig(rig, self.path(JOURNAL_FILE), keep=self.in_place)
-        self._session_start = float(self.rig.elapsed_s)
-
-    def path(self, name):
-        return os.path.join(self.folder, name)
-
-    def rig_s(self):
-        """Rig time of the whole inspection: earlier sessions and this one."""
-        return self._earlier_rig_s + float(self.rig.elapsed_s) - self._session_start
-
-    def record(self):
-        """scan.json as it stands, without the loop's own state."""
-        with open(self.path(RECORD_FILE)) as fh:
-            record = json.load(fh)
-        record.pop(CHECKPOINT, None)
-        return record
-
-    def save(self, state, record=None, journal=True):
-        """Records where the loop stands (after a completed section: the rows on disk are
-        exactly those the state counts, and so are the journal's passes, which then start
-        afresh). ``journal`` False leaves the journal's count as ``state`` has it."""
-        record = self.record() if record is None else dict(record)
-        self.state = dict(state, options=self.identity, complete=False, rig_s=self.rig_s())
-        if journal:
-            self.state["journal_passes"] = self.rig.passes
-        record[CHECKPOINT] = self.state
-        record["complete"] = False
-        write_record(self.path(RECORD_FILE), record)
-        if journal:
-            self.rig.commit()
-
-    def mark_blind(self, record):
-        """The blind scan's scan.json, as scan_to_dir writes it: marked as this inspection's
-        checkpoint from the first write on (the journal's count is scan_to_dir's own)."""
-        record[CHECKPOINT] = dict(self.state if self.state is not None else {},
-                                  phase="blind", options=self.identity, complete=False,
-                                  rig_s=self.rig_s())
-
-    def keep(self):
-        """After a DeviceError or a cancel: the measured data goes to DIR as a checkpoint to resume, in
-        place of any earlier result there (a result beside a checkpoint would not be one)."""
-        if not os.path.exists(self.path(RECORD_FILE)):
-            return
-        state = self.state if self.state is not None else {"phase": "blind"}
-        # The journal stays behind: the kept checkpoint is the completed sections, as before.
-        self.save(state, journal=False)
-        for name in RESULT_FILES:
-            if os.path.exists(os.path.join(self.out_dir, name)):
-                os.remove(os.path.join(self.out_dir, name))
-        # scan.json last: it is what marks the folder as a checkpoint.
-        for name in CHECKPOINT_FILES:
-            if os.path.exists(self.path(name)):
-                os.replace(self.path(name), os.path.join(self.out_dir, name))
-            elif os.path.exists(os.path.join(self.out_dir, name)):
-                os.remove(os.path.join(self.out_dir, name))
-
-    def discard(self):
-        """The live folder goes: the result, or the kept checkpoint, is in DIR."""
-        shutil.rmtree(self.folder, ignore_errors=True)
-
-    def abandon(self):
-        """After an InputError: nothing of this run is left, except a live folder that a kill
-        left, which stays resumable (it holds measurements made before this run)."""
-        if self.in_place:
-            return
-        self.discard()
-        if self._created_dir and os.path.isdir(self.out_dir) and not os.listdir(self.out_dir):
-            os.rmdir(self.out_dir)
-
-    def truncate_points(self, size):
-        path = self.path(POINTS_FILE)
-        if os.path.getsize(path) < size:
-            raise InputError("%s: shorter than its checkpoint in %s (the folder was changed)"
-                             % (os.path.join(self.out_dir, POINTS_FILE), RECORD_FILE))
-        with open(path, "r+b") as fh:
-            fh.truncate(size)
-
-    def points_bytes(self):
-        return os.path.getsize(self.path(POINTS_FILE))
-
-    def rows(self, phase):
-        """The rows of one phase in points.csv (a PointSet; None when there are none)."""
-        pointset = read_points(self.path(POINTS_FILE))
-        keep = pointset.columns["phase"] == phase
-        if not keep.any():
-            return None
-        return PointSet(xyz=pointset.xyz[keep], snr=pointset.snr[keep],
-                        columns={k: np.asarray(v)[keep] for k, v in pointset.columns.items()},
-                        n_rows_skipped=0, source=pointset.source)
-
-    def append_rows(self, xyz, snr, section, angle, phase):
-        """Rows measured after the blind scan, at full precision: a resumed run reads back the
-        very numbers an uninterrupted one keeps in memory."""
-        lines = ["%r,%r,%r,%r,%d,%r,%s\n" % (x, y, z, s, k, a, phase)
-                 for (x, y, z), s, k, a in zip(np.asarray(xyz, dtype=float).tolist(),
-                                               np.asarray(snr, dtype=float).tolist(),
-                                               np.asarray(section).tolist(),
-                                               np.asarray(angle, dtype=float).tolist())]
-        with open(self.path(POINTS_FILE), "a") as fh:
-            fh.write("".join(lines))
-            fh.flush()
-            os.fsync(fh.fileno())
-
-
-def _live_checkpoint(record_path):
-    """The loop's state in the live folder's scan.json, or None when there is none to resume
-    (no folder, or one killed before its first record)."""
-    try:
-        return _saved_checkpoint(record_path)
-    except InputError:
-        return None
-
-
-def _durable_copy(source, target):
-    """Copy ``source`` to ``target`` all at once and on disk (a temporary file replaced)."""
-    tmp = target + ".part"
-    shutil.copyfile(source, tmp)
-    with open(tmp, "rb+") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, target)
-
-
-def _saved_checkpoint(record_path):
-    """The loop's state in DIR/scan.json when DIR holds an interrupted inspection, else None."""
-    if not os.path.exists(record_path):
-        return None
-    try:
-        with open(record_path) as fh:
-            record = json.load(fh)
-    except (OSError, ValueError) as exc:
-        raise InputError("%s: not a readable scan record (%s)" % (record_path, exc))
-    state = record.get(CHECKPOINT) if isinstance(record, dict) else None
-    if not isinstance(state, dict) or state.get("complete", True):
-        return None
-    if state.get("phase") not in ("blind", "planned", "complete") or \
-            not isinstance(state.get("options"), dict):
-        raise InputError("%s: malformed inspection checkpoint" % record_path)
-    return state
-
-
-def _identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan_options):
-    """What a resumed inspection must share with the interrupted one to measure the same
-    points (JSON-ready). ``scan_options`` None: whatever the interrupted run used."""
-    options = None
-    if scan_options is not None:
-        options = contracts.json_ready(scan_options)
-    return {"cad_bbox": np.asarray(nominal.bbox_corners, dtype=float).tolist(),
-            "seed": int(seed), "section_heights": [float(h) for h in heights],
-            "complete": bool(complete), "pitch_mm": float(pitch) if complete else None,
-            "epsilon_mm": float(epsilon), "kinematics": kinematics.to_dict(),
-            "scan_options": options}
-
-
-IDENTITY_FLAGS = (("cad_bbox", "the CAD (its bounding box)"), ("seed", "--seed"),
-                  ("section_heights", "--section-heights"), ("complete", "--complete"),
-                  ("pitch_mm", "--pitch"), ("epsilon_mm", "epsilon"),
-                  ("kinematics", "--rig-file"), ("scan_options", "the blind scan's options"))
-
-
-def _same_identity(saved, given, out_dir):
-    """The identity the resumed run continues with; InputError naming the first difference."""
-    if not isinstance(saved, dict):
-        raise InputError("--resume %s: the checkpoint does not say how it was begun" % out_dir)
-    if given["scan_options"] is None:
-        given = dict(given, scan_options=saved.get("scan_options"))
-    for key, flag in IDENTITY_FLAGS:
-        a, b = saved.get(key), given[key]
-        same = (np.allclose(a, b, rtol=0.0, atol=1e-9) if key == "cad_bbox" and a is not None
-                else a == b)
-        if not same:
-            shown = ("another part" if key == "cad_bbox" else
-                     "another rig file" if key == "kinematics" else "%s, not %s" % (a, b))
-            raise InputError("--resume %s: the interrupted inspection was begun with other %s "
-                             "(%s); resume with the same options" % (out_dir, flag, shown))
-    return given

@@ -72,13 +72,13 @@ def _no_progress(fraction, message):
 def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     """The nominal geometry (see cad.load.load_nominal): a CAD file, a section table, or the
     demo blade when ``cad_path`` is None; ``flip_faces`` as ``--flip-face``."""
-    from ..cad.load import load_nominal as load
+    from ..cad.load import load_nominal as load   # cad/ needs FreeCAD; inspection/ does not
     return load(cad_path, sample_spacing=sample_spacing, flip_faces=flip_faces)
 
 
 def load_points(path):
     """A measured point file (csv/xyz/asc/txt, or ply/pcd through FreeCAD's Points)."""
-    from ..cad.load import read_points_any
+    from ..cad.load import read_points_any   # cad/ needs FreeCAD; inspection/ does not
     return read_points_any(path)
 
 
@@ -404,7 +404,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     if use_reconstruction and "section" in pointset.columns and "angle_deg" in pointset.columns:
         progress(0.02, "reconstructing section curves and surfaces")
-        from ..cad.loft import reconstruct
+        from ..cad.loft import reconstruct   # cad/ needs FreeCAD; inspection/ does not
         try:
             recon = reconstruct(pointset)
         except InputError as exc:

@@ -21,12 +21,13 @@ import numpy as np
 
 from ..core import colourmap, contracts
 from ..core import stats as stats_mod
-from ..core.errors import InputError
 from . import airfoil as airfoil_mod
 from . import airfoil_report
+from . import pipeline
 from . import sections as sections_mod
 from . import fit_report
 from . import verdict as verdict_mod
+from .checks import check_out_dir
 from .result import rival_lines
 
 # Enough points for a faithful picture; more only costs time and PDF size.
@@ -422,9 +423,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
     """report.html and report.pdf for a registration, its section table and verdict. Written
     into ``output`` (an open pipeline.AtomicOutput) when given, else atomically into out_dir.
     Returns {'html': name, 'pdf': name, 'pdf_pages': count}."""
-    from .pipeline import AtomicOutput
     if output is None:
-        with AtomicOutput(out_dir) as out:
+        with pipeline.AtomicOutput(out_dir) as out:
             return write_report(out_dir, result, nominal, sections, verdict, tolerance,
                                 output=out, magnification=magnification, title=title)
     plt, _, _ = _mpl()
@@ -554,20 +554,14 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
                seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
-               nominal=None, document=True, flip_faces=(), allow_mismatch=False, airfoil=None,
+               nominal=None, document=None, flip_faces=(), allow_mismatch=False, airfoil=None,
                fit_choice=None, measurement_model=None):
-    """Register, tabulate the sections, judge and write result.json, deviations.csv,
-    report.html, report.pdf and inspection.FCStd into out_dir, all or nothing: the files are
-    made in a private folder beside out_dir and moved in only when every one is complete.
-    ``nominal`` skips loading the CAD (a batch loads it once); ``flip_faces`` as
-    ``--flip-face`` (cad.orient). ``allow_mismatch``: write the result of a scan that does not
-    fit the CAD, with the warning (pipeline.register). ``airfoil``: an inspection.airfoil.Options
-    to add the airfoil characteristics (issue 15; None: none). ``fit_choice``
-    (inspection.fitting.FitChoice, default least squares and ISO 14253-1) and
-    ``measurement_model`` (inspection.uncertainty) choose the fit and the decision.
-    Returns a summary dict."""
-    from . import pipeline
-    from .checks import check_out_dir
+    """Register, then write_result_report: result.json, deviations.csv, report.html,
+    report.pdf and inspection.FCStd into out_dir, all or nothing. ``nominal`` skips loading
+    the CAD (a batch loads it once); ``flip_faces`` as ``--flip-face`` (cad.orient).
+    ``allow_mismatch``: write the result of a scan that does not fit the CAD, with the warning
+    (pipeline.register). ``document``, ``airfoil``, ``fit_choice``, ``measurement_model``: as
+    for write_result_report. Returns a summary dict."""
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     tolerance = contracts.profile_tolerance(tolerance)
@@ -586,7 +580,30 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PRO
                                cad_source=cad_path or "the demo blade")
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
+    return write_result_report(result, nominal, out_dir, cmm_data=cmm_data,
+                               tolerance=tolerance, progress=progress, heights_pct=heights_pct,
+                               document=document, cad_path=cad_path, airfoil=airfoil,
+                               fit_choice=fit_choice, measurement_model=measurement_model)
 
+
+def write_result_report(result, nominal, out_dir, cmm_data=None,
+                        tolerance=contracts.PROFILE_TOLERANCE_MM, progress=None,
+                        heights_pct=contracts.SECTION_HEIGHTS_PCT, document=None,
+                        cad_path=None, airfoil=None, fit_choice=None, measurement_model=None):
+    """The `report` files of a registration already made (a RegistrationResult, e.g. a
+    document's Registration): tabulate the sections, judge, and write result.json,
+    deviations.csv, report.html, report.pdf and inspection.FCStd into out_dir, all or nothing:
+    the files are made in a private folder beside out_dir and moved in only when every one is
+    complete. ``cmm_data``: sections.read_cmm's table, or None. ``document``: the writer of
+    inspection.FCStd (app.document.write_inspection_document, which this layer cannot import),
+    or None for no document. ``cad_path``: the CAD file of the nominal (None: the demo blade).
+    ``airfoil``: an inspection.airfoil.Options to add the airfoil characteristics (issue 15;
+    None: none). ``fit_choice`` (inspection.fitting.FitChoice, default least squares and ISO
+    14253-1) and ``measurement_model`` (inspection.uncertainty) choose the fit and the
+    decision. Returns a summary dict."""
+    check_out_dir(out_dir)
+    progress = progress or (lambda f, m: None)
+    tolerance = contracts.profile_tolerance(tolerance)
     t0 = time.perf_counter()
     progress(0.82, "section table")
     from . import fitting   # hook: issue 16, the fit, its sensitivity and the decision
@@ -609,9 +626,8 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PRO
         if document:
             t0 = time.perf_counter()
             progress(0.95, "FreeCAD document")
-            from .document import write_inspection_document
-            write_inspection_document(out.path("inspection.FCStd"), nominal, result, table,
-                                      tolerance=tolerance, verdict=verdict, cad_path=cad_path)
+            document(out.path("inspection.FCStd"), nominal, result, table,
+                     tolerance=tolerance, verdict=verdict, cad_path=cad_path)
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance,

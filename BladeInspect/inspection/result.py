@@ -1,10 +1,13 @@
 """The registration result: everything result.json and deviations.csv are made of, as plain data
 that reports, batches, document objects and tests read without recomputing anything."""
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
+
+from ..core import stats
 
 
 @dataclass
@@ -47,8 +50,6 @@ class RegistrationResult:
         """The result restricted to some rows (an inspection's points measured after its blind
         scan), for Table 2 at the nominal sections: the section column, which numbers the scan's
         passes rather than those planes, is left out."""
-        import dataclasses
-        from ..core import stats
         rows = np.asarray(rows)
         columns = {k: np.asarray(v)[rows] for k, v in self.columns.items() if k != "section"}
         return dataclasses.replace(

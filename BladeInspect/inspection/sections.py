@@ -519,7 +519,7 @@ def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, w
     """Table 2 for a registration: one Section per section plane with the optical figures (and
     the CMM's beside them when ``cmm`` — a path or CmmData — is given). See the module notes
     for where sections, edges and sides are."""
-    from ..cad.sections import cut
+    from ..cad.sections import cut   # cad/ needs FreeCAD; inspection/ imports without it
     for name, value in (("band", band), ("within", within), ("edge_fraction", edge_fraction)):
         if not np.isfinite(value) or value <= 0:
             raise InputError("section table: %s must be positive, got %r" % (name, value))

@@ -12,6 +12,7 @@ from ..core import bspline
 from ..core import transforms as tf
 from ..core.errors import InputError
 from ..core.pointio import PointSet, write_points_csv
+from .pipeline import AtomicOutput, register, write_register_outputs
 
 # Good readings and gross outliers get these SNRs: outliers come from poor signal.
 GOOD_SNR = (60.0, 95.0)
@@ -67,7 +68,7 @@ def sample_faces(nominal, faces, n, rng):
 
 def section_lines(nominal, heights_pct, spacing, axis=2):
     """Points along plane cuts of the CAD across its span (paper: three section lines)."""
-    from ..cad.sections import cut
+    from ..cad.sections import cut   # cad/ needs FreeCAD; inspection/ imports without it
     lo, hi = nominal.bbox_corners[:, axis].min(), nominal.bbox_corners[:, axis].max()
     pts = []
     for h in heights_pct:
@@ -145,7 +146,6 @@ def pose_error(estimated, truth, corners):
 
 def run_simulation(nominal, seed=0, progress=None, **options):
     """Simulate, register, judge. Returns (RegistrationResult, report dict)."""
-    from .pipeline import register
     t0 = time.perf_counter()
     pointset, truth, info, good = simulate_measurement(nominal, seed=seed, **options)
     t_sim = time.perf_counter() - t0
@@ -170,7 +170,6 @@ def run_simulation(nominal, seed=0, progress=None, **options):
 
 
 def write_simulation(out_dir, result, report, pointset):
-    from .pipeline import AtomicOutput, write_register_outputs
     with AtomicOutput(out_dir) as out:
         write_register_outputs(out_dir, result, extra={"simulation": report}, output=out)
         write_points_csv(out.path("points.csv"), pointset.xyz, {"snr": pointset.snr})

@@ -14,8 +14,11 @@ and with the diameter known the centre follows from a cap seen from above alone.
 import numpy as np
 
 from ..core import fitting
+from ..core import transforms as tf
 from ..core.errors import InputError
 from ..rig.kinematics import RigKinematics
+from ..rig.serial_rig import SerialRig
+from ..rig.simulated import SimulatedRig
 
 DEFAULT_DIAMETER = 25.0
 # Twelve angles round the full turn: the centres then span the whole circle, which makes the
@@ -297,8 +300,6 @@ def simulated_calibration_rig(sphere_diameter=DEFAULT_DIAMETER, seed=0, axis_off
     given axis offset and tilt (in seeded random directions across +Y) and stage scale errors:
     what `calibrate --rig sim` measures, and what tests judge calibration against.
     Returns (rig, true kinematics)."""
-    from ..core import transforms as tf
-    from ..rig.simulated import SimulatedRig
     rng = np.random.default_rng(seed)
     lean, shift = rng.uniform(0.0, 2.0 * np.pi, 2)
     tilt = np.radians(axis_tilt_deg)
@@ -323,7 +324,6 @@ def run_calibration(out_path, rig_spec="sim", sphere_diameter=DEFAULT_DIAMETER, 
     if rig_spec == "sim":
         rig, truth = simulated_calibration_rig(sphere_diameter, seed=seed, **simulated_errors)
     elif str(rig_spec).startswith("serial:"):
-        from ..rig.serial_rig import SerialRig
         rig = SerialRig(rig_spec[len("serial:"):])
     else:
         raise InputError("--rig: expected sim or serial:PORT, got %r" % (rig_spec,))

@@ -90,7 +90,7 @@ class CompletePlan:
     to_json = plan_json
 
 
-def _check_step(value, name):
+def check_step(value, name):
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -141,8 +141,8 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
     to serve the blade faces' worst normal best).
     Returns a CompletePlan. InputError for bad steps, DeviceError when a setpoint is outside
     the soft limits."""
-    pitch = _check_step(pitch, "--pitch")
-    spacing = _check_step(spacing, "complete scan spacing")
+    pitch = check_step(pitch, "--pitch")
+    spacing = check_step(spacing, "complete scan spacing")
     kinematics = kinematics if kinematics is not None else RigKinematics()
     table_to_cad = np.asarray(table_to_cad, dtype=float)
     cad_to_table = tf.invert_transform(table_to_cad)

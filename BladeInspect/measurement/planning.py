@@ -240,7 +240,7 @@ def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=No
     contours a list of (first index, end index, closed). InputError when the plane misses.
     ``edge_densify`` = (noise_mm, radius_sigma_mm): closed contours get points closer round
     their LE and TE (``_edge_spacing``)."""
-    from ..cad.sections import cut
+    from ..cad.sections import cut   # cad/ needs FreeCAD; measurement/ imports without it
     n = np.asarray(plane_normal, dtype=float)
     n = n / np.linalg.norm(n)
     o = np.asarray(plane_point, dtype=float)

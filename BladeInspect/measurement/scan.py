@@ -20,8 +20,12 @@ import tempfile
 
 import numpy as np
 
+from .. import __version__
 from ..core.contracts import json_ready
 from ..core.errors import DeviceError, InputError
+from ..rig.kinematics import RigKinematics
+from ..rig.serial_rig import SerialRig
+from ..rig.simulated import SimulatedRig, simulated_rig_for
 from .journal import JOURNAL_FILE, JournaledRig, inner_rig
 from .strategy import ScanOptions, ScanStrategy, StrategyState
 
@@ -39,18 +43,17 @@ def open_rig(spec, nominal=None, seed=0, kinematics=None, **rig_options):
     nominal); ``serial:PORT`` (or ``serial:MOTION,SENSOR``): the serial driver."""
     spec = str(spec)
     if spec == "sim":
-        from ..rig.simulated import simulated_rig_for
         if nominal is None:
             nominal = demo_nominal()
         return simulated_rig_for(nominal, seed=seed, kinematics=kinematics, **rig_options)
     if spec.startswith("serial:") and len(spec) > len("serial:"):
-        from ..rig.serial_rig import SerialRig
         return SerialRig(spec[len("serial:"):], **rig_options)
     raise InputError("--rig %s: expected sim or serial:PORT" % spec)
 
 
 def demo_nominal():
     """The built-in demo blade as a Nominal (what ``sim`` measures without a CAD)."""
+    # cad/ needs FreeCAD; measurement/ imports without it (a scan of a given nominal)
     from ..cad.demo_blade import make_demo_blade
     from ..cad.nominal import nominal_from_shape
     model = make_demo_blade()
@@ -158,16 +161,14 @@ def _strategy_options(options):
     options = dict(options)
     kinematics = options.pop("kinematics", None)
     if isinstance(kinematics, dict):
-        from ..rig.kinematics import RigKinematics
         kinematics = RigKinematics.from_dict(kinematics, "scan.json options")
     return ScanOptions.from_dict(options), kinematics
 
 
 def _new_record(rig, seed, options):
-    from .. import __version__ as version
     sensor = rig.sensor
     record = {
-        "software": {"name": "BladeInspect", "version": version},
+        "software": {"name": "BladeInspect", "version": __version__},
         "kind": "blind section scan",
         "rig": type(inner_rig(rig)).__name__,
         "seed": int(seed),
@@ -273,7 +274,6 @@ def _section_record(section):
 def _real_time(rig, record):
     """A simulated rig's time plus the per-pass overhead a real one adds; a real rig's
     elapsed time is already real."""
-    from ..rig.simulated import SimulatedRig
     if isinstance(inner_rig(rig), SimulatedRig):
         return record["simulated_s"] + PASS_OVERHEAD_S * record["passes"]
     return record["simulated_s"]

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.errors import DeviceError
+
 
 @dataclass
 class AxisLimits:
@@ -28,7 +30,6 @@ class AxisLimits:
 
     def check(self, x, y, z, a=None):
         """Raise DeviceError naming the axis when any target lies outside its soft limit."""
-        from ..core.errors import DeviceError
         for name, values, (lo, hi) in (("X", x, self.x), ("Y", y, self.y), ("Z", z, self.z)):
             values = np.atleast_1d(values)
             if np.any(values < lo - 1e-9) or np.any(values > hi + 1e-9):

@@ -17,6 +17,7 @@ import numpy as np
 from ..core.errors import DeviceError, InputError
 from . import protocol as pr
 from .base import Readings, Rig
+from .sensor import SensorModel
 
 # A real GRBL homes at a few mm/s over up to the full travel: give it far longer than a reply.
 HOME_TIMEOUT_S = 120.0
@@ -467,7 +468,6 @@ class SerialRig(Rig):
 
 def _sensor_model(identity):
     """The planning model of the sensor, with what it says of itself in place of the defaults."""
-    from .sensor import SensorModel
     known = {}
     for key, field in (("standoff_mm", "standoff"), ("range_mm", "half_range"),
                        ("rate_hz", "rate_hz")):

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import protocol as pr
+from .simulated import simulated_rig_for
 
 BANNER = "Grbl 1.1h ['$' for help]"
 SENSOR_MODEL = "BladeInspect-SimProbe"
@@ -492,8 +493,7 @@ def run_simrig(nominal=None, seed=0, two_ports=False, stream=None, **rig_options
     """Serve a SimulatedRig of ``nominal`` (None: the demo blade) on a pseudo-terminal, print
     the port to give ``--rig serial:...`` and serve until interrupted (Ctrl-C, SIGTERM)."""
     import signal
-    from ..cad.load import load_nominal
-    from .simulated import simulated_rig_for
+    from ..cad.load import load_nominal   # cad/ needs FreeCAD; rig/ imports without it
     stream = stream or sys.stdout
     if nominal is None:
         nominal = load_nominal(None)
@@ -517,5 +517,5 @@ def run_simrig(nominal=None, seed=0, two_ports=False, stream=None, **rig_options
 def simrig_main(cad_path=None, seed=0):
     """``./bladeinspect simrig [--cad CAD] [--seed S]``: the CAD (None: the demo blade) on
     the simulated rig that ``scan --rig sim --seed S`` uses, so both scan the same points."""
-    from ..cad.load import load_nominal
+    from ..cad.load import load_nominal   # cad/ needs FreeCAD; rig/ imports without it
     return run_simrig(load_nominal(cad_path), seed=seed)

@@ -1,23 +1,30 @@
 """inspection.FCStd: the inspection as a FreeCAD document, written headless.
 
-The document holds the workbench's own objects (BladeInspect.app.objects), so it opens in the
+The document holds the workbench's own objects (app.objects), so it opens in the
 workbench exactly as if the inspection had been done there: the nominal (DemoBlade or
 CadModel), the Measurement (the points as read, in their own frame), the Registration holding
 the result (linked to both, so it re-registers only if one of them changes), the DeviationMap
 (a Points::FeaturePython whose App::PropertyColorList "Color" has one colour per point, from
 core.colourmap) and the nominal section profiles. The verdict is stored beside the section
 profiles. Nothing is recomputed on opening: each object carries the signature of its inputs.
+
+The pipeline functions that write inspection.FCStd (inspection.report.run_report,
+inspection.closed_loop.run_inspect, inspection.batch.run_batch) sit below app/ and take
+``write_inspection_document`` as their ``document`` argument from the callers above them (the
+CLI, the GUI, tests).
 """
 
 import json
 import os
 
+import FreeCAD
 import numpy as np
 
 from ..core import transforms as tf
 from ..core.contracts import PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from ..core.pointio import PointSet
+from . import objects
 
 
 def _measured_pointset(result):
@@ -32,8 +39,6 @@ def write_inspection_document(path, nominal, result, sections, tolerance=PROFILE
                               verdict=None, cad_path=None, name="Inspection"):
     """Save the inspection document at ``path`` (.FCStd) and close it. ``cad_path`` is the CAD
     file the nominal came from (None: the built-in demo blade). Returns the path."""
-    import FreeCAD
-    from ..app import objects
     if not str(path).lower().endswith(".fcstd"):
         raise InputError("%s: an inspection document must be an .FCStd file" % path)
     # hidden: when the GUI is up (a report run from the workbench) no 3D view opens for it
