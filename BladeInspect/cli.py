@@ -45,10 +45,10 @@ class Progress:
 
 def _document_writer():
     """The writer of inspection.FCStd that the pipeline functions take (app/ sits above
-    them). Imported here, not at the top: it loads FreeCAD, which --help and a bad argument
-    do not need."""
-    from .app.document import write_inspection_document
-    return write_inspection_document
+    them), by name: it loads FreeCAD, which --help and a bad argument do not need, and a batch
+    hands it to worker processes (Dask's among them) that start FreeCAD only when it runs."""
+    from .freecad_library import FreeCADFunction
+    return FreeCADFunction("BladeInspect.app.document", "write_inspection_document")
 
 
 def _seed(value):

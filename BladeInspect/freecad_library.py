@@ -116,6 +116,23 @@ def versions():
             "python": "%d.%d.%d" % sys.version_info[:3]}
 
 
+class FreeCADFunction:
+    """A function of a module that needs FreeCAD, named rather than held, so that it pickles
+    to a process that has not started FreeCAD yet (a Dask worker, a spawned batch worker):
+    calling it there starts FreeCAD (import_freecad) first, then imports the module."""
+
+    def __init__(self, module, name):
+        self.module, self.name = module, name
+
+    def __call__(self, *args, **kwargs):
+        import importlib
+        import_freecad()
+        return getattr(importlib.import_module(self.module), self.name)(*args, **kwargs)
+
+    def __repr__(self):
+        return "FreeCADFunction(%r, %r)" % (self.module, self.name)
+
+
 def _run(argv):
     """``scripts/fcpython``: python3 with FreeCAD imported first. ARGV is ``SCRIPT [ARGS]``,
     ``-c CODE [ARGS]`` or ``-m MODULE [ARGS]``; with none, what was found is printed."""
