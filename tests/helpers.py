@@ -1,5 +1,6 @@
 """Shared test helpers: paths to the shared real-blade data, the demo blade, the GUI runner, a
-pose's bound computed from the truth, CPU timing."""
+pose's bound computed from the truth, CPU timing, reading result files."""
+import json
 import os
 import resource
 
@@ -161,3 +162,24 @@ def best_cpu_seconds(run, tries=3, enough=None):
         if enough is not None and best < enough:
             break
     return best, value
+
+
+def read_json(path):
+    with open(path) as fh:
+        return json.load(fh)
+
+
+def read_lines(path):
+    with open(path) as fh:
+        return fh.read().splitlines()
+
+
+def first_difference(mine, theirs):
+    """None when the two lists of lines are equal, else a short note of the first difference
+    (assertEqual's diff of thousands of lines takes minutes)."""
+    for i, (a, b) in enumerate(zip(mine, theirs)):
+        if a != b:
+            return "line %d: %r != %r" % (i + 1, a, b)
+    if len(mine) != len(theirs):
+        return "%d lines, not %d" % (len(mine), len(theirs))
+    return None

@@ -13,9 +13,8 @@ import numpy as np
 
 from BladeInspect.core.errors import DeviceError
 from BladeInspect.core.pointio import read_points
-from tests.helpers import demo_nominal
-from tests.test_inspect_resume import (HEIGHTS, RESULT_FILES, SCAN_OPTIONS, SEED,
-                                       first_difference, read_json, read_lines, simulated_rig)
+from tests.helpers import demo_nominal, first_difference, read_json, read_lines
+from tests.test_inspect_resume import HEIGHTS, RESULT_FILES, SCAN_OPTIONS, SEED, simulated_rig
 
 PITCH = 2.0
 PASSES_BEFORE_FAULT = 3

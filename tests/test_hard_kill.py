@@ -8,7 +8,6 @@ most the pass in flight lost).
 
 The device of the resumed runs is served in this process (rig.simrig_device.SimRigDevice,
 what `simrig` runs), so the passes it served can be counted."""
-import json
 import os
 import re
 import shutil
@@ -23,7 +22,7 @@ import numpy as np
 from BladeInspect.core.errors import InputError
 from BladeInspect.core.pointio import read_points
 from BladeInspect.measurement.journal import JOURNAL_FILE, read_journal
-from tests.helpers import demo_nominal
+from tests.helpers import demo_nominal, first_difference, read_json, read_lines
 from tests.serial_support import FakeSimulatedRig, section_path
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -39,25 +38,6 @@ RUN_TIMEOUT_S = 600
 def sim_rig(nominal):
     from BladeInspect.rig.simulated import simulated_rig_for
     return simulated_rig_for(nominal, seed=SEED)
-
-
-def read_json(path):
-    with open(path) as fh:
-        return json.load(fh)
-
-
-def read_lines(path):
-    with open(path) as fh:
-        return fh.read().splitlines()
-
-
-def first_difference(mine, theirs):
-    for i, (a, b) in enumerate(zip(mine, theirs)):
-        if a != b:
-            return "line %d: %r != %r" % (i + 1, a, b)
-    if len(mine) != len(theirs):
-        return "%d lines, not %d" % (len(mine), len(theirs))
-    return None
 
 
 def journal_passes(folder):

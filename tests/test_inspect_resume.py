@@ -22,7 +22,7 @@ import numpy as np
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
 from BladeInspect.core.pointio import read_points
-from tests.helpers import demo_nominal
+from tests.helpers import demo_nominal, first_difference, read_json, read_lines
 
 HEIGHTS = (30.0, 70.0)
 SEED = 23
@@ -39,27 +39,6 @@ FAULTS = {"blind": ("close", "motion port lost"),
 def simulated_rig(nominal):
     from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
     return SimulatedRig(nominal, random_fixture_pose(np.random.default_rng(SEED)), seed=SEED)
-
-
-def read_json(path):
-    with open(path) as fh:
-        return json.load(fh)
-
-
-def read_lines(path):
-    with open(path) as fh:
-        return fh.read().splitlines()
-
-
-def first_difference(mine, theirs):
-    """None when the two lists of lines are equal, else a short note of the first difference
-    (assertEqual's diff of thousands of lines takes minutes)."""
-    for i, (a, b) in enumerate(zip(mine, theirs)):
-        if a != b:
-            return "line %d: %r != %r" % (i + 1, a, b)
-    if len(mine) != len(theirs):
-        return "%d lines, not %d" % (len(mine), len(theirs))
-    return None
 
 
 class Reference:
