@@ -153,7 +153,8 @@ def fit_plane(points, weights=None):
 
 # ---------------------------------------------------------------- circle in space
 
-def _orthonormal_pair(normal):
+def orthonormal_pair(normal):
+    """Two unit vectors completing ``normal`` (unit) to a right-handed orthonormal frame."""
     helper = np.eye(3)[np.argmin(np.abs(normal))]
     e1 = np.cross(normal, helper)
     e1 /= np.linalg.norm(e1)
@@ -183,7 +184,7 @@ def fit_circle_3d(points, weights=None):
     w = _as_weights(weights, len(pts), "circle fit")
     plane = fit_plane(pts, w)
     n = plane.normal
-    e1, e2 = _orthonormal_pair(n)
+    e1, e2 = orthonormal_pair(n)
     local = pts - plane.point
     c2, R = _algebraic_circle_2d(np.column_stack([local @ e1, local @ e2]), w)
     c = c2[0] * e1 + c2[1] * e2
@@ -209,7 +210,7 @@ def fit_circle_3d(points, weights=None):
         c = c + dx[:3]
         n = n + dx[3] * e1 + dx[4] * e2
         n /= np.linalg.norm(n)
-        e1, e2 = _orthonormal_pair(n)
+        e1, e2 = orthonormal_pair(n)
         R += dx[5]
         if np.linalg.norm(dx) < 1e-13 * max(1.0, R):
             break

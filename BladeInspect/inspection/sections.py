@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 from ..core import pca
 from ..core.contracts import SECTION_HEIGHTS_PCT, section_heights
 from ..core.errors import InputError
-from ..core.fitting import fit_plane
+from ..core.fitting import fit_plane, orthonormal_pair
 
 EDGE_FRACTION = 0.03
 # Profile thickness is compared this far behind each end to tell the round nose from the tail.
@@ -84,7 +84,7 @@ class Section:
         """(n, 2) chord coordinates in mm: along the chord from the leading edge, and across."""
         xyz = np.atleast_2d(np.asarray(xyz, dtype=float))
         if self.profile is None:
-            e1, e2 = _plane_basis(self.normal)
+            e1, e2 = orthonormal_pair(self.normal)
             d = xyz - self.origin
             return np.column_stack([d @ e1, d @ e2])
         d = xyz - self.profile.le
@@ -94,7 +94,7 @@ class Section:
         """(n, 2) directions (e.g. normals) in the same chord coordinates."""
         vec = np.atleast_2d(np.asarray(vec, dtype=float))
         if self.profile is None:
-            e1, e2 = _plane_basis(self.normal)
+            e1, e2 = orthonormal_pair(self.normal)
         else:
             e1, e2 = self.profile.chord_dir, self.profile.cross_dir
         return np.column_stack([vec @ e1, vec @ e2])
@@ -183,13 +183,6 @@ def _zone_figures(dev, zone, within):
 
 
 # ---------------------------------------------------------------- geometry helpers
-
-def _plane_basis(normal):
-    helper = np.eye(3)[np.argmin(np.abs(normal))]
-    e1 = np.cross(normal, helper)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(normal, e1)
-
 
 def _role_faces(nominal, role):
     roles = getattr(nominal, "roles", None) or {}
@@ -295,7 +288,7 @@ def _build_profile(nominal, polylines, normal, fallback_xyz, origin):
     cloud = np.concatenate(verts) if verts else np.asarray(fallback_xyz, dtype=float)
     if len(cloud) < 2:
         return None
-    e1, e2 = _plane_basis(normal)
+    e1, e2 = orthonormal_pair(normal)
     rel = cloud - origin
     xy = np.column_stack([rel @ e1, rel @ e2])
     a2, b2 = _farthest_pair(xy)
