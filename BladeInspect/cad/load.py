@@ -15,6 +15,10 @@ from ..core.errors import InputError
 SHAPE_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
 DOCUMENT_EXTENSIONS = (".fcstd",)
 POINTS_MODULE_EXTENSIONS = (".ply", ".pcd")
+# Built-in parts a command's --cad may name instead of a file: the demo blade, and the demo
+# blade on a root block whose three datum faces carry the roles datum_primary/secondary/
+# tertiary (for --fit datum, which a STEP file's unnamed faces can only reach by index).
+BUILTIN_CADS = {"demo": {}, "demo:root-block": {"root_block": True}}
 
 
 def _check_file(path, kinds):
@@ -128,12 +132,13 @@ def read_points_any(path):
 def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     """The nominal geometry every command measures against: a CAD file, a blade section table
     (.dat, the NASA Rotor 67 format, lofted into B-spline faces), or the built-in demo blade
-    when ``cad_path`` is None. ``flip_faces``: indices of faces whose outward side the user
+    when ``cad_path`` is None or names it (BUILTIN_CADS; a file of that name wins).
+    ``flip_faces``: indices of faces whose outward side the user
     reverses (``--flip-face``, see cad.orient)."""
     from .nominal import nominal_from_shape
-    if cad_path is None:
+    if cad_path is None or (cad_path in BUILTIN_CADS and not os.path.exists(cad_path)):
         from .demo_blade import make_demo_blade
-        model = make_demo_blade()
+        model = make_demo_blade(**BUILTIN_CADS[cad_path or "demo"])
         return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing,
                                   flip_faces=flip_faces)
     if cad_path.lower().endswith(".dat"):

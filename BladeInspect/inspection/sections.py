@@ -26,10 +26,10 @@ from typing import Optional
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..core import pca
 from ..core.contracts import SECTION_HEIGHTS_PCT, section_heights
 from ..core.errors import InputError
 from ..core.fitting import fit_plane, orthonormal_pair
+from ..measurement.planning import span_frame
 
 EDGE_FRACTION = 0.03
 # Profile thickness is compared this far behind each end to tell the round nose from the tail.
@@ -190,40 +190,9 @@ def _role_faces(nominal, role):
 
 
 def span_axis_of(nominal, span_axis=None):
-    """(axis (3,) unit hub -> tip, (lo, hi) extent along it) of the CAD.
-
-    The axis is the given one; else, when the CAD names its hub faces, the normal of the plane
-    fitted to them (a swept or leaned blade's principal axis tilts by the sweep, while a CMM
-    and the rig's rotary axis cut it square to the hub); else the longest principal axis of the
-    CAD's area-weighted surface samples. It points from the hub to the tip faces when they are
-    named, else so that its largest component is positive (+Z for a blade modelled along Z)."""
-    xyz = nominal.samples.xyz
-    face = np.asarray(nominal.samples.face)
-    on_hub = np.isin(face, list(_role_faces(nominal, "hub")))
-    on_tip = np.isin(face, list(_role_faces(nominal, "tip")))
-    if span_axis is not None:
-        axis = np.asarray(span_axis, dtype=float).ravel()
-        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) == 0:
-            raise InputError("span axis: need three finite numbers, not all zero, got %r"
-                             % (span_axis,))
-        axis = axis / np.linalg.norm(axis)
-    else:
-        axis = pca.principal_axes(xyz, nominal.samples.weight).axes[:, 0].copy()
-        if np.count_nonzero(on_hub) >= 3:
-            try:
-                hub_normal = fit_plane(xyz[on_hub]).normal
-            except InputError:
-                hub_normal = None
-            # a hub that is not roughly square to the blade is no reference for the span
-            if hub_normal is not None and abs(hub_normal @ axis) > 0.9:
-                axis = hub_normal
-    if on_hub.any() and on_tip.any():
-        if (xyz[on_tip].mean(axis=0) - xyz[on_hub].mean(axis=0)) @ axis < 0:
-            axis = -axis
-    elif span_axis is None and axis[np.argmax(np.abs(axis))] < 0:
-        axis = -axis
-    s = xyz @ axis
-    return axis, (float(s.min()), float(s.max()))
+    """(axis (3,) unit hub -> tip, (lo, hi) extent along it) of the CAD: core.span's rule."""
+    frame = span_frame(nominal, span_axis)
+    return frame.axis, (frame.lo, frame.hi)
 
 
 def _farthest_pair(xy):

@@ -12,6 +12,7 @@ from ..core import bspline
 from ..core import transforms as tf
 from ..core.errors import InputError
 from ..core.pointio import PointSet, write_points_csv
+from ..measurement.planning import span_frame
 from .pipeline import AtomicOutput, register, write_register_outputs
 
 # Good readings and gross outliers get these SNRs: outliers come from poor signal.
@@ -21,14 +22,15 @@ SECTION_LINE_HEIGHTS_PCT = (25.0, 50.0, 75.0)
 
 
 def measurement_faces(nominal, sides):
-    """Face indices a scan of the given sides covers: the suction/pressure roles when the CAD
-    has them, otherwise every face that is not planar (hub and tip caps are planes)."""
+    """Face indices a scan of the given sides covers: the suction/pressure roles (and a root
+    block's faces, for both sides) when the CAD has them, otherwise every face that is not planar (hub and tip caps are planes)."""
     roles = nominal.roles or {}
     if sides not in ("both", "suction", "pressure"):
         raise InputError("--sides: expected both, suction or pressure, got %r" % sides)
     if roles.get("suction") and roles.get("pressure"):
-        names = ("suction", "pressure") if sides == "both" else (sides,)
-        return sorted(i for name in names for i in roles[name])
+        # A root block is part of the part a scan of both sides sees (and holds the datums).
+        names = ("suction", "pressure", "root_block") if sides == "both" else (sides,)
+        return sorted(i for name in names for i in roles.get(name, ()))
     if sides != "both":
         raise InputError("--sides %s: this CAD has no suction/pressure faces marked" % sides)
     faces = [i for i, f in enumerate(nominal.faces) if "Plane" not in type(f.Surface).__name__]
@@ -66,16 +68,15 @@ def sample_faces(nominal, faces, n, rng):
     return points, normals
 
 
-def section_lines(nominal, heights_pct, spacing, axis=2):
-    """Points along plane cuts of the CAD across its span (paper: three section lines)."""
+def section_lines(nominal, heights_pct, spacing):
+    """Points along plane cuts of the CAD across its span (paper: three section lines), at
+    heights of the span as every command measures it (measurement.planning.span_frame)."""
     from ..cad.sections import cut   # cad/ needs FreeCAD; inspection/ imports without it
-    lo, hi = nominal.bbox_corners[:, axis].min(), nominal.bbox_corners[:, axis].max()
+    frame = span_frame(nominal)
+    normal = frame.axis
     pts = []
     for h in heights_pct:
-        origin = np.zeros(3)
-        origin[axis] = lo + (hi - lo) * h / 100.0
-        normal = np.zeros(3)
-        normal[axis] = 1.0
+        origin = normal * (frame.lo + (frame.hi - frame.lo) * h / 100.0)
         for line in cut(nominal.shape, origin, normal):
             seg = np.linalg.norm(np.diff(line, axis=0), axis=1)
             arc = np.concatenate([[0.0], np.cumsum(seg)])

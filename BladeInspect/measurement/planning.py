@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import pca
+from ..core import span as span_mod
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
 from ..rig.kinematics import RigKinematics
@@ -136,50 +136,29 @@ class Plan:
 
 # ---------------------------------------------------------------- geometry helpers
 
+def _planar_faces(nominal):
+    return [i for i, f in enumerate(nominal.faces) if "Plane" in type(f.Surface).__name__]
+
+
 def blade_faces(nominal):
-    """Faces that make the airfoil: the roles when known, else every non-planar face (the
-    hub and tip caps of a blade are planes)."""
-    roles = nominal.roles or {}
-    names = ("suction", "pressure", "leading_edge", "trailing_edge")
-    faces = sorted({i for name in names for i in roles.get(name, [])})
-    if faces:
-        return faces
-    faces = [i for i, f in enumerate(nominal.faces)
-             if "Plane" not in type(f.Surface).__name__]
-    return faces or list(range(len(nominal.faces)))
+    """Faces that make the airfoil (core.span.airfoil_faces): the roles when known, else every
+    non-planar face."""
+    return span_mod.airfoil_faces(nominal.roles, len(nominal.faces), _planar_faces(nominal))
+
+
+def span_frame(nominal, span_axis=None):
+    """core.span.Span of the nominal: the one span rule of the planner and the analysis."""
+    s = nominal.samples
+    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, _planar_faces(nominal),
+                         len(nominal.faces), span_axis)
 
 
 def span_axis_of(nominal, span_axis=None):
-    """(axis (3,) unit, origin (3,), lo, hi): the span direction and the CAD's extent along
-    it. Default: the longest principal axis of the blade faces' area-weighted
-    samples, pointing from the hub towards the tip when the CAD marks them."""
-    s = nominal.samples
-    mask = np.isin(s.face, blade_faces(nominal))
-    xyz, w = s.xyz[mask], s.weight[mask]
-    if span_axis is None:
-        axes = pca.principal_axes(xyz, w)
-        axis = np.asarray(axes.axes[:, 0], dtype=float)
-        origin = axes.centroid
-    else:
-        axis = np.asarray(span_axis, dtype=float)
-        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) == 0:
-            raise InputError("span axis: expected a non-zero 3-vector, got %r" % (span_axis,))
-        origin = np.average(xyz, axis=0, weights=w)
-    axis = axis / np.linalg.norm(axis)
-    roles = nominal.roles or {}
-    hub, tip = roles.get("hub"), roles.get("tip")
-    if span_axis is None:
-        if hub and tip:
-            hub_c = s.xyz[np.isin(s.face, hub)].mean(axis=0)
-            tip_c = s.xyz[np.isin(s.face, tip)].mean(axis=0)
-            if (tip_c - hub_c) @ axis < 0:
-                axis = -axis
-        elif axis[np.argmax(np.abs(axis))] < 0:
-            axis = -axis
-    # The extent comes from every face's samples: samples sit at cell centres, so the blade
-    # faces alone fall short of their ends, while planar hub and tip caps lie exactly on them.
-    h = (s.xyz - origin) @ axis
-    return axis, origin, float(h.min()), float(h.max())
+    """(axis (3,) unit, origin (3,), lo, hi): span_frame's axis, the airfoil faces' centroid,
+    and the extent along the axis measured from that centroid."""
+    frame = span_frame(nominal, span_axis)
+    offset = float(frame.origin @ frame.axis)
+    return frame.axis, frame.origin, frame.lo - offset, frame.hi - offset
 
 
 def _resample(chain, closed, spacing):
