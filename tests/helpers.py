@@ -183,3 +183,13 @@ def first_difference(mine, theirs):
     if len(mine) != len(theirs):
         return "%d lines, not %d" % (len(mine), len(theirs))
     return None
+
+
+def rodrigues(points, angle_deg, direction, point=(0.0, 0.0, 0.0)):
+    """Points turned by angle_deg about the line through ``point`` along ``direction``:
+    Rodrigues' vector form, independent of the project's rotation matrices."""
+    k = np.asarray(direction, float) / np.linalg.norm(direction)
+    v = np.atleast_2d(points) - np.asarray(point, float)
+    a = np.radians(angle_deg)
+    return (np.asarray(point, float) + v * np.cos(a) + np.cross(k, v) * np.sin(a)
+            + np.outer(v @ k, k) * (1 - np.cos(a)))

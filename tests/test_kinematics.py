@@ -10,15 +10,7 @@ import numpy as np
 
 from BladeInspect.core.errors import InputError
 from BladeInspect.rig.kinematics import RigKinematics
-
-
-def rodrigues(points, angle_deg, point, direction):
-    """Independent turn about a line (Rodrigues' vector form)."""
-    k = np.asarray(direction, float) / np.linalg.norm(direction)
-    v = np.atleast_2d(points) - point
-    a = np.radians(angle_deg)
-    return (point + v * np.cos(a) + np.cross(k, v) * np.sin(a)
-            + np.outer(v @ k, k) * (1 - np.cos(a)))
+from tests.helpers import rodrigues
 
 
 class TestKinematics(unittest.TestCase):
@@ -55,7 +47,7 @@ class TestKinematics(unittest.TestCase):
             table = rng.uniform(-40, 40, (30, 3))
             a = rng.uniform(-400, 400)
             machine = k.machine_point_of_table(table, a)
-            np.testing.assert_allclose(machine, rodrigues(table, a, point, direction),
+            np.testing.assert_allclose(machine, rodrigues(table, a, direction, point),
                                        atol=1e-11)
             np.testing.assert_allclose(k.table_point(machine, a), table, atol=1e-11)
             T = k.table_to_machine_transform(a)

@@ -11,15 +11,8 @@ from BladeInspect.core.errors import DeviceError
 from BladeInspect.rig.base import AxisLimits
 from BladeInspect.rig.simulated import (SimulatedRig, make_bump, make_thickening,
                                         random_fixture_pose)
-from tests.helpers import best_cpu_seconds
+from tests.helpers import best_cpu_seconds, rodrigues
 from tests.rig_parts import Sphere
-
-
-def rodrigues(points, angle_deg, direction):
-    k = np.asarray(direction, float) / np.linalg.norm(direction)
-    v = np.atleast_2d(points)
-    a = np.radians(angle_deg)
-    return v * np.cos(a) + np.cross(k, v) * np.sin(a) + np.outer(v @ k, k) * (1 - np.cos(a))
 
 
 class TestMeasure(unittest.TestCase):

@@ -77,17 +77,19 @@ def _residual_variance(r, w, n_params):
 
 # ---------------------------------------------------------------- sphere
 
-def _algebraic_sphere(pts, w):
-    """|p|^2 = 2 c.p + (R^2 - |c|^2) is linear in c and the constant: Kasa's fit."""
+def _algebraic_hypersphere(pts, w, what):
+    """Kasa's fit of a circle (2D points) or sphere (3D): |p|^2 = 2 c.p + (R^2 - |c|^2) is
+    linear in c and the constant."""
+    dim = pts.shape[1]
     A = np.column_stack([2.0 * pts, np.ones(len(pts))])
     b = np.einsum("ij,ij->i", pts, pts)
     sw = np.sqrt(w)
     sol, _, rank, _ = np.linalg.lstsq(A * sw[:, None], b * sw, rcond=None)
-    if rank < 4:
-        raise InputError("sphere fit: the points are coplanar or collinear, no sphere is defined")
-    center = sol[:3]
-    radius_sq = sol[3] + center @ center
-    return center, float(np.sqrt(max(radius_sq, 0.0)))
+    if rank < dim + 1:
+        raise InputError("%s fit: the points are %s, no %s is defined"
+                         % (what, "collinear" if dim == 2 else "coplanar or collinear", what))
+    center = sol[:dim]
+    return center, float(np.sqrt(max(sol[dim] + center @ center, 0.0)))
 
 
 def fit_sphere(points, radius=None, weights=None):
@@ -104,7 +106,7 @@ def fit_sphere(points, radius=None, weights=None):
         raise InputError("sphere fit: radius must be a positive number, got %r" % (radius,))
     center_shift = np.average(pts, axis=0, weights=w)
     local = pts - center_shift
-    c, r_alg = _algebraic_sphere(local, w)
+    c, r_alg = _algebraic_hypersphere(local, w, "sphere")
     R = float(radius) if known else r_alg
     n_params = 3 if known else 4
     iterations = 0
@@ -161,17 +163,6 @@ def orthonormal_pair(normal):
     return e1, np.cross(normal, e1)
 
 
-def _algebraic_circle_2d(xy, w):
-    A = np.column_stack([2.0 * xy, np.ones(len(xy))])
-    b = np.einsum("ij,ij->i", xy, xy)
-    sw = np.sqrt(w)
-    sol, _, rank, _ = np.linalg.lstsq(A * sw[:, None], b * sw, rcond=None)
-    if rank < 3:
-        raise InputError("circle fit: the points are collinear, no circle is defined")
-    center = sol[:2]
-    return center, float(np.sqrt(max(sol[2] + center @ center, 0.0)))
-
-
 def fit_circle_3d(points, weights=None):
     """Circle in space minimising the squared distances of the points to the circle itself.
 
@@ -186,7 +177,7 @@ def fit_circle_3d(points, weights=None):
     n = plane.normal
     e1, e2 = orthonormal_pair(n)
     local = pts - plane.point
-    c2, R = _algebraic_circle_2d(np.column_stack([local @ e1, local @ e2]), w)
+    c2, R = _algebraic_hypersphere(np.column_stack([local @ e1, local @ e2]), w, "circle")
     c = c2[0] * e1 + c2[1] * e2
     ww = np.concatenate([w, w])
     iterations = 0
