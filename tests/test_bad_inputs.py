@@ -90,21 +90,22 @@ class BadInputCase(unittest.TestCase):
 
 
 class TestRefusedFiles(BadInputCase):
-    def test_a_huge_coordinate_is_refused_naming_its_row(self):
+    def points_with_row(self, name, at, row):
+        """The good scan's file with one more line inserted before line ``at``."""
         rows = open(self.points).read().splitlines()
-        rows.insert(4, "1e300,1,2,50")
-        path = os.path.join(self.tmp, "huge.csv")
+        rows.insert(at, row)
+        path = os.path.join(self.tmp, name)
         with open(path, "w") as fh:
             fh.write("\n".join(rows) + "\n")
-        self.assert_refused(path, "data row 4", "1e+300", "not a measurement in millimetres")
+        return path
+
+    def test_a_huge_coordinate_is_refused_naming_its_row(self):
+        self.assert_refused(self.points_with_row("huge.csv", 4, "1e300,1,2,50"),
+                            "data row 4", "1e+300", "not a measurement in millimetres")
 
     def test_an_infinite_coordinate_is_refused_naming_its_row(self):
-        rows = open(self.points).read().splitlines()
-        rows.insert(6, "3,inf,2,50")
-        path = os.path.join(self.tmp, "infinite.csv")
-        with open(path, "w") as fh:
-            fh.write("\n".join(rows) + "\n")
-        self.assert_refused(path, "data row 6", "y is inf", "not a measurement")
+        self.assert_refused(self.points_with_row("infinite.csv", 6, "3,inf,2,50"),
+                            "data row 6", "y is inf", "not a measurement")
 
     def test_a_huge_coordinate_is_refused_by_report_too(self):
         xyz = self.scan.xyz.copy()

@@ -136,21 +136,26 @@ class Plan:
 
 # ---------------------------------------------------------------- geometry helpers
 
-def _planar_faces(nominal):
-    return [i for i, f in enumerate(nominal.faces) if "Plane" in type(f.Surface).__name__]
+def _faces(nominal):
+    """(number of faces, indices of the planar ones); samples alone (no faces) count as one
+    non-planar face each index."""
+    faces = getattr(nominal, "faces", None)
+    if faces is None:
+        return int(np.max(nominal.samples.face)) + 1, []
+    return len(faces), [i for i, f in enumerate(faces) if "Plane" in type(f.Surface).__name__]
 
 
 def blade_faces(nominal):
     """Faces that make the airfoil (core.span.airfoil_faces): the roles when known, else every
     non-planar face."""
-    return span_mod.airfoil_faces(nominal.roles, len(nominal.faces), _planar_faces(nominal))
+    return span_mod.airfoil_faces(nominal.roles, *_faces(nominal))
 
 
 def span_frame(nominal, span_axis=None):
     """core.span.Span of the nominal: the one span rule of the planner and the analysis."""
     s = nominal.samples
-    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, _planar_faces(nominal),
-                         len(nominal.faces), span_axis)
+    n_faces, planar = _faces(nominal)
+    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis)
 
 
 def span_axis_of(nominal, span_axis=None):
