@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, HERE)
 CLI = os.path.join(HERE, "bladeinspect")
 
-from bench.bench_inspect_resume import pose, read, start_simrig, stop  # noqa: E402
+from bench.bench_inspect_resume import against_reference, read, start_simrig, stop  # noqa: E402
 
 
 def in_process(out, seed, heights, journal=True):
@@ -120,12 +120,8 @@ def main():
     seconds = time.perf_counter() - start
     stop(simrig)
     print("inspect --resume on a new simrig: exit %d, %.1f s" % (resumed.returncode, seconds))
-    reference = read(os.path.join(tmp, "sim", "points.csv"))
-    same = read(os.path.join(out, "points.csv")) == reference
-    print("points.csv %s the in-process run's (%d rows); pose differs by %.1e; %s left"
-          % ("IDENTICAL to" if same else "DIFFERS from", reference.count("\n") - 1,
-             np.max(np.abs(pose(out) - pose(os.path.join(tmp, "sim")))),
-             "a live folder" if os.path.exists(live) else "no live folder"))
+    print("%s; %s left" % (against_reference(out, os.path.join(tmp, "sim")),
+                           "a live folder" if os.path.exists(live) else "no live folder"))
     if args.keep:
         print("folders in %s" % tmp)
     else:

@@ -76,6 +76,15 @@ def pose(folder):
     return np.asarray(json.loads(read(os.path.join(folder, "result.json")))["measured_to_cad"])
 
 
+def against_reference(folder, reference):
+    """'points.csv IDENTICAL to|DIFFERS from the in-process run's (N rows); pose differs by X'"""
+    expected = read(os.path.join(reference, "points.csv"))
+    same = read(os.path.join(folder, "points.csv")) == expected
+    return ("points.csv %s the in-process run's (%d rows); pose differs by %.1e"
+            % ("IDENTICAL to" if same else "DIFFERS from", expected.count("\n") - 1,
+               np.max(np.abs(pose(folder) - pose(reference)))))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=3)
@@ -113,15 +122,11 @@ def main():
     stop(simrig)
     print("inspect --resume on a new simrig:  exit %d, %.1f s %s" % (status, seconds, errors))
 
-    reference = read(os.path.join(folders["sim"], "points.csv"))
     for name in ("serial", "resumed"):
         if not os.path.exists(os.path.join(folders[name], "result.json")):
             print("%s: no result" % name)
             continue
-        same = read(os.path.join(folders[name], "points.csv")) == reference
-        print("%-8s points.csv %s the in-process run's (%d rows); pose differs by %.1e"
-              % (name, "IDENTICAL to" if same else "DIFFERS from", reference.count("\n") - 1,
-                 np.max(np.abs(pose(folders[name]) - pose(folders["sim"])))))
+        print("%-8s %s" % (name, against_reference(folders[name], folders["sim"])))
     if args.keep:
         print("folders in %s" % tmp)
     else:

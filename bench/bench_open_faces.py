@@ -26,21 +26,12 @@ import Part  # noqa: E402
 from BladeInspect.cad import orient  # noqa: E402
 from BladeInspect.cad.load import load_nominal  # noqa: E402
 from BladeInspect.cad.rotor67 import make_rotor67_blade, read_rotor67, side_faces  # noqa: E402
-from tests.helpers import ROTOR67_SECTIONS  # noqa: E402
+from tests.helpers import ROTOR67_SECTIONS, face_points  # noqa: E402
 
 POINTS_PER_SIDE = 200
 OFFSET_MM = (0.005, 0.2)
 BUMP_MM = 0.05
 BAND = (0.4, 0.6)          # span fractions of the bump band
-
-
-def sample(face, n, rng, margin=0.02):
-    u0, u1, v0, v1 = face.ParameterRange
-    uv = rng.uniform([u0 + margin * (u1 - u0), v0 + margin * (v1 - v0)],
-                     [u1 - margin * (u1 - u0), v1 - margin * (v1 - v0)], size=(n, 2))
-    p = np.array([tuple(face.valueAt(a, b)) for a, b in uv])
-    nrm = np.array([tuple(face.normalAt(a, b)) for a, b in uv])
-    return p, nrm / np.linalg.norm(nrm, axis=1)[:, None], uv[:, 1]
 
 
 def main(seed=67):
@@ -72,7 +63,8 @@ def main(seed=67):
 
     points, inside, side, bump, band = [], [], [], [], []
     for k, face in enumerate(truth_faces):
-        p, n, v = sample(face, POINTS_PER_SIDE, rng)
+        p, n, uv = face_points(face, POINTS_PER_SIDE, rng, margin=0.02)
+        v = uv[:, 1]
         offset = rng.choice([-1.0, 1.0], len(p)) * rng.uniform(*OFFSET_MM, len(p))
         q = p + offset[:, None] * n
         points.append(q)

@@ -193,3 +193,14 @@ def rodrigues(points, angle_deg, direction, point=(0.0, 0.0, 0.0)):
     a = np.radians(angle_deg)
     return (np.asarray(point, float) + v * np.cos(a) + np.cross(k, v) * np.sin(a)
             + np.outer(v @ k, k) * (1 - np.cos(a)))
+
+
+def face_points(face, n, rng, margin=0.05):
+    """(points (n, 3), OCC's unit normals there (n, 3), parameters (n, 2)) at random parameters
+    of a Part face, ``margin`` of its parameter range clear of the range's ends."""
+    u0, u1, v0, v1 = face.ParameterRange
+    uv = rng.uniform([u0 + margin * (u1 - u0), v0 + margin * (v1 - v0)],
+                     [u1 - margin * (u1 - u0), v1 - margin * (v1 - v0)], size=(n, 2))
+    p = np.array([tuple(face.valueAt(a, b)) for a, b in uv])
+    nrm = np.array([tuple(face.normalAt(a, b)) for a, b in uv])
+    return p, nrm / np.linalg.norm(nrm, axis=1)[:, None], uv

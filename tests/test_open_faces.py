@@ -25,7 +25,7 @@ from BladeInspect.cad.nominal import nominal_from_shape
 from BladeInspect.cad.surface_build import close_sides, interpolate_grid
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
-from tests.helpers import demo_nominal
+from tests.helpers import demo_nominal, face_points
 
 # A blade other than the built-in one (more twist, fewer sections), so nothing is shared.
 PARAMS = demo_blade.BladeParams(twist_deg=35.0, n_sections=7, camber_root=0.1, sweep=5.0)
@@ -62,12 +62,7 @@ def _truth_solid():
 
 def _surface_points(face, n, rng, margin=0.05):
     """(points (n, 3), OCC outward normals (n, 3)) at random parameters inside the face."""
-    u0, u1, v0, v1 = face.ParameterRange
-    uv = rng.uniform([u0 + margin * (u1 - u0), v0 + margin * (v1 - v0)],
-                     [u1 - margin * (u1 - u0), v1 - margin * (v1 - v0)], size=(n, 2))
-    p = np.array([tuple(face.valueAt(a, b)) for a, b in uv])
-    nrm = np.array([tuple(face.normalAt(a, b)) for a, b in uv])
-    return p, nrm / np.linalg.norm(nrm, axis=1)[:, None]
+    return face_points(face, n, rng, margin)[:2]
 
 
 def _is_inside(solid, points):
