@@ -9,7 +9,8 @@
   covariance and the Cramer-Rao bound of the true 1 / sigma_n^2, and is smaller than the SNR
   weights' (whose own scatter matches the sandwich covariance of a misweighted least squares);
 - the choice of weights for a point set: sensor by default with angle_deg, snr without, and
-  `--weights sensor` on a file without angle_deg refused with a one-line error.
+  `--weights sensor` on a file without angle_deg refused with a one-line error; a bad choice
+  refused by the fit options before anything is measured.
 """
 import unittest
 
@@ -183,6 +184,32 @@ class TestChoice(unittest.TestCase):
             weight_model_for(self.pointset(False), "sensor")
         self.assertIn("scan.csv", str(ctx.exception))
         self.assertIn("angle_deg", str(ctx.exception))
+        # A row without a rotary angle has no beam: the default keeps the paper's weights,
+        # an explicit --weights sensor is refused.
+        broken = self.pointset(True)
+        broken.columns["angle_deg"][3] = np.nan
+        self.assertEqual(weight_model_for(broken)[1]["model"], "snr")
+        with self.assertRaises(InputError):
+            weight_model_for(broken, "sensor")
+
+    def test_bad_choice_refused_with_the_fit_options(self):
+        from BladeInspect.inspection.fitting import FitChoice
+        self.assertEqual(FitChoice(weights="snr").weights, "snr")
+        with self.assertRaises(InputError) as ctx:
+            FitChoice(weights="ml")
+        self.assertIn("--weights", str(ctx.exception))
+
+    def test_the_loops_kinematics_turn_the_beams(self):
+        """inspect weights its rows by the kinematics it turned them back with (RIG.json)."""
+        from BladeInspect.inspection.weighting import weights_for_rows
+        kin = RigKinematics(axis_point=[3.0, 0.0, -2.0],
+                            axis_direction=unit(np.array([0.02, 1.0, -0.03])))
+        ps = self.pointset(True)
+        model, record = weights_for_rows(ps.xyz, ps.snr, ps.columns["angle_deg"], None, kin)
+        np.testing.assert_allclose(
+            model.beam, beam_in_table(ps.columns["angle_deg"], kin.axis_direction,
+                                      MACHINE_BEAM), atol=1e-12)
+        self.assertIn(str(np.round(kin.axis_direction, 9).tolist()), record["beam"])
 
 
 class TestPlannedScanOfTheDemoBlade(unittest.TestCase):
@@ -241,6 +268,11 @@ class TestPlannedScanOfTheDemoBlade(unittest.TestCase):
         result = pipeline.register(self.nominal, self.pointset, seed=1, use_reconstruction=False,
                                    weights="snr")
         self.assertEqual(pipeline.result_json(result)["weights"]["model"], "snr")
+        # --weights arrives with the other fit options (cli -> inspection.fitting.FitChoice).
+        from BladeInspect.inspection.fitting import FitChoice
+        result = pipeline.register(self.nominal, self.pointset, seed=1, use_reconstruction=False,
+                                   fit_choice=FitChoice(weights="snr"))
+        self.assertEqual(result.weights["chosen_by"], "--weights snr")
 
 
 class TestCommandLine(unittest.TestCase):
