@@ -85,6 +85,11 @@ class TestInspectLoop(unittest.TestCase):
                            else self.scan_json["truth"]["table_to_cad"], dtype=float)
         np.testing.assert_allclose(truth.reshape(4, 4), self.truth, atol=1e-9)
 
+    def test_weights_named(self):
+        # The rig's readings carry snr and angle_deg: the sensor model's weights by default.
+        self.assertEqual(self.result_json["weights"]["model"], "sensor")
+        self.assertIn("default", self.result_json["weights"]["chosen_by"])
+
     def test_pose_within_three_times_its_bound(self):
         T = np.asarray(self.result_json["measured_to_cad"])
         err = tf.corner_displacement(T, self.truth, self.nominal.bbox_corners)

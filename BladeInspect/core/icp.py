@@ -3,9 +3,11 @@
 The objective is  sum_i w_i d_i(T)^2  with d_i the signed distance of T p_i to the surface and
 w_i = a_i * rho_i:
 
-* a_i = SNR_i / mean(SNR) — the sensor's noise is sigma_i^2 = sigma_ref^2 SNR_ref / SNR_i
-  (docs/contracts.md), so SNR-linear weights are the maximum-likelihood ones; dividing by the
-  mean makes a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
+* a_i = SNR_i / mean(SNR) — the sensor's noise along its beam is
+  sigma_i^2 = sigma_ref^2 SNR_ref / SNR_i (docs/contracts.md), the paper's weights; or, with
+  ``weight_model`` (core.weights), that model's weights re-evaluated at every pose (the sensor
+  model's 1 / sigma_n^2, the noise along the normal: the maximum-likelihood weights). Dividing
+  by the mean makes a_i = 1 for a typical point, so sigma0 below is the noise of a typical point.
 * rho_i in [0, 1] — a redescending robust weight of the standardised residual
   u_i = |z_i| / s with z_i = d_i sqrt(a_i) and s = max(1.4826 MAD(z), median |z| / k_full),
   a robust scale re-estimated at every iteration (see _robust_deviation). rho = 1 for
@@ -32,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .weights import normalised_weights
 from .transforms import make_transform, rotation_from_vector, rotation_matrix_from_quaternion
 
 MAD_TO_SIGMA = 1.4826   # sigma of a normal distribution per unit of median absolute deviation
@@ -346,9 +349,11 @@ def _gauss_newton_step(points_cad, normals, distances, w, center):
     return x[:3], x[3:]
 
 
-def icp(points, snr, closest_fn, init, options=None):
+def icp(points, snr, closest_fn, init, options=None, weight_model=None):
     """Register `points` (measured frame) to the surface behind `closest_fn`, starting at `init`
-    (measured -> CAD). See the module docstring for the objective and the weights."""
+    (measured -> CAD). See the module docstring for the objective and the weights;
+    ``weight_model(T, normals) -> (N,)`` (core.weights.SensorWeights), when given, replaces the
+    SNR weights a_i and is re-evaluated at every closest-point evaluation."""
     options = options or ICPOptions()
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 7:
@@ -372,6 +377,8 @@ def icp(points, snr, closest_fn, init, options=None):
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
+        if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+            a = normalised_weights(weight_model, T, normals, len(points))
         rho, _ = robust_weights(distances, a, options, neighbourhoods)
         w = a * rho
         if np.count_nonzero(w) < 7:
@@ -413,6 +420,8 @@ def icp(points, snr, closest_fn, init, options=None):
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
         _, normals, distances = closest_fn(moved)
+    if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+        a = normalised_weights(weight_model, T, normals, len(points))
     rho, _ = robust_weights(distances, a, options, neighbourhoods)
     w = a * rho
     inlier = rho > 0

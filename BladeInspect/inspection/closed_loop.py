@@ -47,6 +47,7 @@ from . import airfoil as airfoil_mod
 from . import pipeline
 from . import sections as sections_mod
 from . import verdict as verdict_mod
+from . import weighting
 from .checkpoint import LIVE_FOLDER, Checkpoint, inspection_identity, save_plan, start_or_resume
 from .checks import unmeasured_warning
 from .report import write_report
@@ -241,7 +242,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
                                     out_dir, identity, rig, resume)
             scan_options = dict(checkpoint.identity["scan_options"] or {})
             register_options = {"allow_mismatch": allow_mismatch, "tolerance": tolerance,
-                                "cad_source": cad_path or "the demo blade"}
+                                "cad_source": cad_path or "the demo blade",
+                                "weights": getattr(fit_choice, "weights", None)}  # issue 16
             judge_options = {"fit_choice": fit_choice,   # hook: issue 16
                              "measurement_model": measurement_model}
             phase_of = _RasterPhase if complete else _SectionsPhase
@@ -273,7 +275,8 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
     """The blind section scan into the checkpoint and its registration: nothing is known of
     the pose yet, so only what the sensor reads is used. A resumed inspection continues an
     interrupted blind scan (scan_to_dir's own resume) or reads the finished one back.
-    ``register_options``: pipeline.register's allow_mismatch, tolerance and cad_source.
+    ``register_options``: pipeline.register's allow_mismatch, tolerance, cad_source and
+    weights (their beams turned back by ``kinematics``).
     Returns (the blind scan's record, points, rig time spent, registration)."""
     t0 = time.perf_counter()
     state = checkpoint.state
@@ -295,7 +298,8 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
     t0 = time.perf_counter()
     first = pipeline.register(
         nominal, blind, seed=seed,
-        progress=lambda f, m: progress(scan_share + register_share * f, m), **register_options)
+        progress=lambda f, m: progress(scan_share + register_share * f, m),
+        rig_kinematics=kinematics, **register_options)
     timing["register_blind"] = time.perf_counter() - t0
     if state is not None and state["phase"] != "blind":
         # The saved pose plans the rest; a registration that no longer lands there means the
@@ -530,8 +534,12 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
         t0 = time.perf_counter()
         xyz = np.vstack([blind.xyz, measured[0]])
         snr = np.concatenate([blind.snr, measured[1]])
+        weight_model, weights_record = weighting.weights_for_rows(   # hook: issue 16 item 3
+            xyz, snr, np.concatenate([_blind_column(blind, "angle_deg", n_blind), measured[3]]),
+            register_options["weights"], kinematics, phase.source)
         fit = pipeline.fine_register(xyz, snr, nominal, pose,
-                                     progress=lambda f, m: progress(phase.fit_progress, m))
+                                     progress=lambda f, m: progress(phase.fit_progress, m),
+                                     weight_model=weight_model)
         timing[phase.fit_timing[attempt]] = time.perf_counter() - t0
         if not phase.again(state, plan, pose, fit, n_measured, attempt, checkpoint):
             break
@@ -542,6 +550,7 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     t0 = time.perf_counter()
     columns, result = _result_of_all(nominal, blind, blind_sections, measured, phase.name, xyz,
                                      snr, fit, first, timing, cad_label, phase.source)
+    result.weights = weights_record   # hook: issue 16 item 3
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_measured, heights,

@@ -26,6 +26,7 @@ from ..core import stats as stats_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 from . import sections as sections_mod
+from . import weighting
 
 ENGINE_AXIS = (1.0, 0.0, 0.0)        # CAD +X: the engine axis of a blade modelled along Z
 # Every tenth of the span: one OCC cut each (about 0.2-0.5 s); the chord turns by a tenth of
@@ -40,13 +41,16 @@ DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
 @dataclass
 class FitChoice:
     """What the user chose: the objective, the free degrees of freedom (text of --free, None
-    for all six), region weights (text of --weights-by-zone), the decision rule."""
+    for all six), region weights (text of --weights-by-zone), the decision rule; ``weights``
+    the fine ICP's weight model (--weights snr|sensor, None the default: inspection.weighting),
+    whose weights the fits start from (region weights multiply them)."""
     objective: str = DEFAULT_OBJECTIVE
     free: Optional[str] = None
     weights_by_zone: Optional[str] = None
     decision_rule: str = "iso14253"
     engine_axis: tuple = ENGINE_AXIS
     datum_faces: Optional[str] = None
+    weights: Optional[str] = None   # hook: issue 16 item 3, inspection.weighting
 
     def __post_init__(self):
         # Checked before anything is measured or written: a typo must not cost a scan.
@@ -63,6 +67,7 @@ class FitChoice:
         if self.decision_rule not in decision_mod.RULES:
             raise InputError("--decision-rule: unknown rule '%s' (use %s)"
                              % (self.decision_rule, ", ".join(decision_mod.RULES)))
+        weighting.check_choice(self.weights)
         if self.free is not None:
             fits.parse_free(self.free, _axes((0.0, 0.0, 1.0), self.engine_axis))
         if self.weights_by_zone is not None:
@@ -92,7 +97,7 @@ class FitChoice:
 
 
 def add_arguments(parser):
-    """--fit, --free, --weights-by-zone and --decision-rule on a subcommand."""
+    """--fit, --free, --weights-by-zone, --decision-rule and --weights on a subcommand."""
     parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=OBJECTIVE_NAMES,
                         help="fit objective after the robust least-squares ICP "
                              "(default least-squares: the ICP's pose)")
@@ -108,11 +113,16 @@ def add_arguments(parser):
     parser.add_argument("--decision-rule", default="iso14253", choices=decision_mod.RULES,
                         help="iso14253 (pass / not proven / fail, the default) or simple "
                              "(simple acceptance)")
+    parser.add_argument("--weights", default=None, choices=weighting.WEIGHT_MODELS,
+                        help="the fine fit's weights: snr (the paper's, SNR-linear) or sensor "
+                             "(the sensor model's 1/(sigma_beam cos incidence)^2, needs "
+                             "angle_deg); default: %s" % weighting.DEFAULT_RULE)
 
 
 def from_args(args):
     return FitChoice(objective=args.fit, free=args.free, weights_by_zone=args.weights_by_zone,
-                     decision_rule=args.decision_rule, datum_faces=args.datum_faces)
+                     decision_rule=args.decision_rule, datum_faces=args.datum_faces,
+                     weights=getattr(args, "weights", None))
 
 
 def _axes(stacking, engine):

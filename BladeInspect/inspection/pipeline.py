@@ -23,7 +23,7 @@ from ..core import transforms as tf
 from ..core.icp import MAD_TO_SIGMA
 from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
-from . import checks
+from . import checks, weighting
 from .result import RegistrationResult
 from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
 
@@ -323,11 +323,12 @@ def exact_closest_fn(nominal):
 
 
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
-                  time_limit_s=FINE_TIME_LIMIT_S):
+                  time_limit_s=FINE_TIME_LIMIT_S, weight_model=None):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
     information (and its covariance is the whole cloud's). Both runs together get
-    ``time_limit_s``; an InputError says so when it is spent."""
+    ``time_limit_s``; an InputError says so when it is spent. ``weight_model``: core.icp's
+    (inspection.weighting; None: the SNR weights)."""
     rng = np.random.default_rng(1) if rng is None else rng
     closest = exact_closest_fn(nominal)
     deadline = time.monotonic() + time_limit_s
@@ -340,7 +341,9 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         sub = _subsample(n, FINE_SUBSAMPLE, rng)
         progress(0.1, "fine registration on %d of %d points" % (len(sub), n))
         fit = icp_mod.icp(measured_xyz[sub], None if snr is None else snr[sub], closest, T,
-                          icp_mod.ICPOptions(time_limit_s=remaining()))
+                          icp_mod.ICPOptions(time_limit_s=remaining()),
+                          weight_model=None if weight_model is None   # hook: issue 16
+                          else weight_model.subset(sub))
         _check_time(fit, time_limit_s)
         T = fit.transform
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
@@ -351,7 +354,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     else:
         options = icp_mod.ICPOptions(time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
-    fit = icp_mod.icp(measured_xyz, snr, closest, T, options)
+    fit = icp_mod.icp(measured_xyz, snr, closest, T, options, weight_model=weight_model)
     _check_time(fit, time_limit_s)
     return fit
 
@@ -379,14 +382,17 @@ def _check_time(fit, time_limit_s):
 
 def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
              allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None,
-             fit_choice=None):
+             fit_choice=None, weights=None, rig_kinematics=None):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
     Refused (InputError) before any fitting when the points are too degenerate to fix a pose
     or do not match the CAD's size, and after it when they do not fit the CAD (see
     inspection.checks; ``allow_mismatch`` keeps the result with a warning instead, and
     ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
-    in those messages. ``fit_choice``: an inspection.fitting.FitChoice applied after the ICP."""
+    in those messages. ``fit_choice``: an inspection.fitting.FitChoice applied after the ICP.
+    ``weights``: the fine fit's, "snr", "sensor" or None for the default (inspection.weighting;
+    None also takes ``fit_choice.weights``); ``rig_kinematics`` turns the sensor weights'
+    beams back (default the nominal rig's)."""
     progress = progress or _no_progress
     timing = {}
     xyz = _check_points(pointset)
@@ -396,6 +402,9 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     extent_ratio = checks.check_scale(xyz, nominal, source, cad_label)
     checks.check_spread(xyz, source)
     snr = None if pointset.snr is None else np.asarray(pointset.snr, dtype=float)
+    weight_model, weights_record = weighting.weight_model_for(   # hook: issue 16 item 3
+        pointset, weights if weights is not None else getattr(fit_choice, "weights", None),
+        kinematics=rig_kinematics)
     rng = np.random.default_rng(seed)
     # A CAD face whose outside could not be decided signs its deviations by a guess: say so.
     warnings = list(nominal.face_side_warnings)
@@ -427,7 +436,8 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     try:
         fit = fine_register(xyz, snr, nominal, coarse["measured_to_cad"], rng=rng,
-                            progress=lambda f, m: progress(0.3 + 0.6 * f, m))
+                            progress=lambda f, m: progress(0.3 + 0.6 * f, m),
+                            weight_model=weight_model)
     except InputError as exc:
         raise InputError("%s: against %s: %s" % (source, cad_label, exc)) from None
     timing["fine"] = time.perf_counter() - t0
@@ -482,6 +492,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         pose_unmeasured=unmeasured, surface_fit=fit_record,
         pose_uncertainty_statistical_mm=float(statistical),
         pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights)
+    result.weights = weights_record   # hook: issue 16 item 3
     if fit_choice is not None:   # hook: inspection.fitting (issue 16)
         from . import fitting
         fitting.apply(result, nominal, fit_choice, tolerance)
@@ -553,7 +564,7 @@ def result_json(result, extra=None):
         "pose_unmeasured": list(result.pose_unmeasured),
         "surface_fit": result.surface_fit,
     }
-    for name in ("fit", "fit_sensitivity"):   # hook: inspection.fitting (issue 16)
+    for name in ("fit", "fit_sensitivity", "weights"):   # hook: inspection.fitting (issue 16)
         if getattr(result, name, None) is not None:
             doc[name] = getattr(result, name)
     if extra:

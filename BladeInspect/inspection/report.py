@@ -577,7 +577,8 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PRO
     result = pipeline.register(nominal, points, seed=seed,
                                progress=lambda f, m: progress(0.8 * f, m),
                                allow_mismatch=allow_mismatch, tolerance=tolerance,
-                               cad_source=cad_path or "the demo blade")
+                               cad_source=cad_path or "the demo blade",
+                               weights=getattr(fit_choice, "weights", None))   # issue 16
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
     return write_result_report(result, nominal, out_dir, cmm_data=cmm_data,

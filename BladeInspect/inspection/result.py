@@ -45,6 +45,7 @@ class RegistrationResult:
     icp_weights: Optional[np.ndarray] = None
     fit: Optional[dict] = None
     fit_sensitivity: Optional[dict] = None
+    weights: Optional[dict] = None   # the fine ICP's weight model (inspection.weighting)
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind

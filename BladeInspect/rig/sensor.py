@@ -2,8 +2,10 @@
 and its noise"): which readings exist, their SNR, their noise and their gross errors.
 
 One noise model serves measurement and registration: a reading's standard deviation is
-sigma(SNR) = sigma_ref * sqrt(SNR_ref / SNR), so 1/sigma^2 is proportional to SNR and the paper's
-SNR-linear ICP weights are the maximum-likelihood weights for these readings.
+sigma(SNR) = sigma_ref * sqrt(SNR_ref / SNR) along the beam, so 1/sigma^2 is proportional to SNR.
+Along the surface normal, which the fit's residual measures, that noise is sigma(SNR) cos(theta)
+at incidence theta, so the maximum-likelihood weights are 1 / (sigma(SNR) cos theta)^2
+(core.weights, `--weights sensor`), not the paper's SNR-linear ones (`--weights snr`).
 """
 
 from dataclasses import asdict, dataclass
