@@ -36,6 +36,7 @@ from ..core.errors import InputError
 from ..core.pointio import PointSet
 from ..inspection import pipeline
 from ..inspection.result import RegistrationResult
+from . import registration_fit
 
 _view_provider_hook = None
 
@@ -456,6 +457,7 @@ class Registration(_Proxy):
         _add(obj, "App::PropertyLink", "Measurement", g, "Measured points")
         _add(obj, "App::PropertyLink", "Nominal", g, "Nominal CAD (a Part feature)")
         _add(obj, "App::PropertyInteger", "Seed", g, "Random seed of the coarse stage")
+        registration_fit.add_properties(obj, _add)   # hook: the fit (issue 16)
         g = "Pose"
         _add(obj, "App::PropertyPlacement", "Pose", g, "Measured -> CAD rigid transform",
              read_only=True)
@@ -505,14 +507,18 @@ class Registration(_Proxy):
             return ""
         m = obj.Measurement
         return _signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
-                          _shape_signature(obj.Nominal.Shape), obj.Seed)
+                          _shape_signature(obj.Nominal.Shape), obj.Seed,
+                          *registration_fit.signature_part(obj))   # hook: issue 16
 
     def execute(self, obj):
         signature = self.signature(obj)
         if not signature or signature == obj.InputSignature:
             return
-        result = pipeline.register(nominal_of(obj.Nominal), pointset_of(obj.Measurement),
-                                   seed=obj.Seed)
+        nominal = nominal_of(obj.Nominal)
+        result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed)
+        from .actions import judge_fits   # hook: issue 16 (actions imports this module)
+        from .settings import value
+        judge_fits(result, nominal, registration_fit.choice_of(obj), value("ToleranceMm"))
         store_registration(obj, result)
         obj.InputSignature = signature
 
@@ -544,18 +550,22 @@ def store_registration(obj, result):
     obj.PointsCad = np.asarray(result.points_cad, dtype=float).ravel().tolist()
     obj.Deviation = np.asarray(result.deviation, dtype=float).tolist()
     obj.Inlier = np.asarray(result.inlier, dtype=int).tolist()
+    registration_fit.store(obj, result)   # hook: issue 16
 
 
 def make_registration(doc, result, measurement=None, nominal=None, seed=0,
-                      name="Registration"):
+                      name="Registration", fit_choice=None):
     """A Registration holding `result` (the pipeline's RegistrationResult). With `measurement`
-    and `nominal` linked it re-registers when they change; without, it keeps `result`."""
+    and `nominal` linked it re-registers when they change; without, it keeps `result`.
+    ``fit_choice``: the inspection.fitting.FitChoice `result` was moved by (default none)."""
     with building(doc, "Registration"):
         obj = doc.addObject("App::FeaturePython", name)
         Registration(obj)
         obj.Measurement = measurement
         obj.Nominal = nominal
         obj.Seed = int(seed)
+        if fit_choice is not None:   # hook: issue 16
+            registration_fit.set_choice(obj, fit_choice)
         store_registration(obj, result)
         obj.InputSignature = obj.Proxy.signature(obj)
         obj.purgeTouched()
