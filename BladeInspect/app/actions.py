@@ -71,6 +71,15 @@ def _object(doc, name, what):
     return obj
 
 
+def _registration(doc_name, name):
+    """(document, Registration) by name; the Registration must have its nominal linked."""
+    doc = _document(doc_name)
+    reg = _object(doc, name, "registration")
+    if reg.Nominal is None:
+        raise InputError("%s: no nominal linked" % reg.Label)
+    return doc, reg
+
+
 def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
                decision_rule="iso14253", datum_faces=None):
     """The FitChoice of the GUI's fit selector (the same checks as the command line's)."""
@@ -116,19 +125,20 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
                                      fit_choice=choice)
 
 
-def section_analysis(doc_name, registration):
-    """The section table of the Registration named ``registration`` (inspection.sections),
-    its nominal profiles added to the document."""
-    doc = _document(doc_name)
-    reg = _object(doc, registration, "registration")
-    if reg.Nominal is None:
-        raise InputError("%s: no nominal linked" % reg.Label)
-    p = _progress()
+def _registered_sections(reg, p):
+    """(Nominal, RegistrationResult, section table) of a Registration, as stored."""
     nominal = objects.nominal_of(reg.Nominal)
     p(0.2, "signed distances of the registered points")
     result = objects.registration_result(reg, nominal)
     p(0.5, "cutting sections")
-    table = section_table(result, nominal)
+    return nominal, result, section_table(result, nominal)
+
+
+def section_analysis(doc_name, registration):
+    """The section table of the Registration named ``registration`` (inspection.sections),
+    its nominal profiles added to the document."""
+    doc, reg = _registration(doc_name, registration)
+    _, _, table = _registered_sections(reg, _progress())
     objects.make_section_profiles(doc, table, reg)
     return table
 
@@ -221,19 +231,12 @@ def airfoil(doc_name, registration, characteristics=None, chord_method=None,
     Returns the stage (its ``blocks`` are result.json's ``airfoil``)."""
     from ..inspection import airfoil as airfoil_mod
     from . import airfoil_objects
-    doc = _document(doc_name)
-    reg = _object(doc, registration, "registration")
-    if reg.Nominal is None:
-        raise InputError("%s: no nominal linked" % reg.Label)
+    doc, reg = _registration(doc_name, registration)
     opts = airfoil_mod.options_from_args(engine_axis=engine_axis,
                                          characteristics=characteristics,
                                          chord_method=chord_method)
     p = _progress()
-    nominal = objects.nominal_of(reg.Nominal)
-    p(0.1, "signed distances of the registered points")
-    result = objects.registration_result(reg, nominal)
-    p(0.3, "cutting sections")
-    table = section_table(result, nominal)
+    nominal, result, table = _registered_sections(reg, lambda f, m: p(0.5 * f, m))
     p(0.5, "airfoil characteristics")
     stage = airfoil_mod.run_stage(nominal, airfoil_mod.planes_of_table(table), opts, result,
                                   table.span_axis)

@@ -105,17 +105,19 @@ class CamberLine(_SectionGeometry):
     Type = "BladeInspect::CamberLine"
 
     def add_results(self, obj):
-        add, g = objects._add, "Camber line"
-        for name, tip in (("LengthMm", "Length of the camber line, LE point to TE point, mm"),
-                          ("ChordMm", "Chord by ChordMethod, mm"),
-                          ("InletAngleDeg", "Inlet metal angle, from the engine axis, degrees"),
-                          ("OutletAngleDeg", "Outlet metal angle, from the engine axis, "
-                           "degrees"),
-                          ("MaxThicknessMm", "Largest inscribed circle's diameter, mm")):
-            add(obj, "App::PropertyFloat", name, g, tip, read_only=True)
-        add(obj, "App::PropertyVector", "LePoint", g, "Leading-edge point, mm", read_only=True)
-        add(obj, "App::PropertyVector", "TePoint", g, "Trailing-edge point, mm",
-            read_only=True)
+        ro = objects.READ_ONLY
+        objects._add_table(obj, "Camber line", (
+            ("App::PropertyFloat", "LengthMm", "Length of the camber line, LE to TE point, mm",
+             ro),
+            ("App::PropertyFloat", "ChordMm", "Chord by ChordMethod, mm", ro),
+            ("App::PropertyFloat", "InletAngleDeg",
+             "Inlet metal angle, from the engine axis, degrees", ro),
+            ("App::PropertyFloat", "OutletAngleDeg",
+             "Outlet metal angle, from the engine axis, degrees", ro),
+            ("App::PropertyFloat", "MaxThicknessMm", "Largest inscribed circle's diameter, mm",
+             ro),
+            ("App::PropertyVector", "LePoint", "Leading-edge point, mm", ro),
+            ("App::PropertyVector", "TePoint", "Trailing-edge point, mm", ro)))
 
     def store(self, obj, ch, frame):
         import Part
@@ -135,15 +137,12 @@ class EdgeCircles(_SectionGeometry):
     Type = "BladeInspect::EdgeCircles"
 
     def add_results(self, obj):
-        add, g = objects._add, "Edge circles"
-        add(obj, "App::PropertyFloat", "LeRadiusMm", g, "Leading-edge radius, mm",
-            read_only=True)
-        add(obj, "App::PropertyFloat", "TeRadiusMm", g, "Trailing-edge radius, mm",
-            read_only=True)
-        add(obj, "App::PropertyVector", "LeCenter", g, "Leading-edge circle's centre, mm",
-            read_only=True)
-        add(obj, "App::PropertyVector", "TeCenter", g, "Trailing-edge circle's centre, mm",
-            read_only=True)
+        ro = objects.READ_ONLY
+        objects._add_table(obj, "Edge circles", (
+            ("App::PropertyFloat", "LeRadiusMm", "Leading-edge radius, mm", ro),
+            ("App::PropertyFloat", "TeRadiusMm", "Trailing-edge radius, mm", ro),
+            ("App::PropertyVector", "LeCenter", "Leading-edge circle's centre, mm", ro),
+            ("App::PropertyVector", "TeCenter", "Trailing-edge circle's centre, mm", ro)))
 
     def store(self, obj, ch, frame):
         import Part
@@ -179,9 +178,7 @@ def _make(doc, cls, name, section, profile, ch, registration, nominal_obj, opts)
     obj.Label = "%s %s (%s)" % ({"CamberLine": "MCL", "EdgeCircles": "Edge circles"}[
         cls.__name__], plane.label, profile)
     cls.store(obj.Proxy, obj, ch, section.frame)
-    obj.InputSignature = obj.Proxy.signature(obj)
-    obj.purgeTouched()
-    objects._attach_view(obj)
+    objects._finish(obj)
     return obj
 
 

@@ -63,6 +63,15 @@ def _add(obj, kind, name, group, tooltip, read_only=False, hidden=False):
         obj.setEditorMode(name, modes)
 
 
+READ_ONLY, HIDDEN = "read only", "hidden"
+
+
+def _add_table(obj, group, rows):
+    """_add for each row (kind, name, tooltip[, READ_ONLY or HIDDEN]) of one group."""
+    for kind, name, tip, *mode in rows:
+        _add(obj, kind, name, group, tip, read_only=READ_ONLY in mode, hidden=HIDDEN in mode)
+
+
 def proxy_type(obj):
     """The BladeInspect type of a document object ("BladeInspect::Measurement", ...) or None."""
     proxy = getattr(obj, "Proxy", None)
@@ -272,6 +281,14 @@ def make_cad_model(doc, path, name="Nominal"):
     return obj
 
 
+def _finish(obj):
+    """An object just made from its inputs: its input signature stored, not touched (nothing
+    to recompute), its view provider given."""
+    obj.InputSignature = obj.Proxy.signature(obj)
+    obj.purgeTouched()
+    _attach_view(obj)
+
+
 def _check_recomputed(obj):
     """recompute() reports a failing execute() only through the object's state."""
     if "Invalid" in obj.State or "Error" in obj.State:
@@ -287,22 +304,21 @@ class Measurement(_Proxy):
     Type = "BladeInspect::Measurement"
 
     def add_properties(self, obj):
-        _add(obj, "App::PropertyFile", "SourceFile", "Measurement",
-             "Point file read into this measurement (empty: made in memory)")
-        _add(obj, "App::PropertyFloatList", "Coordinates", "Measurement",
-             "x, y, z of every point, flattened, mm (double precision)", hidden=True)
-        _add(obj, "App::PropertyFloatList", "SNR", "Measurement",
-             "Signal-to-noise ratio of every point, 0..100 (empty: none measured)", hidden=True)
-        _add(obj, "App::PropertyStringList", "ColumnNames", "Measurement",
-             "Extra columns carried through (each stored as Column_<name>)", read_only=True)
-        _add(obj, "App::PropertyInteger", "NPoints", "Measurement", "Usable points",
-             read_only=True)
-        _add(obj, "App::PropertyInteger", "NRowsSkipped", "Measurement",
-             "Rows of the file that were not usable", read_only=True)
-        _add(obj, "App::PropertyFloat", "MeanSNR", "Measurement", "Mean SNR of the points",
-             read_only=True)
-        _add(obj, "App::PropertyString", "LoadedSignature", "Measurement",
-             "Path, size and time of the file last read", hidden=True)
+        _add_table(obj, "Measurement", (
+            ("App::PropertyFile", "SourceFile",
+             "Point file read into this measurement (empty: made in memory)"),
+            ("App::PropertyFloatList", "Coordinates",
+             "x, y, z of every point, flattened, mm (double precision)", HIDDEN),
+            ("App::PropertyFloatList", "SNR",
+             "Signal-to-noise ratio of every point, 0..100 (empty: none measured)", HIDDEN),
+            ("App::PropertyStringList", "ColumnNames",
+             "Extra columns carried through (each stored as Column_<name>)", READ_ONLY),
+            ("App::PropertyInteger", "NPoints", "Usable points", READ_ONLY),
+            ("App::PropertyInteger", "NRowsSkipped", "Rows of the file that were not usable",
+             READ_ONLY),
+            ("App::PropertyFloat", "MeanSNR", "Mean SNR of the points", READ_ONLY),
+            ("App::PropertyString", "LoadedSignature",
+             "Path, size and time of the file last read", HIDDEN)))
 
     def execute(self, obj):
         if obj.SourceFile and os.path.exists(obj.SourceFile):
@@ -374,21 +390,18 @@ class Reconstruction(_Proxy):
     Type = "BladeInspect::Reconstruction"
 
     def add_properties(self, obj):
-        _add(obj, "App::PropertyLink", "Measurement", "Reconstruction",
-             "Measurement whose section lines are fitted")
-        _add(obj, "App::PropertyFloatList", "FitErrors", "Reconstruction",
-             "RMS fit error of each section curve, mm", read_only=True)
-        _add(obj, "App::PropertyFloat", "MaxFitErrorMm", "Reconstruction",
-             "Largest distance of a measured point from its section curve, mm", read_only=True)
-        _add(obj, "App::PropertyString", "FitErrorsJson", "Reconstruction",
-             "Fit errors per curve (section, side, rms, max) as cad.loft reports them",
-             hidden=True)
-        _add(obj, "App::PropertyInteger", "NCurves", "Reconstruction", "Section curves",
-             read_only=True)
-        _add(obj, "App::PropertyInteger", "NSurfaces", "Reconstruction", "Lofted surfaces",
-             read_only=True)
-        _add(obj, "App::PropertyString", "InputSignature", "Reconstruction",
-             "Signature of the inputs the shape was made from", hidden=True)
+        _add_table(obj, "Reconstruction", (
+            ("App::PropertyLink", "Measurement", "Measurement whose section lines are fitted"),
+            ("App::PropertyFloatList", "FitErrors", "RMS fit error of each section curve, mm",
+             READ_ONLY),
+            ("App::PropertyFloat", "MaxFitErrorMm",
+             "Largest distance of a measured point from its section curve, mm", READ_ONLY),
+            ("App::PropertyString", "FitErrorsJson",
+             "Fit errors per curve (section, side, rms, max) as cad.loft reports them", HIDDEN),
+            ("App::PropertyInteger", "NCurves", "Section curves", READ_ONLY),
+            ("App::PropertyInteger", "NSurfaces", "Lofted surfaces", READ_ONLY),
+            ("App::PropertyString", "InputSignature",
+             "Signature of the inputs the shape was made from", HIDDEN)))
 
     def signature(self, obj):
         return _signature(np.asarray(obj.Measurement.Coordinates),
@@ -429,9 +442,7 @@ def make_reconstruction(doc, measurement, reconstruction=None, name="Reconstruct
             obj.Proxy.execute(obj)
         else:
             store_reconstruction(obj, reconstruction)
-            obj.InputSignature = obj.Proxy.signature(obj)
-        obj.purgeTouched()
-        _attach_view(obj)
+        _finish(obj)
     return obj
 
 
@@ -567,9 +578,7 @@ def make_registration(doc, result, measurement=None, nominal=None, seed=0,
         if fit_choice is not None:   # hook: issue 16
             registration_fit.set_choice(obj, fit_choice)
         store_registration(obj, result)
-        obj.InputSignature = obj.Proxy.signature(obj)
-        obj.purgeTouched()
-        _attach_view(obj)
+        _finish(obj)
     return obj
 
 
