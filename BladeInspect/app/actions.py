@@ -51,7 +51,11 @@ def call_text(function, *args, **kwargs):
     if not callable(globals().get(function)):
         raise ValueError("%s has no action %r" % (MODULE, function))
     for value in list(args) + list(kwargs.values()):
-        if ast.literal_eval(repr(value)) != value:   # raises for what is no literal
+        try:
+            literal = ast.literal_eval(repr(value)) == value
+        except (SyntaxError, ValueError):
+            literal = False
+        if not literal:
             raise ValueError("%r: not a Python literal" % (value,))
     parts = [repr(a) for a in args] + ["%s=%r" % kv for kv in sorted(kwargs.items())]
     return ("import %s" % MODULE,), "%s.%s(%s)" % (MODULE, function, ", ".join(parts))
@@ -143,10 +147,10 @@ def section_analysis(doc_name, registration):
     return table
 
 
-def scan(doc_name, out_dir, rig_spec="sim", seed=0, nominal=None, **options):
-    """Scan with the rig (the GUI's connected one, else opened from ``rig_spec``; the
-    simulated rig needs the nominal named ``nominal``) into out_dir, and add the points as a
-    Measurement."""
+def scan(doc_name, out_dir, rig_spec="sim", rig_seed=0, nominal=None, **options):
+    """Scan with the rig (the GUI's connected one, else opened from ``rig_spec`` and
+    ``rig_seed``; the simulated rig needs the nominal named ``nominal``) into out_dir with the
+    scan ``options`` (measurement.scan.scan_to_dir's), and add the points as a Measurement."""
     from ..measurement.scan import open_rig, scan_to_dir
     doc = _document(doc_name)
     rig = _INTERACTIVE["rig"]
@@ -155,7 +159,7 @@ def scan(doc_name, out_dir, rig_spec="sim", seed=0, nominal=None, **options):
         model = objects.nominal_of(_object(doc, nominal, "nominal")) if nominal else None
         if rig_spec == "sim" and model is None:
             raise InputError("simulated rig: load a CAD or build the demo blade first")
-        rig = open_rig(rig_spec, model, seed, sensor=settings.sensor_model())
+        rig = open_rig(rig_spec, model, rig_seed, sensor=settings.sensor_model())
     try:
         scan_to_dir(out_dir, rig, progress=_progress(), **options)
     finally:
@@ -224,7 +228,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
 
 
 def airfoil(doc_name, registration, characteristics=None, chord_method=None,
-            engine_axis=None):
+            engine_axis=None, draws=None):
     """The airfoil characteristics (inspection.airfoil) of the Registration named
     ``registration`` at its section table's planes, and the nominal and measured mean camber
     lines and edge circles of each section as document objects (app.airfoil_objects).
@@ -235,6 +239,8 @@ def airfoil(doc_name, registration, characteristics=None, chord_method=None,
     opts = airfoil_mod.options_from_args(engine_axis=engine_axis,
                                          characteristics=characteristics,
                                          chord_method=chord_method)
+    if draws is not None:   # re-fits for the uncertainty (0: none)
+        opts.draws = int(draws)
     p = _progress()
     nominal, result, table = _registered_sections(reg, lambda f, m: p(0.5 * f, m))
     p(0.5, "airfoil characteristics")
