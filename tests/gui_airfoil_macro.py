@@ -41,7 +41,7 @@ def run():
     def _():
         blade = objects.make_demo_blade(doc)
         doc.recompute()
-        ps, _, _, _ = simulate_measurement(objects.nominal_of(blade), n_points=6000, seed=5)
+        ps, _, _, _ = simulate_measurement(objects.nominal_of(blade), n_points=20000, seed=5)
         meas = objects.make_measurement(doc, ps)
         Gui.runCommand("BladeInspect_Register")
         settle(0.3)
@@ -109,6 +109,28 @@ def run():
         view.viewTop()
         view.fitAll()
         view_shot("airfoil_view_camber_edges_top", fit=False)
+        # One section close up, along its normal: the camber lines end at the edge circles.
+        label = blocks[len(blocks) // 2]["label"]
+        for obj in group.Group:
+            obj.ViewObject.Visibility = obj.SectionLabel == label
+        section = [o for o in group.Group if o.SectionLabel == label]
+        Gui.Selection.clearSelection()
+        for obj in section:
+            Gui.Selection.addSelection(obj)
+        view.viewTop()
+        Gui.SendMsgToActiveView("ViewSelection")
+        Gui.Selection.clearSelection()
+        view_shot("airfoil_view_section_close_up", fit=False)
+        circles = [o for o in section if objects.proxy_type(o) == airfoil_objects.EdgeCircles.Type]
+        Gui.Selection.addSelection(circles[0])
+        for edge in ("Edge1",):
+            Gui.Selection.clearSelection()
+            Gui.Selection.addSelection(doc.Name, circles[0].Name, edge)
+        Gui.SendMsgToActiveView("ViewSelection")
+        Gui.Selection.clearSelection()
+        view_shot("airfoil_view_leading_edge_circle", fit=False)
+        for obj in group.Group:
+            obj.ViewObject.Visibility = True
         state["group"] = group
 
     @step("camber lines and edge circles survive save and reopen")

@@ -444,3 +444,12 @@ class AirfoilPanel(_ResultPanel):
         label = QtGui.QLabel("\n".join(line for line in lines if line))
         label.setWordWrap(True)
         layout.addWidget(label)
+        # What the stage says it could not do well (sparse edges, non-circular ends): a
+        # number shown without its caveat would be trusted where it should not be.
+        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"], note)
+                 for block in analysis.get("airfoil", []) for note in block.get("notes", [])]
+        if notes:
+            self.notes = QtGui.QTextBrowser()
+            self.notes.setPlainText("\n".join(notes))
+            self.notes.setMaximumHeight(140)
+            layout.addWidget(self.notes)
