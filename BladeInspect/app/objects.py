@@ -527,9 +527,7 @@ class Registration(_Proxy):
             return
         nominal = nominal_of(obj.Nominal)
         result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed)
-        from .actions import judge_fits   # hook: issue 16 (actions imports this module)
-        from .settings import value
-        judge_fits(result, nominal, registration_fit.choice_of(obj), value("ToleranceMm"))
+        registration_fit.refit(obj, result, nominal)   # hook: issue 16
         store_registration(obj, result)
         obj.InputSignature = signature
 

@@ -59,6 +59,19 @@ def signature_part(obj):
     return (choice.objective, choice.free, choice.weights_by_zone, choice.decision_rule)
 
 
+def refit(obj, result, nominal):
+    """After a recompute registered again: move ``result`` to the object's fit with its
+    sensitivity table, as the Register command did. The default choice is the ICP's pose
+    itself; then the recompute stays what it was before fits existed (the table, which
+    needs a section cut and every objective's fit, is dropped rather than left stale)."""
+    choice = choice_of(obj)
+    if choice == fitting.FitChoice():
+        return
+    from . import settings
+    from .actions import judge_fits   # actions imports app.objects, which imports this
+    judge_fits(result, nominal, choice, settings.value("ToleranceMm"))
+
+
 def store(obj, result):
     obj.FitJson = json.dumps(result.fit, default=json_default) if result.fit else ""
     obj.FitSensitivityJson = (json.dumps(result.fit_sensitivity, default=json_default)
