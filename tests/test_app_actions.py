@@ -112,6 +112,16 @@ class ActionLines(unittest.TestCase):
         self.assertTrue(profiles)
         self.assertIn("ReadOnly", profiles[-1].getEditorMode("Sections"))
 
+    def test_scan_line_opens_the_rig_it_names_and_adds_the_points(self):
+        out_dir = os.path.join(self.tmp, "scan")
+        line = actions.call_text("scan", self.doc.Name, out_dir, rig_spec="sim", rig_seed=3,
+                                 nominal=self.blade.Name, n_sections=2, point_spacing=1.0)
+        measurement = replay(*line)
+        rows = np.loadtxt(os.path.join(out_dir, "points.csv"), delimiter=",", skiprows=1,
+                          usecols=(0, 1, 2), ndmin=2)
+        np.testing.assert_array_equal(objects.pointset_of(measurement).xyz, rows)
+        self.assertEqual(measurement.SourceFile, os.path.join(out_dir, "points.csv"))
+
     def test_airfoil_line_objects_lie_in_their_planes_and_survive_reopening(self):
         stage = replay(*actions.call_text("airfoil", self.doc.Name, self.registration.Name,
                                           draws=0))

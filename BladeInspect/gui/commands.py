@@ -367,8 +367,7 @@ class Register(_Command):
 
     @staticmethod
     def show(obj):
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(taskpanels.RegistrationPanel(obj))
+        taskpanels.show_panel(taskpanels.RegistrationPanel(obj))
 
 
 class DeviationMap(_Command):
@@ -435,8 +434,7 @@ class SectionAnalysis(_Command):
     @staticmethod
     def show(table):
         header, rows = section_rows(table)
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(taskpanels.TablePanel(
+        taskpanels.show_panel(taskpanels.TablePanel(
             translate("BladeInspect", "Section analysis"), header, rows,
             "; ".join(table.warnings)))
 
@@ -521,8 +519,7 @@ class Airfoil(_Command):
 
     @staticmethod
     def show(analysis):
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(taskpanels.AirfoilPanel(analysis))
+        taskpanels.show_panel(taskpanels.AirfoilPanel(analysis))
 
 
 class Preferences(_Command):

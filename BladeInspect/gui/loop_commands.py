@@ -81,8 +81,7 @@ def _hide_measured_frame(measurement):
 def _show_table(title, table, note, sensitivity=None):
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
-    FreeCADGui.Control.closeDialog()
-    FreeCADGui.Control.showDialog(taskpanels.TablePanel(
+    taskpanels.show_panel(taskpanels.TablePanel(
         title, header, rows, "; ".join(n for n in notes if n), sensitivity))
 
 

@@ -17,6 +17,13 @@ from ..inspection.result import rival_lines
 from .i18n import QT_TRANSLATE_NOOP, translate
 
 
+def show_panel(panel):
+    """Show ``panel`` in the task view in place of whatever panel is open."""
+    FreeCADGui.Control.closeDialog()
+    FreeCADGui.Control.showDialog(panel)
+    return panel
+
+
 def spin_box(value, minimum, maximum, decimals=3, suffix=""):
     if isinstance(value, int) and not isinstance(value, bool):
         box = QtGui.QSpinBox()

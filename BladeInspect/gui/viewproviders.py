@@ -6,7 +6,7 @@ import FreeCADGui
 
 from ..app import airfoil_objects, objects
 from . import legend, resources
-from .taskpanels import AirfoilPanel, RegistrationPanel
+from .taskpanels import AirfoilPanel, RegistrationPanel, show_panel
 
 
 class ViewProvider:
@@ -123,8 +123,7 @@ class ViewProviderAirfoilGeometry(ViewProvider):
         groups = [o for o in vobj.Object.InList if "AirfoilJson" in o.PropertiesList]
         if not groups:
             return False
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(AirfoilPanel(airfoil_objects.analysis_of(groups[0])))
+        show_panel(AirfoilPanel(airfoil_objects.analysis_of(groups[0])))
         return True
 
 
