@@ -121,14 +121,6 @@ def run():
         Gui.SendMsgToActiveView("ViewSelection")
         Gui.Selection.clearSelection()
         view_shot("airfoil_view_section_close_up", fit=False)
-        circles = [o for o in section if objects.proxy_type(o) == airfoil_objects.EdgeCircles.Type]
-        Gui.Selection.addSelection(circles[0])
-        for edge in ("Edge1",):
-            Gui.Selection.clearSelection()
-            Gui.Selection.addSelection(doc.Name, circles[0].Name, edge)
-        Gui.SendMsgToActiveView("ViewSelection")
-        Gui.Selection.clearSelection()
-        view_shot("airfoil_view_leading_edge_circle", fit=False)
         for obj in group.Group:
             obj.ViewObject.Visibility = True
         state["group"] = group
