@@ -1,11 +1,14 @@
 # FreeCAD runs this file (executed, not imported: no __file__) when the GUI starts.
 # Registration only: the commands are imported when the workbench is first activated.
+import FreeCAD
 import FreeCADGui
 
 
 class BladeInspectWorkbench(FreeCADGui.Workbench):
-    MenuText = "BladeInspect"
-    ToolTip = "Register optical scans of turbine blades to their CAD and map the deviations"
+    MenuText = FreeCAD.Qt.translate("Workbench", "BladeInspect")
+    ToolTip = FreeCAD.Qt.translate(
+        "Workbench", "Register optical scans of turbine blades to their CAD and map the "
+        "deviations")
 
     def __init__(self):
         # The module folder is found through the package, since this file has no __file__.

@@ -130,6 +130,13 @@ def run():
         check("cancelled registration leaves no object",
               not objects.find_objects(doc, "BladeInspect::Registration"))
         Gui.runCommand("BladeInspect_Register")
+        settle(0.3)
+        from BladeInspect.gui import taskpanels
+        register_panel = active_panel(taskpanels.RegisterPanel)
+        check("register opens its panel with the fit selector", register_panel is not None
+              and register_panel.fit.objective.currentText() == "least-squares")
+        window_shot("task_panel_register")
+        register_panel.accept()
         regs = objects.find_objects(doc, "BladeInspect::Registration")
         check("registration made", len(regs) == 1, progress.MESSAGES[-1:])
         reg = regs[0]

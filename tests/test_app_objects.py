@@ -18,7 +18,8 @@ from BladeInspect.core.errors import InputError
 from tests.helpers import REPO
 
 COMMAND_VERBS = ("DemoBlade", "LoadCad", "ConnectRig", "Scan", "ImportPoints", "Reconstruct",
-                 "Register", "DeviationMap", "SectionAnalysis", "Report", "Preferences")
+                 "Register", "DeviationMap", "SectionAnalysis", "Airfoil", "Report", "Preferences",
+                 "CamberLine", "EdgeCircles")
 
 
 class FakePointSet:

@@ -36,6 +36,7 @@ from ..core.errors import InputError
 from ..core.pointio import PointSet
 from ..inspection import pipeline
 from ..inspection.result import RegistrationResult
+from . import registration_fit
 
 _view_provider_hook = None
 
@@ -60,6 +61,15 @@ def _add(obj, kind, name, group, tooltip, read_only=False, hidden=False):
     modes = (["ReadOnly"] if read_only else []) + (["Hidden"] if hidden else [])
     if modes:
         obj.setEditorMode(name, modes)
+
+
+READ_ONLY, HIDDEN = "read only", "hidden"
+
+
+def _add_table(obj, group, rows):
+    """_add for each row (kind, name, tooltip[, READ_ONLY or HIDDEN]) of one group."""
+    for kind, name, tip, *mode in rows:
+        _add(obj, kind, name, group, tip, read_only=READ_ONLY in mode, hidden=HIDDEN in mode)
 
 
 def proxy_type(obj):
@@ -271,6 +281,14 @@ def make_cad_model(doc, path, name="Nominal"):
     return obj
 
 
+def _finish(obj):
+    """An object just made from its inputs: its input signature stored, not touched (nothing
+    to recompute), its view provider given."""
+    obj.InputSignature = obj.Proxy.signature(obj)
+    obj.purgeTouched()
+    _attach_view(obj)
+
+
 def _check_recomputed(obj):
     """recompute() reports a failing execute() only through the object's state."""
     if "Invalid" in obj.State or "Error" in obj.State:
@@ -286,22 +304,21 @@ class Measurement(_Proxy):
     Type = "BladeInspect::Measurement"
 
     def add_properties(self, obj):
-        _add(obj, "App::PropertyFile", "SourceFile", "Measurement",
-             "Point file read into this measurement (empty: made in memory)")
-        _add(obj, "App::PropertyFloatList", "Coordinates", "Measurement",
-             "x, y, z of every point, flattened, mm (double precision)", hidden=True)
-        _add(obj, "App::PropertyFloatList", "SNR", "Measurement",
-             "Signal-to-noise ratio of every point, 0..100 (empty: none measured)", hidden=True)
-        _add(obj, "App::PropertyStringList", "ColumnNames", "Measurement",
-             "Extra columns carried through (each stored as Column_<name>)", read_only=True)
-        _add(obj, "App::PropertyInteger", "NPoints", "Measurement", "Usable points",
-             read_only=True)
-        _add(obj, "App::PropertyInteger", "NRowsSkipped", "Measurement",
-             "Rows of the file that were not usable", read_only=True)
-        _add(obj, "App::PropertyFloat", "MeanSNR", "Measurement", "Mean SNR of the points",
-             read_only=True)
-        _add(obj, "App::PropertyString", "LoadedSignature", "Measurement",
-             "Path, size and time of the file last read", hidden=True)
+        _add_table(obj, "Measurement", (
+            ("App::PropertyFile", "SourceFile",
+             "Point file read into this measurement (empty: made in memory)"),
+            ("App::PropertyFloatList", "Coordinates",
+             "x, y, z of every point, flattened, mm (double precision)", HIDDEN),
+            ("App::PropertyFloatList", "SNR",
+             "Signal-to-noise ratio of every point, 0..100 (empty: none measured)", HIDDEN),
+            ("App::PropertyStringList", "ColumnNames",
+             "Extra columns carried through (each stored as Column_<name>)", READ_ONLY),
+            ("App::PropertyInteger", "NPoints", "Usable points", READ_ONLY),
+            ("App::PropertyInteger", "NRowsSkipped", "Rows of the file that were not usable",
+             READ_ONLY),
+            ("App::PropertyFloat", "MeanSNR", "Mean SNR of the points", READ_ONLY),
+            ("App::PropertyString", "LoadedSignature",
+             "Path, size and time of the file last read", HIDDEN)))
 
     def execute(self, obj):
         if obj.SourceFile and os.path.exists(obj.SourceFile):
@@ -373,21 +390,18 @@ class Reconstruction(_Proxy):
     Type = "BladeInspect::Reconstruction"
 
     def add_properties(self, obj):
-        _add(obj, "App::PropertyLink", "Measurement", "Reconstruction",
-             "Measurement whose section lines are fitted")
-        _add(obj, "App::PropertyFloatList", "FitErrors", "Reconstruction",
-             "RMS fit error of each section curve, mm", read_only=True)
-        _add(obj, "App::PropertyFloat", "MaxFitErrorMm", "Reconstruction",
-             "Largest distance of a measured point from its section curve, mm", read_only=True)
-        _add(obj, "App::PropertyString", "FitErrorsJson", "Reconstruction",
-             "Fit errors per curve (section, side, rms, max) as cad.loft reports them",
-             hidden=True)
-        _add(obj, "App::PropertyInteger", "NCurves", "Reconstruction", "Section curves",
-             read_only=True)
-        _add(obj, "App::PropertyInteger", "NSurfaces", "Reconstruction", "Lofted surfaces",
-             read_only=True)
-        _add(obj, "App::PropertyString", "InputSignature", "Reconstruction",
-             "Signature of the inputs the shape was made from", hidden=True)
+        _add_table(obj, "Reconstruction", (
+            ("App::PropertyLink", "Measurement", "Measurement whose section lines are fitted"),
+            ("App::PropertyFloatList", "FitErrors", "RMS fit error of each section curve, mm",
+             READ_ONLY),
+            ("App::PropertyFloat", "MaxFitErrorMm",
+             "Largest distance of a measured point from its section curve, mm", READ_ONLY),
+            ("App::PropertyString", "FitErrorsJson",
+             "Fit errors per curve (section, side, rms, max) as cad.loft reports them", HIDDEN),
+            ("App::PropertyInteger", "NCurves", "Section curves", READ_ONLY),
+            ("App::PropertyInteger", "NSurfaces", "Lofted surfaces", READ_ONLY),
+            ("App::PropertyString", "InputSignature",
+             "Signature of the inputs the shape was made from", HIDDEN)))
 
     def signature(self, obj):
         return _signature(np.asarray(obj.Measurement.Coordinates),
@@ -428,9 +442,7 @@ def make_reconstruction(doc, measurement, reconstruction=None, name="Reconstruct
             obj.Proxy.execute(obj)
         else:
             store_reconstruction(obj, reconstruction)
-            obj.InputSignature = obj.Proxy.signature(obj)
-        obj.purgeTouched()
-        _attach_view(obj)
+        _finish(obj)
     return obj
 
 
@@ -456,6 +468,7 @@ class Registration(_Proxy):
         _add(obj, "App::PropertyLink", "Measurement", g, "Measured points")
         _add(obj, "App::PropertyLink", "Nominal", g, "Nominal CAD (a Part feature)")
         _add(obj, "App::PropertyInteger", "Seed", g, "Random seed of the coarse stage")
+        registration_fit.add_properties(obj, _add)   # hook: the fit (issue 16)
         g = "Pose"
         _add(obj, "App::PropertyPlacement", "Pose", g, "Measured -> CAD rigid transform",
              read_only=True)
@@ -505,14 +518,16 @@ class Registration(_Proxy):
             return ""
         m = obj.Measurement
         return _signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
-                          _shape_signature(obj.Nominal.Shape), obj.Seed)
+                          _shape_signature(obj.Nominal.Shape), obj.Seed,
+                          *registration_fit.signature_part(obj))   # hook: issue 16
 
     def execute(self, obj):
         signature = self.signature(obj)
         if not signature or signature == obj.InputSignature:
             return
-        result = pipeline.register(nominal_of(obj.Nominal), pointset_of(obj.Measurement),
-                                   seed=obj.Seed)
+        nominal = nominal_of(obj.Nominal)
+        result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed)
+        registration_fit.refit(obj, result, nominal)   # hook: issue 16
         store_registration(obj, result)
         obj.InputSignature = signature
 
@@ -544,22 +559,24 @@ def store_registration(obj, result):
     obj.PointsCad = np.asarray(result.points_cad, dtype=float).ravel().tolist()
     obj.Deviation = np.asarray(result.deviation, dtype=float).tolist()
     obj.Inlier = np.asarray(result.inlier, dtype=int).tolist()
+    registration_fit.store(obj, result)   # hook: issue 16
 
 
 def make_registration(doc, result, measurement=None, nominal=None, seed=0,
-                      name="Registration"):
+                      name="Registration", fit_choice=None):
     """A Registration holding `result` (the pipeline's RegistrationResult). With `measurement`
-    and `nominal` linked it re-registers when they change; without, it keeps `result`."""
+    and `nominal` linked it re-registers when they change; without, it keeps `result`.
+    ``fit_choice``: the inspection.fitting.FitChoice `result` was moved by (default none)."""
     with building(doc, "Registration"):
         obj = doc.addObject("App::FeaturePython", name)
         Registration(obj)
         obj.Measurement = measurement
         obj.Nominal = nominal
         obj.Seed = int(seed)
+        if fit_choice is not None:   # hook: issue 16
+            registration_fit.set_choice(obj, fit_choice)
         store_registration(obj, result)
-        obj.InputSignature = obj.Proxy.signature(obj)
-        obj.purgeTouched()
-        _attach_view(obj)
+        _finish(obj)
     return obj
 
 

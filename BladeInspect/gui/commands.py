@@ -1,7 +1,9 @@
 """The workbench's commands (BladeInspect_<Verb>). Each gathers its inputs from the document
 and the selection, runs a pipeline stage with progress and cancel (gui.progress.run), and
 stores the outcome as document objects through the app layer's make_* functions, which remove
-what they made if anything fails."""
+what they made if anything fails. What makes objects runs as a console line through
+FreeCADGui.doCommand (do_command, run_action): an app.objects or app.actions call with literal
+arguments, which a recorded macro replays."""
 import os
 import tempfile
 
@@ -9,29 +11,29 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
-from ..app import objects, settings
+from ..app import actions, objects, registration_fit, settings
 from ..app.document import write_inspection_document
 from ..cad.loft import reconstruct
 from ..core.errors import InputError
-from ..inspection.pipeline import load_points, register
 from ..inspection.report import section_rows, write_result_report
-from ..inspection.sections import section_table
-from ..measurement.scan import open_rig, scan_to_dir
+from ..measurement.scan import open_rig
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
+from .i18n import QT_TRANSLATE_NOOP, translate
 from .preferences import PreferencesPage
 from .session import RIG
 
-# Marks the command texts for translation (FreeCAD translates them in the command's context).
-QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
-
-POINT_FILTER = "Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)"
-CAD_FILTER = "CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)"
+POINT_FILTER = QT_TRANSLATE_NOOP(
+    "BladeInspect", "Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)")
+CAD_FILTER = QT_TRANSLATE_NOOP(
+    "BladeInspect",
+    "CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)")
 
 
 # ---------------------------------------------------------------- file dialogs (tests replace)
 
 def ask_open_file(title, filters):
-    path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), title, "", filters)
+    path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), title, "",
+                                                translate("BladeInspect", filters))
     return path or None
 
 
@@ -109,6 +111,19 @@ def object_text(obj):
 APP_OBJECTS = "from BladeInspect.app import objects"
 
 
+def run_action(title, function, *args, on_plan=None, rig=None, **kwargs):
+    """app.actions.<function>(*args, **kwargs) as a console line (do_command) under
+    progress.run(title): the status-bar progress, the plan drawing ``on_plan`` and the
+    connected ``rig`` reach it through actions.interactive. Returns its value, or None when it
+    failed or was cancelled (reported)."""
+    imports, call = actions.call_text(function, *args, **kwargs)
+
+    def job(p):
+        with actions.interactive(progress=p, on_plan=on_plan, rig=rig):
+            return do_command(imports, call)
+    return progress.run(title, job)
+
+
 def fit_view():
     if FreeCADGui.ActiveDocument is not None:
         view = FreeCADGui.ActiveDocument.ActiveView
@@ -128,6 +143,7 @@ class _Command:
     name = ""
     menu = ""
     tip = ""
+    panel = None       # a task panel class: Activated shows panel(self.start)
 
     def GetResources(self):
         return {"Pixmap": resources.icon_path(self.name), "MenuText": self.menu,
@@ -139,6 +155,20 @@ class _Command:
     def ready(self):
         return True
 
+    def Activated(self):
+        FreeCADGui.Control.showDialog(self.panel(self.start))
+
+
+class _OpenFileCommand(_Command):
+    """A command that reads one file the user picks and makes an object of it (self.load)."""
+    dialog_title = ""
+    file_filter = ""
+
+    def Activated(self):
+        path = ask_open_file(translate("BladeInspect", self.dialog_title), self.file_filter)
+        if path:
+            self.load(path)
+
 
 class DemoBlade(_Command):
     name = "BladeInspect_DemoBlade"
@@ -147,12 +177,14 @@ class DemoBlade(_Command):
         "BladeInspect_DemoBlade",
         "Build the parametric demo blade as the nominal CAD (parameters in a task panel)")
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(taskpanels.DemoBladePanel(self.build))
+    panel = taskpanels.DemoBladePanel
+
+    def start(self, params):
+        return self.build(params)
 
     def build(self, params):
         doc = active_document()
-        obj = progress.run("Demo blade", lambda p: do_command(
+        obj = progress.run(translate("BladeInspect", "Demo blade"), lambda p: do_command(
             (APP_OBJECTS, "from BladeInspect.cad.demo_blade import BladeParams"),
             "objects.make_demo_blade(%s, %r)" % (document_text(doc), params)))
         if obj is not None:
@@ -160,32 +192,22 @@ class DemoBlade(_Command):
         return obj
 
 
-class LoadCad(_Command):
+class LoadCad(_OpenFileCommand):
     name = "BladeInspect_LoadCad"
     menu = QT_TRANSLATE_NOOP("BladeInspect_LoadCad", "Load CAD...")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_LoadCad",
         "Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)")
-
-    def Activated(self):
-        path = ask_open_file("Nominal CAD", CAD_FILTER)
-        if path:
-            self.load(path)
+    dialog_title = QT_TRANSLATE_NOOP("BladeInspect", "Nominal CAD")
+    file_filter = CAD_FILTER
 
     def load(self, path):
         doc = active_document()
-        obj = progress.run("Load CAD", lambda p: do_command(
+        obj = progress.run(translate("BladeInspect", "Load CAD"), lambda p: do_command(
             (APP_OBJECTS,), "objects.make_cad_model(%s, %r)" % (document_text(doc), path)))
         if obj is not None:
             _recompute_gui(doc)
         return obj
-
-
-def simulated_rig(nominal, seed, kinematics=None):
-    """The simulated rig of ``nominal`` (a Nominal) with the sensor the preferences describe,
-    as ConnectRig opens it; ``kinematics``: its true geometry (default nominal)."""
-    from ..measurement.scan import open_rig
-    return open_rig("sim", nominal, seed, kinematics=kinematics, sensor=settings.sensor_model())
 
 
 class ConnectRig(_Command):
@@ -195,21 +217,26 @@ class ConnectRig(_Command):
         "BladeInspect_ConnectRig",
         "Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port")
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(taskpanels.ConnectRigPanel(self.connect))
+    panel = taskpanels.ConnectRigPanel
+
+    def start(self, spec, seed):
+        return self.connect(spec, seed)
 
     def connect(self, spec, seed):
         def job(p):
             nominal_obj = find_nominal()
             if spec == "sim" and nominal_obj is None:
-                raise InputError("simulated rig: load a CAD or build the demo blade first")
+                raise InputError(translate(
+                    "BladeInspect", "simulated rig: load a CAD or build the demo blade first"))
             nominal = objects.nominal_of(nominal_obj) if nominal_obj is not None else None
-            p(0.5, "opening %s" % spec)
-            RIG.connect(open_rig(spec, nominal, seed, sensor=settings.sensor_model()), spec)
+            p(0.5, translate("BladeInspect", "opening %s") % spec)
+            RIG.connect(open_rig(spec, nominal, seed, sensor=settings.sensor_model()), spec,
+                        seed)
             return RIG.rig
-        rig = progress.run("Connect rig", job)
+        rig = progress.run(translate("BladeInspect", "Connect rig"), job)
         if rig is not None:
-            FreeCAD.Console.PrintMessage("BladeInspect: rig connected (%s)\n" % spec)
+            FreeCAD.Console.PrintMessage(
+                translate("BladeInspect", "BladeInspect: rig connected (%s)") % spec + "\n")
         return rig
 
 
@@ -223,19 +250,20 @@ class Scan(_Command):
     def ready(self):
         return RIG.connected
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(taskpanels.ScanPanel(self.scan))
+    panel = taskpanels.ScanPanel
+
+    def start(self, options):
+        return self.scan(options)
 
     def scan(self, options):
+        """app.actions.scan with the connected rig; the line names the rig's spec and seed
+        so that a replayed macro opens the same one."""
         doc = active_document()
-        out_dir = scan_folder(doc)
-
-        def job(p):
-            scan_to_dir(out_dir, RIG.rig, progress=p, **options)
-            path = os.path.join(out_dir, "points.csv")
-            pointset = load_points(path)
-            return objects.make_measurement(doc, pointset, name="Scan", source_file=path)
-        obj = progress.run("Scan", job)
+        nominal_obj = find_nominal()
+        obj = run_action(translate("BladeInspect", "Scan"), "scan", doc.Name, scan_folder(doc),
+                         rig_spec=RIG.spec, rig_seed=RIG.seed, rig=RIG.rig,
+                         nominal=nominal_obj.Name if nominal_obj is not None else None,
+                         **options)
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -250,30 +278,27 @@ def scan_folder(doc):
     return tempfile.mkdtemp(prefix="bladeinspect-scan-")
 
 
-class ImportPoints(_Command):
+class ImportPoints(_OpenFileCommand):
     name = "BladeInspect_ImportPoints"
     menu = QT_TRANSLATE_NOOP("BladeInspect_ImportPoints", "Import points...")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_ImportPoints",
         "Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)")
-
-    def Activated(self):
-        path = ask_open_file("Measured points", POINT_FILTER)
-        if path:
-            self.load(path)
+    dialog_title = QT_TRANSLATE_NOOP("BladeInspect", "Measured points")
+    file_filter = POINT_FILTER
 
     def load(self, path):
         doc = active_document()
 
         def job(p):
-            p(0.1, "reading %s" % os.path.basename(path))
+            p(0.1, translate("BladeInspect", "reading %s") % os.path.basename(path))
             obj = do_command(
                 (APP_OBJECTS, "from BladeInspect.inspection.pipeline import load_points"),
                 "objects.make_measurement(%s, load_points(%r), name='Measurement', "
                 "source_file=%r)" % (document_text(doc), path, path))
             obj.Label = os.path.splitext(os.path.basename(path))[0]
             return obj
-        obj = progress.run("Import points", job)
+        obj = progress.run(translate("BladeInspect", "Import points"), job)
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -296,11 +321,12 @@ class Reconstruct(_Command):
         doc = measurement.Document
 
         def job(p):
-            p(0.1, "fitting section curves")
+            p(0.1, translate("BladeInspect", "fitting section curves"))
             recon = reconstruct(objects.pointset_of(measurement))
-            p(0.9, "storing %d curves, %d surfaces" % (len(recon.curves), len(recon.surfaces)))
+            p(0.9, translate("BladeInspect", "storing %d curves, %d surfaces")
+              % (len(recon.curves), len(recon.surfaces)))
             return objects.make_reconstruction(doc, measurement, recon)
-        obj = progress.run("Reconstruct", job)
+        obj = progress.run(translate("BladeInspect", "Reconstruct"), job)
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -312,27 +338,27 @@ class Register(_Command):
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_Register",
         "Register the measurement to the nominal with no starting pose (PCA, then SNR-"
-        "weighted ICP) and show the pose with its uncertainty")
+        "weighted ICP), move it to the chosen fit and show the pose with its uncertainty and "
+        "the fit-sensitivity table")
+    panel = taskpanels.RegisterPanel
 
     def ready(self):
         return find_input((objects.Measurement.Type,)) is not None and find_nominal() is not None
 
-    def Activated(self):
-        obj = self.register(find_input((objects.Measurement.Type,)), find_nominal())
+    def start(self, seed, **fit):
+        obj = self.register(find_input((objects.Measurement.Type,)), find_nominal(), seed,
+                            **fit)
         if obj is not None:
             self.show(obj)
+        return obj
 
-    def register(self, measurement, nominal_obj, seed=None):
+    def register(self, measurement, nominal_obj, seed=None, **fit):
+        """app.actions.register; ``fit``: the fit selector's choice (app.actions.fit_choice)."""
         doc = measurement.Document
         seed = settings.value("Seed") if seed is None else seed
-
-        def job(p):
-            p(0.0, "sampling the nominal")
-            nominal = objects.nominal_of(nominal_obj)
-            result = register(nominal, objects.pointset_of(measurement), seed=seed, progress=p)
-            result.cad_source = nominal_obj.Label
-            return objects.make_registration(doc, result, measurement, nominal_obj, seed)
-        obj = progress.run("Register", job)
+        obj = run_action(translate("BladeInspect", "Register"), "register", doc.Name,
+                         measurement.Name, nominal_obj.Name, int(seed),
+                         tolerance=float(settings.value("ToleranceMm")), **fit)
         if obj is not None:
             doc.recompute()
             for warning in obj.Warnings:
@@ -341,8 +367,7 @@ class Register(_Command):
 
     @staticmethod
     def show(obj):
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(taskpanels.RegistrationPanel(obj))
+        taskpanels.show_panel(taskpanels.RegistrationPanel(obj))
 
 
 class DeviationMap(_Command):
@@ -361,7 +386,7 @@ class DeviationMap(_Command):
     def make(self, registration, limit=None):
         doc = registration.Document
         limit = settings.colour_limit() if limit is None else limit
-        obj = progress.run("Deviation map", lambda p: do_command(
+        obj = progress.run(translate("BladeInspect", "Deviation map"), lambda p: do_command(
             (APP_OBJECTS,), "objects.make_deviation_map(%s, %s, %r)"
             % (document_text(doc), object_text(registration), float(limit))))
         if obj is not None:
@@ -395,21 +420,11 @@ class SectionAnalysis(_Command):
             self.show(table)
 
     def analyse(self, registration):
-        """The section table of a registration (inspection.sections), its nominal profiles added
-        to the document; None when it failed (reported)."""
+        """The section table of a registration (app.actions.section_analysis), its nominal
+        profiles added to the document; None when it failed (reported)."""
         doc = registration.Document
-
-        def job(p):
-            if registration.Nominal is None:
-                raise InputError("%s: no nominal linked" % registration.Label)
-            nominal = objects.nominal_of(registration.Nominal)
-            p(0.2, "signed distances of the registered points")
-            result = objects.registration_result(registration, nominal)
-            p(0.5, "cutting sections")
-            table = section_table(result, nominal)
-            objects.make_section_profiles(doc, table, registration)
-            return table
-        table = progress.run("Section analysis", job)
+        table = run_action(translate("BladeInspect", "Section analysis"), "section_analysis",
+                           doc.Name, registration.Name)
         if table is not None:
             doc.recompute()
             for warning in table.warnings:
@@ -419,22 +434,24 @@ class SectionAnalysis(_Command):
     @staticmethod
     def show(table):
         header, rows = section_rows(table)
-        FreeCADGui.Control.closeDialog()
-        FreeCADGui.Control.showDialog(taskpanels.TablePanel(
-            "Section analysis", header, rows, "; ".join(table.warnings)))
+        taskpanels.show_panel(taskpanels.TablePanel(
+            translate("BladeInspect", "Section analysis"), header, rows,
+            "; ".join(table.warnings)))
 
 
 class Report(_Command):
     name = "BladeInspect_Report"
-    menu = "Report..."
-    tip = "Write the inspection report (HTML and PDF, result.json, deviations.csv) to a folder"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Report", "Report...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Report",
+        "Write the inspection report (HTML and PDF, result.json, deviations.csv) to a folder")
 
     def ready(self):
         reg = find_input((objects.Registration.Type,))
         return reg is not None and reg.Measurement is not None and reg.Nominal is not None
 
     def Activated(self):
-        out_dir = ask_directory("Report folder")
+        out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
             summary = self.report(find_input((objects.Registration.Type,)), out_dir)
             html = os.path.join(out_dir, "report.html")
@@ -459,14 +476,50 @@ class Report(_Command):
             result.cad_source = cad_path or "built-in demo blade"
             return write_result_report(result, nominal, out_dir,
                                        tolerance=settings.value("ToleranceMm"), progress=p,
-                                       document=writer, cad_path=cad_path)
+                                       document=writer, cad_path=cad_path,
+                                       fit_choice=registration_fit.choice_of(registration))
         doc = registration.Document
         try:
-            return progress.run("Report", job)
+            return progress.run(translate("BladeInspect", "Report"), job)
         finally:
             # The report saves its own document, which leaves another one active.
             FreeCAD.setActiveDocument(doc.Name)
             FreeCADGui.setActiveDocument(doc.Name)
+
+
+class Airfoil(_Command):
+    name = "BladeInspect_Airfoil"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Airfoil", "Airfoil analysis...")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Airfoil",
+        "Airfoil characteristics per section (chord, stagger, thickness, edge radii, angles, "
+        "shift, twist) nominal and measured, judged against a characteristics file; the mean "
+        "camber lines and edge circles added to the document")
+    panel = taskpanels.AirfoilOptionsPanel
+
+    def ready(self):
+        reg = find_input((objects.Registration.Type,))
+        return reg is not None and reg.Nominal is not None
+
+    def start(self, **options):
+        stage = self.analyse(find_input((objects.Registration.Type,)), **options)
+        if stage is not None:
+            self.show(stage.extras())
+        return stage
+
+    def analyse(self, registration, **options):
+        """app.actions.airfoil; ``options``: characteristics, chord_method, engine_axis (the
+        `airfoil` command's --characteristics, --chord-method, --engine-axis)."""
+        doc = registration.Document
+        stage = run_action(translate("BladeInspect", "Airfoil analysis"), "airfoil", doc.Name,
+                           registration.Name, **options)
+        if stage is not None:
+            _recompute_gui(doc)
+        return stage
+
+    @staticmethod
+    def show(analysis):
+        taskpanels.show_panel(taskpanels.AirfoilPanel(analysis))
 
 
 class Preferences(_Command):
@@ -481,7 +534,7 @@ class Preferences(_Command):
 
 
 COMMANDS = [DemoBlade(), LoadCad(), ConnectRig(), Scan(), ImportPoints(), Reconstruct(),
-            Register(), DeviationMap(), SectionAnalysis(), Report(), Preferences()]
+            Register(), DeviationMap(), SectionAnalysis(), Airfoil(), Report(), Preferences()]
 TOOLBAR = [c.name for c in COMMANDS if c.name != Preferences.name]
 MENU = [c.name for c in COMMANDS]
 BY_NAME = {c.name: c for c in COMMANDS}

@@ -3,6 +3,8 @@ space (its own orthographic camera), left out of the scene's bounding box so "fi
 the blade, not the legend. It draws the values and colours the DeviationMap object computed."""
 from pivy import coin
 
+from .i18n import translate
+
 # Legend geometry in normalised view coordinates: the view spans [-1, 1] in x and in y
 # whatever its aspect, so the legend keeps to the left edge in any window.
 BAR_X = (-0.975, -0.945)
@@ -19,9 +21,11 @@ def _skip_bounding_group():
     return node
 
 
-def legend_node(values, colours, title="Deviation [mm]", font_size=14):
+def legend_node(values, colours, title=None, font_size=14):
     """values (ascending, mm) with their colours (r, g, b in 0..1) -> a Coin node to add to a
-    view provider's root."""
+    view provider's root; ``title`` default "Deviation [mm]", translated."""
+    if title is None:
+        title = translate("BladeInspect", "Deviation [mm]")
     group = _skip_bounding_group()
     hud = coin.SoAnnotation()
     group.addChild(hud)

@@ -2,35 +2,32 @@
 to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
 function as the command line (run_inspect, run_calibration, section_table, run_simulation)
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
-or a cancel leaves the document as it was."""
+or a cancel leaves the document as it was. Inspect runs as a console line
+(app.actions.inspect through commands.run_action), which a recorded macro replays."""
 import contextlib
 import os
 import shutil
 import tempfile
 
-import numpy as np
 
 import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from ..app import loop, objects, settings
+from ..app import actions, loop, objects, settings
 from ..core import contracts
 from ..core.errors import InputError
-from ..core.pointio import read_points
-from ..inspection.closed_loop import run_inspect
 from ..inspection.report import section_rows
 from ..inspection.simulate import run_simulation
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from . import commands, progress, taskpanels
+from .i18n import QT_TRANSLATE_NOOP, translate
 from .session import RIG
 
-# Marks the command texts for translation (FreeCAD translates them in the command's context).
-QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
+CMM_FILTER = QT_TRANSLATE_NOOP("BladeInspect", "CMM files (*.csv *.txt *.dat);;All files (*)")
+RIG_FILTER = QT_TRANSLATE_NOOP("BladeInspect", "Rig calibration (*.json);;All files (*)")
 
-CMM_FILTER = "CMM files (*.csv *.txt *.dat);;All files (*)"
-RIG_FILTER = "Rig calibration (*.json);;All files (*)"
-
+NOISE_MODELS = ("uniform", "normal")
 # Results shown to the user, newest last: (title, text). Tests read them.
 RESULTS = []
 # The RIG.json the last calibration wrote: the inspect panel offers it.
@@ -45,21 +42,14 @@ def inspection_rig(nominal_obj, seed, rig_file=None):
     """The rig Inspect runs on: the connected one, else the simulated rig with the
     preferences' sensor (as ConnectRig opens it), its true geometry ``rig_file``'s, closed
     after."""
-    if RIG.connected:
-        yield RIG.rig
-        return
-    from ..rig.kinematics import RigKinematics
-    kinematics = RigKinematics.from_json(rig_file) if rig_file else None
-    rig = commands.simulated_rig(objects.nominal_of(nominal_obj), seed, kinematics)
-    try:
+    with actions.interactive(rig=RIG.rig), \
+            actions.inspection_rig(nominal_obj, seed, rig_file) as rig:
         yield rig
-    finally:
-        rig.close()
 
 
 def ask_save_file(title, filters, default_name):
     path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), title,
-                                                default_name, filters)
+                                                default_name, translate("BladeInspect", filters))
     return path or None
 
 
@@ -67,7 +57,8 @@ def show_result(title, text):
     RESULTS.append((title, text))
     FreeCAD.Console.PrintMessage("BladeInspect: %s: %s\n" % (title, text))
     if progress.SHOW_DIALOGS and FreeCAD.GuiUp:
-        box = QtGui.QMessageBox(QtGui.QMessageBox.Information, "BladeInspect: " + title, text,
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Information,
+                                translate("BladeInspect", "BladeInspect: %s") % title, text,
                                 QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
         progress.show_modeless(box)
 
@@ -87,41 +78,49 @@ def _hide_measured_frame(measurement):
         measurement.ViewObject.Visibility = False
 
 
-def _show_table(title, table, note):
+def _show_table(title, table, note, sensitivity=None):
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
-    FreeCADGui.Control.closeDialog()
-    FreeCADGui.Control.showDialog(taskpanels.TablePanel(title, header, rows,
-                                                        "; ".join(n for n in notes if n)))
+    taskpanels.show_panel(taskpanels.TablePanel(
+        title, header, rows, "; ".join(n for n in notes if n), sensitivity))
 
 
 # ---------------------------------------------------------------- task panels
 
 class InspectPanel(taskpanels.FormPanel):
-    """Nominal section heights, tolerance, seed and the rig calibration file."""
-    title = "Inspect"
+    """Nominal section heights, tolerance, seed, the rig calibration file and the fit."""
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Inspect")
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.heights = QtGui.QLineEdit(", ".join("%g" % h
-                                                 for h in contracts.SECTION_HEIGHTS_PCT))
-        self.heights.setToolTip("Nominal sections to measure, % of the span from hub to tip")
-        self.tolerance = taskpanels.spin_box(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm")
-        self.seed = taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.seed.setToolTip("Fixture pose of the simulated rig and the registration's sampling")
-        self.rig_file = QtGui.QLineEdit(LAST_RIG_FILE[0] or "")
-        self.rig_file.setToolTip("RIG.json from Calibrate; empty: the nominal kinematics")
-        self.layout.addRow("Section heights (%)", self.heights)
-        self.layout.addRow("Tolerance", self.tolerance)
-        self.layout.addRow("Seed", self.seed)
-        self.layout.addRow("Rig calibration", self.rig_file)
-        self.layout.addRow(QtGui.QLabel("Rig: " + (RIG.spec if RIG.connected else
-                                                    "simulated (none connected)")))
+        self.heights = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Section heights (%)"),
+            QtGui.QLineEdit(", ".join("%g" % h for h in contracts.SECTION_HEIGHTS_PCT)),
+            QT_TRANSLATE_NOOP("BladeInspect",
+                              "Nominal sections to measure, % of the span from hub to tip"))
+        self.tolerance = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Tolerance"),
+            taskpanels.spin_box(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm"))
+        self.seed = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+            taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
+            QT_TRANSLATE_NOOP("BladeInspect",
+                              "Fixture pose of the simulated rig and the registration's sampling"))
+        self.rig_file = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Rig calibration"),
+            QtGui.QLineEdit(LAST_RIG_FILE[0] or ""),
+            QT_TRANSLATE_NOOP("BladeInspect",
+                              "RIG.json from Calibrate; empty: the nominal kinematics"))
+        self.fit = taskpanels.FitSelector()
+        self.layout.addRow(self.fit)
+        self.layout.addRow(QtGui.QLabel(translate("BladeInspect", "Rig: %s") % (
+            RIG.spec if RIG.connected else translate("BladeInspect", "simulated (none connected)"))))
 
     def options(self):
-        return {"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
-                "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None}
+        return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
+                     "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None},
+                    **self.fit.values())
 
     def accept(self):
         options = self.options()   # read before closing: closing deletes the widgets
@@ -133,16 +132,16 @@ class InspectPanel(taskpanels.FormPanel):
 class CalibratePanel(taskpanels.ConnectRigPanel):
     """The rig (simulated or a serial port), the reference sphere's diameter and, for the
     simulated rig, the axis errors to inject."""
-    title = "Calibrate rig"
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Calibrate rig")
 
     def __init__(self, on_accept):
         super().__init__(on_accept)
-        self.diameter = taskpanels.spin_box(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm")
-        self.offset = taskpanels.spin_box(0.0, 0.0, 10.0, 3, "mm")
-        self.tilt = taskpanels.spin_box(0.0, 0.0, 5.0, 3, "deg")
-        self.layout.addRow("Sphere diameter", self.diameter)
-        self.layout.addRow("Axis offset (simulated)", self.offset)
-        self.layout.addRow("Axis tilt (simulated)", self.tilt)
+        self.diameter = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Sphere diameter"),
+                                     taskpanels.spin_box(DEFAULT_DIAMETER, 1.0, 200.0, 4, "mm"))
+        self.offset = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Axis offset (simulated)"),
+                                   taskpanels.spin_box(0.0, 0.0, 10.0, 3, "mm"))
+        self.tilt = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Axis tilt (simulated)"),
+                                 taskpanels.spin_box(0.0, 0.0, 5.0, 3, "deg"))
         self.kind.currentIndexChanged.connect(self._update_errors)
         self._update_errors()
 
@@ -163,20 +162,21 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
 
 class SimulatePanel(taskpanels.FormPanel):
     """The simulation test bed's options (inspection.simulate.simulate_measurement)."""
-    title = "Simulation test bed"
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Simulation test bed")
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.points = taskpanels.spin_box(20000, 10, 2000000)
-        self.noise = QtGui.QComboBox()
-        self.noise.addItems(["uniform", "normal"])
-        self.outliers = taskpanels.spin_box(0.0, 0.0, 0.5, 3)
-        self.seed = taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.layout.addRow("Surface points", self.points)
-        self.layout.addRow("Measurement error", self.noise)
-        self.layout.addRow("Outlier fraction", self.outliers)
-        self.layout.addRow("Seed", self.seed)
+        self.points = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Surface points"),
+                                   taskpanels.spin_box(20000, 10, 2000000))
+        # The noise model's names are the option values run_simulation takes, not prose.
+        self.noise = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Measurement error"),
+                                  QtGui.QComboBox())
+        self.noise.addItems(list(NOISE_MODELS))
+        self.outliers = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Outlier fraction"),
+                                     taskpanels.spin_box(0.0, 0.0, 0.5, 3))
+        self.seed = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+                                 taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1))
 
     def options(self):
         return {"seed": self.seed.value(), "n_points": self.points.value(),
@@ -202,24 +202,24 @@ class Inspect(commands._Command):
     def ready(self):
         return commands.find_nominal() is not None
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(InspectPanel(self.start))
+    panel = InspectPanel
 
-    def start(self, heights_text, tolerance, seed, rig_file=None):
+    def start(self, heights_text, tolerance, seed, rig_file=None, **fit):
         try:
             heights = contracts.parse_section_heights(heights_text, "section heights")
         except InputError as exc:
-            progress.report_error("Inspect", str(exc))
+            progress.report_error(translate("BladeInspect", "Inspect"), str(exc))
             return None
-        summary = self.inspect(commands.find_nominal(), heights, tolerance, seed, rig_file)
+        summary = self.inspect(commands.find_nominal(), heights, tolerance, seed, rig_file,
+                               **fit)
         if summary is not None:
             self.show(summary)
         return summary
 
-    def inspect(self, nominal_obj, heights, tolerance, seed, rig_file=None):
-        """run_inspect on the nominal with the connected rig (else the simulated one); the plan
-        drawn as it is made; the points, registration, deviation map and section profiles
-        added. Returns run_inspect's summary with the new objects under "objects", or None."""
+    def inspect(self, nominal_obj, heights, tolerance, seed, rig_file=None, **fit):
+        """app.actions.inspect on the nominal with the connected rig (else the simulated one),
+        the fit ``fit`` chooses; the plan drawn as it is made. Returns run_inspect's summary
+        with the new objects under "objects", or None."""
         doc = nominal_obj.Document
         out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
 
@@ -233,64 +233,38 @@ class Inspect(commands._Command):
             for listener in PLAN_LISTENERS:
                 listener(plan, obj)
 
-        def job(p):
-            if rig_file and not os.path.isfile(rig_file):
-                raise InputError("rig calibration %s: no such file" % rig_file)
-            with objects.building(doc, "Inspect"), \
-                    inspection_rig(nominal_obj, seed, rig_file) as rig:
-                summary = run_inspect(
-                    getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
-                    section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
-                    progress=p, rig=rig,
-                    nominal=objects.nominal_of(nominal_obj), document=False, on_plan=draw)
-                result = summary["result"]
-                p(0.95, "adding the inspection to the document")
-                points_csv = os.path.join(out_dir, "points.csv")
-                pointset = read_points(points_csv)
-                if len(pointset.xyz) != len(result.points_cad):
-                    # The loop wrote its own points: a mismatch is a bug, not bad input.
-                    raise RuntimeError("%s: %d rows, the registration has %d points"
-                                     % (points_csv, len(pointset.xyz), len(result.points_cad)))
-                measurement = objects.make_measurement(doc, pointset, name="InspectionPoints",
-                                                       source_file=points_csv)
-                registration = objects.make_registration(doc, result, measurement, nominal_obj,
-                                                         seed, name="Inspection")
-                n_blind = int(np.count_nonzero(result.columns["phase"] == "blind"))
-                loop.mark_inspection(registration, heights, n_blind, out_dir)
-                deviation_map = objects.make_deviation_map(doc, registration,
-                                                           settings.colour_limit())
-                profiles = objects.make_section_profiles(doc, summary["sections"], registration)
-            _hide_measured_frame(measurement)
-            if drawn["plan"].ViewObject is not None:
-                # The paths ran; drawn over the deviation map they would hide its colours.
-                drawn["plan"].ViewObject.Visibility = False
-            summary["objects"] = {"measurement": measurement, "registration": registration,
-                                  "deviation_map": deviation_map, "profiles": profiles,
-                                  "plan": drawn["plan"]}
-            return summary
-        summary = progress.run("Inspect", job)
+        summary = commands.run_action(
+            translate("BladeInspect", "Inspect"), "inspect", doc.Name, nominal_obj.Name, out_dir,
+            tuple(float(h) for h in heights), float(tolerance), int(seed), rig_file=rig_file,
+            on_plan=draw, rig=RIG.rig, **fit)
         if summary is None and os.path.exists(os.path.join(out_dir, "scan.json")):
             # A rig that failed mid-run leaves what it measured as a checkpoint.
-            FreeCAD.Console.PrintWarning(
+            FreeCAD.Console.PrintWarning(translate(
+                "BladeInspect",
                 "BladeInspect: the measured sections are kept in %s; "
                 "'./bladeinspect inspect --resume --out %s' with the same CAD, rig and options "
-                "continues the inspection\n" % (out_dir, out_dir))
+                "continues the inspection") % (out_dir, out_dir) + "\n")
         elif summary is None:
             # Bad input or a cancel: run_inspect wrote nothing, the folder made for it is empty.
             shutil.rmtree(os.path.dirname(out_dir), ignore_errors=True)
         else:
+            _hide_measured_frame(summary["objects"]["measurement"])
+            if drawn["plan"].ViewObject is not None:
+                # The paths ran; drawn over the deviation map they would hide its colours.
+                drawn["plan"].ViewObject.Visibility = False
+            summary["objects"]["plan"] = drawn["plan"]
             doc.recompute()
             commands.fit_view()
         return summary
 
     @staticmethod
     def show(summary):
-        note = ("%s. Pose uncertainty %.2f um after the planned scan (%.2f um after the blind "
-                "scan). Files in %s" % (summary["verdict"]["summary"],
-                                        1e3 * summary["pose_uncertainty_mm"],
-                                        1e3 * summary["uncertainty_after_blind_mm"],
-                                        summary["out_dir"]))
-        _show_table("Inspection: Table 2 at the nominal sections", summary["sections"], note)
+        note = (translate("BladeInspect", "%s. Pose uncertainty %.2f um after the planned scan "
+                          "(%.2f um after the blind scan). Files in %s")
+                % (summary["verdict"]["summary"], 1e3 * summary["pose_uncertainty_mm"],
+                   1e3 * summary["uncertainty_after_blind_mm"], summary["out_dir"]))
+        _show_table(translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
+                    summary["sections"], note, summary["result"].fit_sensitivity)
 
 
 class Calibrate(commands._Command):
@@ -301,11 +275,11 @@ class Calibrate(commands._Command):
         "Measure a reference sphere at several rotary angles, find the rotary axis and write "
         "RIG.json (simulated rig or a serial port)")
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(CalibratePanel(self.start))
+    panel = CalibratePanel
 
     def start(self, **options):
-        out_path = ask_save_file("Write the rig calibration", RIG_FILTER, "RIG.json")
+        out_path = ask_save_file(translate("BladeInspect", "Write the rig calibration"),
+                                 RIG_FILTER, "RIG.json")
         if out_path:
             return self.calibrate(out_path, **options)
         return None
@@ -316,28 +290,31 @@ class Calibrate(commands._Command):
             # The calibration opens the port itself; the scan session would hold it busy.
             RIG.disconnect()
         diameter = DEFAULT_DIAMETER if sphere_diameter is None else sphere_diameter
-        result = progress.run("Calibrate", lambda p: run_calibration(
+        title = translate("BladeInspect", "Calibrate")
+        result = progress.run(title, lambda p: run_calibration(
             out_path, rig_spec=rig_spec, sphere_diameter=diameter, seed=seed, progress=p,
             **simulated_errors))
         if result is not None:
             LAST_RIG_FILE[0] = out_path
-            show_result("Calibrate", calibration_text(result, out_path))
+            show_result(title, calibration_text(result, out_path))
         return result
 
 
 def calibration_text(result, out_path):
-    lines = ["Rotary axis through (%.4f, %.4f, %.4f) mm, direction (%.7f, %.7f, %.7f)."
+    lines = [translate("BladeInspect", "Rotary axis through (%.4f, %.4f, %.4f) mm, direction "
+                       "(%.7f, %.7f, %.7f).")
              % (tuple(result["axis_point"]) + tuple(result["axis_direction"])),
-             "Tilt from +Y: %.4f deg about Z, %.4f deg about X. Sphere measured %.4f mm "
-             "(nominal %.4f); circle residual RMS %.4f mm."
+             translate("BladeInspect", "Tilt from +Y: %.4f deg about Z, %.4f deg about X. "
+                       "Sphere measured %.4f mm (nominal %.4f); circle residual RMS %.4f mm.")
              % (result["axis_tilt_about_z_deg"], result["axis_tilt_about_x_deg"],
                 result["measured_diameter_mm"], result["sphere_diameter_mm"],
                 result["circle_residual_rms_mm"])]
     error = result.get("truth_error")
     if error:
-        lines.append("Against the simulator's truth: axis position %.2f um, direction %.5f deg."
+        lines.append(translate("BladeInspect", "Against the simulator's truth: axis position "
+                               "%.2f um, direction %.5f deg.")
                      % (1e3 * error["position_mm"], error["direction_deg"]))
-    lines.append("Written to %s." % out_path)
+    lines.append(translate("BladeInspect", "Written to %s.") % out_path)
     return "\n".join(lines)
 
 
@@ -354,7 +331,7 @@ class AddCmm(commands._Command):
         return reg is not None and reg.Nominal is not None
 
     def Activated(self):
-        path = commands.ask_open_file("CMM file", CMM_FILTER)
+        path = commands.ask_open_file(translate("BladeInspect", "CMM file"), CMM_FILTER)
         if path:
             table = self.add(commands.find_input((objects.Registration.Type,)), path)
             if table is not None:
@@ -362,14 +339,16 @@ class AddCmm(commands._Command):
 
     def add(self, registration, cmm_path):
         def job(p):
-            p(0.2, "reading %s and cutting the sections" % os.path.basename(cmm_path))
+            p(0.2, translate("BladeInspect", "reading %s and cutting the sections")
+              % os.path.basename(cmm_path))
             table, _ = loop.cmm_section_table(registration, cmm_path)
             return table
-        return progress.run("Add CMM file", job)
+        return progress.run(translate("BladeInspect", "Add CMM file"), job)
 
     @staticmethod
     def show(table):
-        _show_table("Table 2: optical and CMM", table, "CMM: %s" % table.cmm_source)
+        _show_table(translate("BladeInspect", "Table 2: optical and CMM"), table,
+                    translate("BladeInspect", "CMM: %s") % table.cmm_source)
 
 
 class Simulate(commands._Command):
@@ -380,19 +359,22 @@ class Simulate(commands._Command):
         "The paper's simulation test bed: points from the CAD (or the demo blade) at a random"
         " pose with measurement error, registered blind; pose error against its bound")
 
-    def Activated(self):
-        FreeCADGui.Control.showDialog(SimulatePanel(self.simulate))
+    panel = SimulatePanel
+
+    def start(self, **options):
+        return self.simulate(**options)
 
     def simulate(self, seed=0, **options):
         """run_simulation on the document's nominal, else a new demo blade; adds the simulated
         measurement, its registration and deviation map. Returns (report, registration)."""
         doc = commands.active_document()
+        title = translate("BladeInspect", "Simulation test bed")
 
         def job(p):
             with objects.building(doc, "Simulation test bed"):
                 nominal_obj = commands.find_nominal()
                 if nominal_obj is None:
-                    p(0.0, "building the demo blade")
+                    p(0.0, translate("BladeInspect", "building the demo blade"))
                     nominal_obj = objects.make_demo_blade(doc)
                     doc.recompute()
                 result, report, pointset = run_simulation(
@@ -408,23 +390,26 @@ class Simulate(commands._Command):
                          report["pose_error_over_bound"])):
                     registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
                     setattr(registration, prop, value)
+                    # The simulator's truth, not an input.
+                    registration.setEditorMode(prop, ["ReadOnly"])
                 deviation_map = objects.make_deviation_map(doc, registration,
                                                            settings.colour_limit())
             _hide_measured_frame(measurement)
             return report, registration, deviation_map
-        outcome = progress.run("Simulation test bed", job)
+        outcome = progress.run(title, job)
         if outcome is None:
             return None
         report, registration, _ = outcome
         doc.recompute()
         commands.fit_view()
-        show_result("Simulation test bed", simulation_text(report))
+        show_result(title, simulation_text(report))
         return report, registration
 
 
 def simulation_text(report):
-    return ("Pose error %.3f um = %.2f x its bound (%.3f um). Residual RMS %.4f mm (injected "
-            "%.4f), min %.4f, max %.4f mm; paper: RMS 0.0019, min -0.0053, max 0.006."
+    return (translate("BladeInspect", "Pose error %.3f um = %.2f x its bound (%.3f um). "
+                      "Residual RMS %.4f mm (injected %.4f), min %.4f, max %.4f mm; paper: "
+                      "RMS 0.0019, min -0.0053, max 0.006.")
             % (1e3 * report["pose_error_mm"], report["pose_error_over_bound"],
                1e3 * report["pose_uncertainty_mm"], report["residual_rms_mm"],
                report["noise_rms_injected_mm"], report["residual_min_mm"],

@@ -3,12 +3,13 @@ colour limits, stored in User parameter:BaseApp/Preferences/Mod/BladeInspect (ap
 from PySide import QtGui
 
 from ..app import settings
+from .i18n import translate
 
 
 class PreferencesPage:
     def __init__(self, parent=None):
         self.form = QtGui.QWidget(parent)
-        self.form.setWindowTitle("BladeInspect")
+        self.form.setWindowTitle(translate("BladeInspect", "BladeInspect"))
         layout = QtGui.QFormLayout(self.form)
         self.widgets = {}
         for name, (kind, default, label, unit, lo, hi) in settings.SETTINGS.items():
@@ -23,7 +24,7 @@ class PreferencesPage:
                     widget.setSuffix(" " + unit)
             widget.setObjectName(name)
             self.widgets[name] = widget
-            layout.addRow(label, widget)
+            layout.addRow(translate("BladeInspect", label), widget)
         self.loadSettings()
 
     def loadSettings(self):

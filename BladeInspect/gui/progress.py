@@ -11,6 +11,7 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from ..core.errors import Cancelled, InputError
+from .i18n import translate
 
 # Messages shown to the user, newest last: (title, text). Tests read them; dialogs can be off.
 MESSAGES = []
@@ -38,7 +39,8 @@ def report_error(title, text):
     MESSAGES.append((title, text))
     FreeCAD.Console.PrintError("BladeInspect: %s: %s\n" % (title, text))
     if SHOW_DIALOGS and FreeCAD.GuiUp:
-        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "BladeInspect: " + title, text,
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning,
+                                translate("BladeInspect", "BladeInspect: %s") % title, text,
                                 QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
         show_modeless(box)
 
@@ -54,13 +56,14 @@ class StatusProgress:
         self.bar.setObjectName("BladeInspectProgress")
         self.bar.setRange(0, 1000)
         self.bar.setMaximumWidth(220)
-        self.button = QtGui.QPushButton("Cancel")
-        self.button.setToolTip("Stop %s; the document keeps what it had before" % title)
+        self.button = QtGui.QPushButton(translate("BladeInspect", "Cancel"))
+        self.button.setToolTip(translate(
+            "BladeInspect", "Stop %s; the document keeps what it had before") % title)
         self.button.clicked.connect(self.cancel)
         self.status.addPermanentWidget(self.bar)
         self.status.addPermanentWidget(self.button)
         self.messages = []
-        self.show(0.0, "starting")
+        self.show(0.0, translate("BladeInspect", "starting"))
 
     def cancel(self):
         self.cancelled = True
@@ -90,19 +93,21 @@ def run(title, job):
     _busy.append(title)
     try:
         value = job(progress)
-        progress.status.showMessage("%s: done" % title, 5000)
+        progress.status.showMessage(translate("BladeInspect", "%s: done") % title, 5000)
         return value
     except Cancelled:
-        FreeCAD.Console.PrintWarning("BladeInspect: %s cancelled\n" % title)
+        FreeCAD.Console.PrintWarning(
+            translate("BladeInspect", "BladeInspect: %s cancelled") % title + "\n")
         MESSAGES.append((title, "cancelled"))
-        progress.status.showMessage("%s: cancelled" % title, 5000)
+        progress.status.showMessage(translate("BladeInspect", "%s: cancelled") % title, 5000)
     except InputError as exc:
         report_error(title, str(exc))
     except Exception as exc:
         # A bug, not bad input: one line to the user, the traceback to the log for a report.
         LAST_TRACEBACK[0] = traceback.format_exc()
         FreeCAD.Console.PrintLog(LAST_TRACEBACK[0])
-        report_error(title, "internal error: %s: %s (details in the report view's log)"
+        report_error(title, translate("BladeInspect", "internal error: %s: %s (details in the "
+                                                     "report view's log)")
                      % (type(exc).__name__, exc))
     finally:
         _busy.remove(title)

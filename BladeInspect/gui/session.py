@@ -5,10 +5,11 @@ class RigSession:
     def __init__(self):
         self.rig = None
         self.spec = None
+        self.seed = 0      # the simulated rig's: a replayed Scan line opens the same one
 
-    def connect(self, rig, spec):
+    def connect(self, rig, spec, seed=0):
         self.disconnect()
-        self.rig, self.spec = rig, spec
+        self.rig, self.spec, self.seed = rig, spec, seed
 
     def disconnect(self):
         if self.rig is not None:

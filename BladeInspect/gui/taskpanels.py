@@ -7,9 +7,21 @@ import math
 import FreeCADGui
 from PySide import QtGui
 
-from ..app import settings
+from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
+from ..core import decision
+from ..core.airfoil import CHORD_METHODS
+from ..inspection import airfoil as airfoil_mod
+from ..inspection import fitting
 from ..inspection.result import rival_lines
+from .i18n import QT_TRANSLATE_NOOP, translate
+
+
+def show_panel(panel):
+    """Show ``panel`` in the task view in place of whatever panel is open."""
+    FreeCADGui.Control.closeDialog()
+    FreeCADGui.Control.showDialog(panel)
+    return panel
 
 
 def spin_box(value, minimum, maximum, decimals=3, suffix=""):
@@ -28,12 +40,19 @@ def spin_box(value, minimum, maximum, decimals=3, suffix=""):
 
 
 class FormPanel:
-    title = ""
+    title = ""    # marked with QT_TRANSLATE_NOOP("BladeInspect", ...), translated when shown
 
     def __init__(self):
         self.form = QtGui.QWidget()
-        self.form.setWindowTitle(self.title)
+        self.form.setWindowTitle(translate("BladeInspect", self.title))
         self.layout = QtGui.QFormLayout(self.form)
+
+    def add_row(self, label, widget, tip=None):
+        """A form row; ``label`` and ``tip`` are translated here."""
+        if tip:
+            widget.setToolTip(translate("BladeInspect", tip))
+        self.layout.addRow(translate("BladeInspect", label), widget)
+        return widget
 
     def reject(self):
         FreeCADGui.Control.closeDialog()
@@ -42,7 +61,7 @@ class FormPanel:
 
 class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
-    title = "Demo blade"
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Demo blade")
 
     def __init__(self, on_accept):
         super().__init__()
@@ -56,7 +75,7 @@ class DemoBladePanel(FormPanel):
                 continue
             box = spin_box(value, -1e4, 1e4)
             self.boxes[field.name] = box
-            self.layout.addRow(field.name.replace("_", " "), box)
+            self.add_row(field.name.replace("_", " "), box)
 
     def params(self):
         return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())
@@ -71,21 +90,22 @@ class DemoBladePanel(FormPanel):
 
 class ConnectRigPanel(FormPanel):
     """Simulated rig, or a serial port picked from the ports pyserial finds."""
-    title = "Connect rig"
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Connect rig")
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
         self.kind = QtGui.QComboBox()
-        self.kind.addItems(["Simulated rig", "Serial port"])
+        self.kind.addItems([translate("BladeInspect", "Simulated rig"),
+                            translate("BladeInspect", "Serial port")])
         self.port = QtGui.QComboBox()
         self.port.setEditable(True)
         for port in self._ports():
             self.port.addItem(port)
         self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.layout.addRow("Rig", self.kind)
-        self.layout.addRow("Port", self.port)
-        self.layout.addRow("Seed (simulated)", self.seed)
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Rig"), self.kind)
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Port"), self.port)
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed (simulated)"), self.seed)
         self.kind.currentIndexChanged.connect(self._update)
         self._update()
 
@@ -116,27 +136,31 @@ class ConnectRigPanel(FormPanel):
 
 class ScanPanel(FormPanel):
     """Scan parameters (the scan strategy's options), defaults from the preferences."""
-    title = "Scan"
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Scan")
 
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.sections = spin_box(settings.value("Sections"), 1, 200)
-        self.spacing = spin_box(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm")
-        self.spacing.setToolTip("Distance between sections; 0 spreads them over the span")
-        self.point_spacing = spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm")
-        self.sides = spin_box(settings.value("Sides"), 1, 2)
-        self.sides.setToolTip("2 turns the part over to scan the other side")
-        self.epsilon = spin_box(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm")
-        self.epsilon.setToolTip("Rescan a section until every point is within this distance "
-                                "of the sensor's standoff")
-        self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.layout.addRow("Sections", self.sections)
-        self.layout.addRow("Section spacing", self.spacing)
-        self.layout.addRow("Point spacing", self.point_spacing)
-        self.layout.addRow("Sides", self.sides)
-        self.layout.addRow("Standoff criterion \u03b5", self.epsilon)
-        self.layout.addRow("Seed", self.seed)
+        self.sections = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Sections"),
+                                     spin_box(settings.value("Sections"), 1, 200))
+        self.spacing = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Section spacing"),
+            spin_box(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm"),
+            QT_TRANSLATE_NOOP("BladeInspect",
+                              "Distance between sections; 0 spreads them over the span"))
+        self.point_spacing = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Point spacing"),
+            spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm"))
+        self.sides = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Sides"), spin_box(settings.value("Sides"), 1, 2),
+            QT_TRANSLATE_NOOP("BladeInspect", "2 turns the part over to scan the other side"))
+        self.epsilon = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Standoff criterion \u03b5"),
+            spin_box(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Rescan a section until every point is within "
+                                              "this distance of the sensor's standoff"))
+        self.seed = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+                                 spin_box(settings.value("Seed"), 0, 2 ** 31 - 1))
 
     def options(self):
         spacing = self.spacing.value()
@@ -152,48 +176,142 @@ class ScanPanel(FormPanel):
         return True
 
 
+class FitSelector(QtGui.QGroupBox):
+    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule, as the
+    command line's (inspection.fitting checks them when the command runs)."""
+
+    def __init__(self):
+        super().__init__(translate("BladeInspect", "Fit"))
+        layout = QtGui.QFormLayout(self)
+        self.objective = QtGui.QComboBox()
+        self.objective.addItems(list(fitting.OBJECTIVE_NAMES))
+        self.objective.setToolTip(translate(
+            "BladeInspect", "least-squares: the robust ICP's pose; minimax: minimum zone; "
+            "tolerance: largest margin inside the tolerance; datum: the CAD's datum faces"))
+        self.free = QtGui.QLineEdit()
+        self.free.setPlaceholderText(translate("BladeInspect", "all six"))
+        self.free.setToolTip(translate(
+            "BladeInspect", "Free degrees of freedom, any of tx,ty,tz,rx,ry,rz and t_stacking,"
+            "r_stacking,t_engine,r_engine; empty: all six"))
+        self.weights = QtGui.QLineEdit()
+        self.weights.setPlaceholderText(translate("BladeInspect", "none"))
+        self.weights.setToolTip(translate(
+            "BladeInspect", "Least-squares region weights, e.g. LE=2,TE=2,suction=1,pressure=1"))
+        self.rule = QtGui.QComboBox()
+        self.rule.addItems(list(decision.RULES))
+        self.rule.setToolTip(translate(
+            "BladeInspect", "iso14253: pass / not proven / fail (ISO 14253-1); simple: simple "
+            "acceptance"))
+        for label, widget in ((QT_TRANSLATE_NOOP("BladeInspect", "Objective"), self.objective),
+                              (QT_TRANSLATE_NOOP("BladeInspect", "Free DOF"), self.free),
+                              (QT_TRANSLATE_NOOP("BladeInspect", "Zone weights"), self.weights),
+                              (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule)):
+            layout.addRow(translate("BladeInspect", label), widget)
+
+    def values(self):
+        """Keywords of app.actions.fit_choice (literals, for the console line)."""
+        return {"fit": self.objective.currentText(),
+                "free": self.free.text().strip() or None,
+                "weights_by_zone": self.weights.text().strip() or None,
+                "decision_rule": self.rule.currentText()}
+
+
+class RegisterPanel(FormPanel):
+    """The registration's seed and the fit to move it to."""
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Register")
+
+    def __init__(self, on_accept):
+        super().__init__()
+        self.on_accept = on_accept
+        self.seed = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+            spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
+            QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the coarse stage"))
+        self.fit = FitSelector()
+        self.layout.addRow(self.fit)
+
+    def accept(self):
+        seed, fit = self.seed.value(), self.fit.values()
+        FreeCADGui.Control.closeDialog()
+        self.on_accept(seed, **fit)
+        return True
+
+
+def _escape(text):
+    return text.replace("&", "&amp;").replace("<", "&lt;")
+
+
 def registration_html(obj):
     """The pose, its uncertainty and the deviation statistics of a Registration, as a table."""
     pose = obj.Pose
     axis, angle = pose.Rotation.Axis, math.degrees(pose.Rotation.Angle)
     t, ts, rs = pose.Base, obj.TranslationSigmaMm, obj.RotationSigmaDeg
+    tr = lambda text: translate("BladeInspect", text)  # noqa: E731
     rows = [
-        ("Translation", "%.4f, %.4f, %.4f mm" % (t.x, t.y, t.z)),
-        ("Rotation", "%.4f&deg; about (%.4f, %.4f, %.4f)" % (angle, axis.x, axis.y, axis.z)),
-        ("Pose uncertainty (1&sigma;, worst corner)", "%.3f &micro;m"
+        (tr("Translation"), "%.4f, %.4f, %.4f mm" % (t.x, t.y, t.z)),
+        (tr("Rotation"), tr("%.4f&deg; about (%.4f, %.4f, %.4f)")
+         % (angle, axis.x, axis.y, axis.z)),
+        (tr("Pose uncertainty (1&sigma;, worst corner)"), "%.3f &micro;m"
          % (obj.PoseUncertaintyMm * 1000.0)),
-        ("Translation 1&sigma;", "%.3f, %.3f, %.3f &micro;m"
+        (tr("Translation 1&sigma;"), "%.3f, %.3f, %.3f &micro;m"
          % (ts.x * 1000, ts.y * 1000, ts.z * 1000)),
-        ("Rotation 1&sigma;", "%.2f, %.2f, %.2f arcsec"
+        (tr("Rotation 1&sigma;"), "%.2f, %.2f, %.2f arcsec"
          % (rs.x * 3600, rs.y * 3600, rs.z * 3600)),
-        ("RMS (inliers)", "%.4f mm" % obj.RmsMm),
-        ("Points / inliers", "%d / %d" % (obj.NPoints, obj.NInliers)),
-        ("Deviation min / max", "%.4f / %.4f mm" % (obj.DeviationMinMm, obj.DeviationMaxMm)),
-        ("Mean &plusmn; std", "%.4f &plusmn; %.4f mm" % (obj.DeviationMeanMm, obj.DeviationStdMm)),
-        ("Within 1&sigma; / 3&sigma;", "%.1f %% / %.1f %%"
+        (tr("RMS (inliers)"), "%.4f mm" % obj.RmsMm),
+        (tr("Points / inliers"), "%d / %d" % (obj.NPoints, obj.NInliers)),
+        (tr("Deviation min / max"), "%.4f / %.4f mm" % (obj.DeviationMinMm, obj.DeviationMaxMm)),
+        (tr("Mean &plusmn; std"), "%.4f &plusmn; %.4f mm"
+         % (obj.DeviationMeanMm, obj.DeviationStdMm)),
+        (tr("Within 1&sigma; / 3&sigma;"), "%.1f %% / %.1f %%"
          % (obj.PctWithin1Sigma, obj.PctWithin3Sigma)),
     ]
+    record = registration_fit.fit_record(obj)
+    if record:
+        rows.append((tr("Fit"), _escape("%s, free %s, decision rule %s" % (
+            record["objective"], ",".join(record["free"]) if isinstance(record["free"], list)
+            else record["free"], record["decision_rule"]))))
     html = "<table cellspacing='4'>" + "".join(
         "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
     notes = list(obj.Warnings) + rival_lines(json.loads(obj.CoarseJson or "{}"))
     if notes:
-        html += "<p><b>Warnings</b><br>" + "<br>".join(
-            w.replace("&", "&amp;").replace("<", "&lt;") for w in notes) + "</p>"
+        html += "<p><b>%s</b><br>" % tr("Warnings") + "<br>".join(
+            _escape(w) for w in notes) + "</p>"
     return html
 
 
-class RegistrationPanel:
-    """What a registration found: the pose and how well it is known."""
+def table_widget(header, rows):
+    table = QtGui.QTableWidget(len(rows), len(header))
+    table.setHorizontalHeaderLabels([translate("BladeInspect", h) for h in header])
+    for r, row in enumerate(rows):
+        for c, cell in enumerate(row):
+            table.setItem(r, c, QtGui.QTableWidgetItem(str(cell)))
+    table.resizeColumnsToContents()
+    return table
 
-    def __init__(self, obj):
-        self.obj = obj
-        self.form = QtGui.QWidget()
-        self.form.setWindowTitle("Registration: " + obj.Label)
-        layout = QtGui.QVBoxLayout(self.form)
-        self.text = QtGui.QTextBrowser()
-        self.text.setHtml(registration_html(obj))
-        self.text.setMinimumHeight(320)
-        layout.addWidget(self.text)
+
+def sensitivity_widget(sensitivity):
+    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change."""
+    box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
+    layout = QtGui.QVBoxLayout(box)
+    header, rows = fitting.report_rows(sensitivity)
+    table = table_widget(header, rows)
+    table.setMinimumHeight(200)
+    layout.addWidget(table)
+    largest = sensitivity.get("largest_change")
+    if largest:
+        label = QtGui.QLabel(translate("BladeInspect", "Largest change: %s, %.4f mm; the "
+                                       "verdict %s with the fit.")
+                             % (largest["characteristic"], largest["change_mm"],
+                                translate("BladeInspect", "changes")
+                                if sensitivity["verdict_changes"]
+                                else translate("BladeInspect", "does not change")))
+        label.setWordWrap(True)
+        layout.addWidget(label)
+    return box
+
+
+class _ResultPanel:
+    """A panel that only shows a result: a Close button."""
 
     def getStandardButtons(self):
         return int(QtGui.QDialogButtonBox.Close)
@@ -205,29 +323,140 @@ class RegistrationPanel:
         return True
 
 
-class TablePanel:
-    """A table of text cells with its header: the section analysis."""
+class RegistrationPanel(_ResultPanel):
+    """What a registration found: the pose and how well it is known, the fit and what the
+    choice of fit changes."""
 
-    def __init__(self, title, header, rows, note=""):
+    def __init__(self, obj):
+        self.obj = obj
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle(translate("BladeInspect", "Registration: %s") % obj.Label)
+        layout = QtGui.QVBoxLayout(self.form)
+        self.text = QtGui.QTextBrowser()
+        self.text.setHtml(registration_html(obj))
+        self.text.setMinimumHeight(320)
+        layout.addWidget(self.text)
+        sensitivity = registration_fit.sensitivity_of(obj)
+        self.sensitivity = None
+        if sensitivity:
+            self.sensitivity = sensitivity_widget(sensitivity)
+            layout.addWidget(self.sensitivity)
+
+
+class TablePanel(_ResultPanel):
+    """A table of text cells with its header: the section analysis; ``sensitivity`` (a
+    fit_sensitivity block) adds its table below."""
+
+    def __init__(self, title, header, rows, note="", sensitivity=None):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
-        self.table = QtGui.QTableWidget(len(rows), len(header))
-        self.table.setHorizontalHeaderLabels(list(header))
-        for r, row in enumerate(rows):
-            for c, cell in enumerate(row):
-                self.table.setItem(r, c, QtGui.QTableWidgetItem(str(cell)))
-        self.table.resizeColumnsToContents()
+        self.table = table_widget(header, rows)
         self.table.setMinimumHeight(260)
         layout.addWidget(self.table)
         if note:
             label = QtGui.QLabel(note)
             label.setWordWrap(True)
             layout.addWidget(label)
+        if sensitivity:
+            layout.addWidget(sensitivity_widget(sensitivity))
 
-    def getStandardButtons(self):
-        return int(QtGui.QDialogButtonBox.Close)
 
-    def reject(self):
+# ---------------------------------------------------------------- airfoil (issue 15)
+
+class AirfoilOptionsPanel(FormPanel):
+    """The `airfoil` command's options: the characteristics file, chord method, engine axis."""
+    title = QT_TRANSLATE_NOOP("BladeInspect", "Airfoil analysis")
+
+    def __init__(self, on_accept):
+        super().__init__()
+        self.on_accept = on_accept
+        self.characteristics = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"), QtGui.QLineEdit(),
+            QT_TRANSLATE_NOOP("BladeInspect", "CSV: characteristic,section,lower,upper"
+                              "[,nominal]; empty: every characteristic reported, none judged"))
+        self.chord = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Chord"),
+                                  QtGui.QComboBox())
+        self.chord.addItems(list(CHORD_METHODS))
+        self.axis = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Engine axis"), QtGui.QLineEdit("x"),
+            QT_TRANSLATE_NOOP("BladeInspect", "A letter (x, y, z, -x, ...) or a vector"))
+
+    def options(self):
+        return {"characteristics": self.characteristics.text().strip() or None,
+                "chord_method": self.chord.currentText(),
+                "engine_axis": self.axis.text().strip() or None}
+
+    def accept(self):
+        options = self.options()
         FreeCADGui.Control.closeDialog()
+        self.on_accept(**options)
         return True
+
+
+AIRFOIL_HEADER = (QT_TRANSLATE_NOOP("BladeInspect", "section"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "characteristic"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "nominal"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "actual"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "deviation"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "\u00b1U (k=2)"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "tolerance"),
+                  QT_TRANSLATE_NOOP("BladeInspect", "verdict"))
+
+
+def _number(value, signed=False):
+    if value is None:
+        return ""
+    return ("%+.4f" if signed else "%.4f") % value
+
+
+def airfoil_rows(blocks):
+    """The characteristics table: per section and characteristic, nominal, actual, deviation,
+    the expanded uncertainty U = 2u of the block's standard uncertainty, the tolerance and the
+    verdict (inspection.airfoil.csv_rows)."""
+    rows = []
+    for label, key, nominal, measured, deviation, u, lower, upper, verdict in \
+            airfoil_mod.csv_rows(blocks):
+        tolerance = "" if lower is None and upper is None else "%s .. %s" % (
+            _number(lower, True) or "-", _number(upper, True) or "+")
+        rows.append([label, key, _number(nominal), _number(measured),
+                     _number(deviation, True), "" if u is None else "%.4f" % (2.0 * u),
+                     tolerance, translate("BladeInspect", verdict)])
+    return rows
+
+
+class AirfoilPanel(_ResultPanel):
+    """The airfoil characteristics of every section (result.json's airfoil blocks), the
+    airfoil verdict and the lean and bow."""
+
+    def __init__(self, analysis):
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle(translate("BladeInspect", "Airfoil characteristics"))
+        layout = QtGui.QVBoxLayout(self.form)
+        self.rows = airfoil_rows(analysis.get("airfoil", []))
+        self.table = table_widget(AIRFOIL_HEADER, self.rows)
+        self.table.setMinimumHeight(420)
+        layout.addWidget(self.table)
+        lines = [analysis.get("airfoil_verdict", {}).get("summary", "")]
+        lean_bow = analysis.get("lean_bow")
+        if lean_bow:
+            lines.append(translate("BladeInspect", "Lean and bow: largest bow at section %s.")
+                         % lean_bow["largest_bow_section"])
+        settings_ = analysis.get("airfoil_settings", {})
+        if settings_:
+            lines.append(translate("BladeInspect", "Chord: %s; U = 2 x the %s (%s).")
+                         % (settings_.get("chord_method"),
+                            settings_.get("uncertainty_coverage"),
+                            settings_.get("uncertainty_method")))
+        label = QtGui.QLabel("\n".join(line for line in lines if line))
+        label.setWordWrap(True)
+        layout.addWidget(label)
+        # What the stage says it could not do well (sparse edges, non-circular ends): a
+        # number shown without its caveat would be trusted where it should not be.
+        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"], note)
+                 for block in analysis.get("airfoil", []) for note in block.get("notes", [])]
+        if notes:
+            self.notes = QtGui.QTextBrowser()
+            self.notes.setPlainText("\n".join(notes))
+            self.notes.setMaximumHeight(140)
+            layout.addWidget(self.notes)

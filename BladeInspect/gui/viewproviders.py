@@ -4,9 +4,9 @@ Importing this module registers them with the app layer's objects."""
 import FreeCAD
 import FreeCADGui
 
-from ..app import objects
+from ..app import airfoil_objects, objects
 from . import legend, resources
-from .taskpanels import RegistrationPanel
+from .taskpanels import AirfoilPanel, RegistrationPanel, show_panel
 
 
 class ViewProvider:
@@ -110,7 +110,35 @@ class ViewProviderDeviationMap(ViewProvider):
             self.show_legend(vobj)
 
 
+class ViewProviderAirfoilGeometry(ViewProvider):
+    """A camber line or edge circles: nominal in dark orange/green, measured lighter and
+    dashed-looking thin; double-click shows the characteristics table of its analysis."""
+    colours = {"nominal": (0.85, 0.33, 0.0), "measured": (1.0, 0.65, 0.2)}
+
+    def configure(self, vobj):
+        vobj.LineColor = self.colours.get(vobj.Object.Profile, (0.85, 0.33, 0.0))
+        vobj.LineWidth = 3 if vobj.Object.Profile == "nominal" else 2
+
+    def doubleClicked(self, vobj):
+        groups = [o for o in vobj.Object.InList if "AirfoilJson" in o.PropertiesList]
+        if not groups:
+            return False
+        show_panel(AirfoilPanel(airfoil_objects.analysis_of(groups[0])))
+        return True
+
+
+class ViewProviderCamberLine(ViewProviderAirfoilGeometry):
+    icon = "BladeInspect_CamberLine"
+
+
+class ViewProviderEdgeCircles(ViewProviderAirfoilGeometry):
+    icon = "BladeInspect_EdgeCircles"
+    colours = {"nominal": (0.1, 0.6, 0.2), "measured": (0.45, 0.85, 0.45)}
+
+
 VIEW_PROVIDERS = {
+    airfoil_objects.CamberLine.Type: ViewProviderCamberLine,
+    airfoil_objects.EdgeCircles.Type: ViewProviderEdgeCircles,
     objects.DemoBlade.Type: ViewProviderNominal,
     objects.CadModel.Type: ViewProviderCadModel,
     objects.Measurement.Type: ViewProviderMeasurement,

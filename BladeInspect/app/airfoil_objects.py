@@ -1,0 +1,223 @@
+"""The airfoil analysis in the document (issue 15): per section, the mean camber line and the
+LE/TE edge circles of the nominal profile (the CAD's exact cut) and of the measured one (that
+section's registered points), as FeaturePython objects in an "Airfoil" group beside the
+section profiles. Each keeps its plane and links as inputs and rebuilds its shape when the
+nominal's shape, the registration's points or the plane change (a signature is stored, so
+opening a document is cheap); the numbers come from inspection.airfoil.run_stage, the same
+stage the `airfoil` and `report --airfoil` commands run.
+
+No GUI imports: view providers come from the gui layer's hook (objects.set_view_provider_hook)."""
+
+import json
+
+import numpy as np
+
+import FreeCAD
+
+from ..core.contracts import json_default
+from ..core.errors import InputError
+from ..inspection import airfoil as airfoil_mod
+from . import objects
+
+GROUP_NAME = "Airfoil"
+PROFILES = ("nominal", "measured")
+MCL_SAMPLES = 200
+
+
+def _vector(v):
+    return FreeCAD.Vector(*[float(c) for c in np.asarray(v, dtype=float).ravel()[:3]])
+
+
+class _SectionGeometry(objects._Proxy):
+    """What both kinds share: the section's plane and links, and the stage's result."""
+    group = "Airfoil"
+
+    def add_properties(self, obj):
+        add, g = objects._add, "Section"
+        add(obj, "App::PropertyLink", "Nominal", g, "Nominal CAD the section is cut from")
+        add(obj, "App::PropertyLink", "Registration", g,
+            "Registration whose points give the measured profile")
+        if "Profile" not in obj.PropertiesList:
+            add(obj, "App::PropertyEnumeration", "Profile", g,
+                "nominal: the CAD's exact cut; measured: the section's registered points")
+            obj.Profile = list(PROFILES)
+        add(obj, "App::PropertyString", "SectionLabel", g, "Section label (as in Table 2)",
+            read_only=True)
+        add(obj, "App::PropertyFloat", "HeightPct", g, "Section height, % of the span",
+            read_only=True)
+        add(obj, "App::PropertyVector", "PlaneOrigin", g, "A point of the section plane, mm")
+        add(obj, "App::PropertyVector", "PlaneNormal", g, "Normal of the section plane")
+        add(obj, "App::PropertyVector", "EngineAxis", g, "Engine axis (--engine-axis)")
+        add(obj, "App::PropertyString", "ChordMethod", g,
+            "Chord definition: nose-tail, caliper or tangent")
+        add(obj, "App::PropertyIntegerList", "PointIndex", g,
+            "Rows of the registration's points in this section", hidden=True)
+        add(obj, "App::PropertyString", "InputSignature", g,
+            "Signature of the inputs the shape was made from", hidden=True)
+        self.add_results(obj)
+
+    def add_results(self, obj):
+        raise NotImplementedError
+
+    def signature(self, obj):
+        if obj.Nominal is None:
+            return ""
+        parts = [objects._shape_signature(obj.Nominal.Shape), tuple(obj.PlaneOrigin),
+                 tuple(obj.PlaneNormal), tuple(obj.EngineAxis), obj.ChordMethod, obj.Profile]
+        if obj.Profile == "measured":
+            if obj.Registration is None:
+                return ""
+            parts += [np.asarray(obj.Registration.PointsCad), list(obj.PointIndex)]
+        return objects._signature(*parts)
+
+    def characteristics(self, obj):
+        """(core.airfoil.Characteristics, PlaneFrame) of the object's profile, recomputed."""
+        nominal = objects.nominal_of(obj.Nominal)
+        result = None
+        if obj.Profile == "measured":
+            result = objects.registration_result(obj.Registration, nominal)
+        plane = airfoil_mod.Plane(obj.SectionLabel, np.array(obj.PlaneOrigin, dtype=float),
+                                  np.array(obj.PlaneNormal, dtype=float), obj.HeightPct,
+                                  point_index=np.asarray(obj.PointIndex, dtype=int))
+        opts = airfoil_mod.Options(engine_axis=tuple(obj.EngineAxis),
+                                   chord_method=obj.ChordMethod or "nose-tail", draws=0)
+        section = airfoil_mod.run_stage(nominal, [plane], opts, result).sections[0]
+        ch = section.measured if obj.Profile == "measured" else section.nominal
+        if ch is None:
+            raise InputError("%s: section %s: %s" % (obj.Label, obj.SectionLabel,
+                                                      "; ".join(section.notes)))
+        return ch, section.frame
+
+    def execute(self, obj):
+        signature = self.signature(obj)
+        if not signature:
+            raise InputError("%s: no nominal (or, for a measured profile, no registration) "
+                             "linked" % obj.Label)
+        if signature == obj.InputSignature and not obj.Shape.isNull():
+            return
+        self.store(obj, *self.characteristics(obj))
+        obj.InputSignature = signature
+
+
+class CamberLine(_SectionGeometry):
+    """The mean camber line: centres of the circles inscribed between the sides, extended to
+    the LE and TE points (docs/airfoil.md), in the section plane (CAD frame)."""
+    Type = "BladeInspect::CamberLine"
+
+    def add_results(self, obj):
+        ro = objects.READ_ONLY
+        objects._add_table(obj, "Camber line", (
+            ("App::PropertyFloat", "LengthMm", "Length of the camber line, LE to TE point, mm",
+             ro),
+            ("App::PropertyFloat", "ChordMm", "Chord by ChordMethod, mm", ro),
+            ("App::PropertyFloat", "InletAngleDeg",
+             "Inlet metal angle, from the engine axis, degrees", ro),
+            ("App::PropertyFloat", "OutletAngleDeg",
+             "Outlet metal angle, from the engine axis, degrees", ro),
+            ("App::PropertyFloat", "MaxThicknessMm", "Largest inscribed circle's diameter, mm",
+             ro),
+            ("App::PropertyVector", "LePoint", "Leading-edge point, mm", ro),
+            ("App::PropertyVector", "TePoint", "Trailing-edge point, mm", ro)))
+
+    def store(self, obj, ch, frame):
+        import Part
+        xyz = frame.to_3d(ch.mcl.sample(MCL_SAMPLES))
+        obj.Shape = Part.makePolygon([_vector(p) for p in xyz])
+        obj.LengthMm = float(ch.mcl.length)
+        obj.ChordMm = float(ch.chord_mm)
+        obj.InletAngleDeg = float(ch.inlet_angle_deg)
+        obj.OutletAngleDeg = float(ch.outlet_angle_deg)
+        obj.MaxThicknessMm = float(ch.max_thickness_mm)
+        obj.LePoint = _vector(frame.to_3d(ch.le_point)[0])
+        obj.TePoint = _vector(frame.to_3d(ch.te_point)[0])
+
+
+class EdgeCircles(_SectionGeometry):
+    """The circles fitted to the LE and TE zones (docs/airfoil.md), in the section plane."""
+    Type = "BladeInspect::EdgeCircles"
+
+    def add_results(self, obj):
+        ro = objects.READ_ONLY
+        objects._add_table(obj, "Edge circles", (
+            ("App::PropertyFloat", "LeRadiusMm", "Leading-edge radius, mm", ro),
+            ("App::PropertyFloat", "TeRadiusMm", "Trailing-edge radius, mm", ro),
+            ("App::PropertyVector", "LeCenter", "Leading-edge circle's centre, mm", ro),
+            ("App::PropertyVector", "TeCenter", "Trailing-edge circle's centre, mm", ro)))
+
+    def store(self, obj, ch, frame):
+        import Part
+        normal = _vector(frame.normal)
+        circles = []
+        for circle, radius_prop, centre_prop in ((ch.le_circle, "LeRadiusMm", "LeCenter"),
+                                                 (ch.te_circle, "TeRadiusMm", "TeCenter")):
+            centre = _vector(frame.to_3d(circle.center)[0])
+            circles.append(Part.makeCircle(float(circle.radius), centre, normal))
+            setattr(obj, radius_prop, float(circle.radius))
+            setattr(obj, centre_prop, centre)
+        obj.Shape = Part.Compound(circles)
+
+
+KINDS = {"CamberLine": CamberLine, "EdgeCircles": EdgeCircles}
+
+
+def _make(doc, cls, name, section, profile, ch, registration, nominal_obj, opts):
+    obj = doc.addObject("Part::FeaturePython", name)
+    cls(obj)
+    obj.Nominal = nominal_obj
+    obj.Registration = registration
+    obj.Profile = profile
+    plane = section.plane
+    obj.SectionLabel = str(plane.label)
+    obj.HeightPct = float(plane.height_pct)
+    obj.PlaneOrigin = _vector(plane.origin)
+    obj.PlaneNormal = _vector(plane.normal)
+    obj.EngineAxis = _vector(opts.engine_axis)
+    obj.ChordMethod = opts.chord_method
+    obj.PointIndex = [int(i) for i in (plane.point_index if plane.point_index is not None
+                                       else [])]
+    obj.Label = "%s %s (%s)" % ({"CamberLine": "MCL", "EdgeCircles": "Edge circles"}[
+        cls.__name__], plane.label, profile)
+    cls.store(obj.Proxy, obj, ch, section.frame)
+    objects._finish(obj)
+    return obj
+
+
+def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
+    """A group holding, per section of ``stage`` (inspection.airfoil.Stage), a CamberLine and
+    an EdgeCircles of the nominal profile and, where the section was measured, of the measured
+    one; the stage's blocks (result.json's ``airfoil``) kept on the group for the table."""
+    made = []
+    with objects.building(doc, "Airfoil"):
+        group = doc.addObject("App::DocumentObjectGroup", name)
+        group.addProperty("App::PropertyLink", "Registration", "Airfoil",
+                          "Registration the characteristics were measured from")
+        group.addProperty("App::PropertyString", "AirfoilJson", "Airfoil",
+                          "Blocks of result.json's airfoil, lean_bow and settings")
+        group.Registration = registration
+        group.AirfoilJson = json.dumps(stage.extras(), default=json_default)
+        # A record of the analysis, not an input: editing it would not re-measure.
+        group.setEditorMode("Registration", ["ReadOnly"])
+        group.setEditorMode("AirfoilJson", ["Hidden"])
+        for section in stage.sections:
+            for profile, ch in (("nominal", section.nominal), ("measured", section.measured)):
+                if ch is None:
+                    continue
+                for kind, cls in KINDS.items():
+                    name = "%s_%s_%s" % (kind, section.plane.label, profile)
+                    made.append(_make(doc, cls, name, section, profile, ch, registration,
+                                      registration.Nominal, opts))
+        group.Group = made
+    return group
+
+
+def analysis_of(group):
+    """result.json's airfoil fields kept on an Airfoil group."""
+    return json.loads(group.AirfoilJson or "{}")
+
+
+def find_analysis(doc):
+    """The newest Airfoil group of the document, else None."""
+    for obj in reversed(doc.Objects):
+        if "AirfoilJson" in obj.PropertiesList:
+            return obj
+    return None

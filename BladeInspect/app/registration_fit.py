@@ -1,0 +1,86 @@
+"""A Registration's fit (issue 16, inspection.fitting): the objective, free degrees of freedom,
+region weights and decision rule as its inputs, and the fit record and fit-sensitivity table
+it produced (result.json's ``fit`` and ``fit_sensitivity``) as read-only results.
+
+A Registration made before these existed, or with the default choice, keeps its input
+signature, so opening an older document does not register it again."""
+
+import json
+
+from ..core.contracts import json_default
+from ..inspection import fitting
+
+GROUP = "Fit"
+# (property, FitChoice field, tooltip); the enumerations list their choices.
+TEXT_INPUTS = (("FreeDof", "free", "Free degrees of freedom (--free), empty: all six"),
+               ("ZoneWeights", "weights_by_zone",
+                "Region weights (--weights-by-zone), e.g. LE=2,TE=2; empty: none"))
+
+
+def add_properties(obj, add):
+    """``add``: app.objects._add."""
+    for prop, choices, tip in (
+            ("Fit", fitting.OBJECTIVE_NAMES, "Fit objective after the robust ICP (--fit)"),
+            ("DecisionRule", ("iso14253", "simple"),
+             "iso14253: pass / not proven / fail; simple: simple acceptance")):
+        if prop not in obj.PropertiesList:
+            add(obj, "App::PropertyEnumeration", prop, GROUP, tip)
+            setattr(obj, prop, list(choices))
+    for prop, _, tip in TEXT_INPUTS:
+        add(obj, "App::PropertyString", prop, GROUP, tip)
+    add(obj, "App::PropertyString", "FitJson", GROUP,
+        "The fit's record, as result.json's fit", hidden=True)
+    add(obj, "App::PropertyString", "FitSensitivityJson", GROUP,
+        "Each judged value and the verdict under each fit objective (fit_sensitivity)",
+        hidden=True)
+
+
+def choice_of(obj):
+    """The FitChoice a Registration's inputs name (the default for an older one)."""
+    if "Fit" not in obj.PropertiesList:
+        return fitting.FitChoice()
+    return fitting.FitChoice(objective=obj.Fit, free=obj.FreeDof or None,
+                             weights_by_zone=obj.ZoneWeights or None,
+                             decision_rule=obj.DecisionRule)
+
+
+def set_choice(obj, choice):
+    obj.Fit = choice.objective
+    obj.DecisionRule = choice.decision_rule
+    obj.FreeDof = choice.free or ""
+    obj.ZoneWeights = choice.weights_by_zone or ""
+
+
+def signature_part(obj):
+    """() for the default choice (the signature older documents stored), else the choice."""
+    choice = choice_of(obj)
+    if choice == fitting.FitChoice():
+        return ()
+    return (choice.objective, choice.free, choice.weights_by_zone, choice.decision_rule)
+
+
+def refit(obj, result, nominal):
+    """After a recompute registered again: move ``result`` to the object's fit with its
+    sensitivity table, as the Register command did. The default choice is the ICP's pose
+    itself; then the recompute stays what it was before fits existed (the table, which
+    needs a section cut and every objective's fit, is dropped rather than left stale)."""
+    choice = choice_of(obj)
+    if choice == fitting.FitChoice():
+        return
+    from . import settings
+    from .actions import judge_fits   # actions imports app.objects, which imports this
+    judge_fits(result, nominal, choice, settings.value("ToleranceMm"))
+
+
+def store(obj, result):
+    obj.FitJson = json.dumps(result.fit, default=json_default) if result.fit else ""
+    obj.FitSensitivityJson = (json.dumps(result.fit_sensitivity, default=json_default)
+                              if result.fit_sensitivity else "")
+
+
+def fit_record(obj):
+    return json.loads(getattr(obj, "FitJson", "") or "null")
+
+
+def sensitivity_of(obj):
+    return json.loads(getattr(obj, "FitSensitivityJson", "") or "null")

@@ -1,0 +1,172 @@
+"""The console lines the GUI commands run (app.actions through FreeCADGui.doCommand), executed
+here headless in FreeCADCmd exactly as a recorded macro would replay them: they are plain
+imports and calls with literal arguments, they make the objects the commands make, and what
+those objects hold is checked against independent truth (the simulator's pose, the section
+plane, circle geometry). The airfoil objects and a fitted Registration survive save and
+reopen; a default-fit Registration keeps the input signature older documents stored."""
+import ast
+import os
+import shutil
+import tempfile
+import unittest
+
+import numpy as np
+
+import FreeCAD
+
+from BladeInspect.app import actions, airfoil_objects, objects, registration_fit
+from BladeInspect.core import transforms as tf
+from BladeInspect.core.errors import InputError
+from BladeInspect.inspection.simulate import simulate_measurement
+
+
+def replay(imports, call):
+    """Run a console line as FreeCADGui.doCommand would, in a fresh namespace."""
+    namespace = {}
+    exec("\n".join(("import FreeCAD",) + tuple(imports) + ("obj = " + call,)), namespace)
+    return namespace["obj"]
+
+
+class ActionLines(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="bi-actions-")
+        cls.doc = FreeCAD.newDocument("BladeInspectActions")
+        cls.blade = objects.make_demo_blade(cls.doc)
+        cls.doc.recompute()
+        cls.nominal = objects.nominal_of(cls.blade)
+        ps, cls.truth, _, _ = simulate_measurement(cls.nominal, n_points=4000, seed=11)
+        cls.measurement = objects.make_measurement(cls.doc, ps)
+        cls.line = actions.call_text("register", cls.doc.Name, cls.measurement.Name,
+                                     cls.blade.Name, 11, tolerance=0.04, fit="minimax")
+        cls.registration = replay(*cls.line)
+
+    @classmethod
+    def tearDownClass(cls):
+        for doc in list(FreeCAD.listDocuments().values()):
+            if doc.Name.startswith("BladeInspectActions"):
+                FreeCAD.closeDocument(doc.Name)
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_console_line_is_an_import_and_a_call_of_literals(self):
+        imports, call = self.line
+        self.assertEqual(imports, ("import BladeInspect.app.actions",))
+        node = ast.parse(call, mode="eval").body
+        self.assertIsInstance(node, ast.Call)
+        self.assertEqual(ast.unparse(node.func), "BladeInspect.app.actions.register")
+        for arg in list(node.args) + [k.value for k in node.keywords]:
+            ast.literal_eval(arg)    # raises for anything but a literal
+
+    def test_non_literal_arguments_are_refused(self):
+        with self.assertRaises(ValueError):
+            actions.call_text("register", self.doc.Name, self.measurement, self.blade.Name)
+        with self.assertRaises(ValueError):
+            actions.call_text("no_such_action", 1)
+
+    def test_register_line_finds_the_simulated_pose_with_the_chosen_fit(self):
+        reg = self.registration
+        self.assertEqual(objects.proxy_type(reg), objects.Registration.Type)
+        self.assertEqual(reg.Fit, "minimax")
+        self.assertEqual(registration_fit.fit_record(reg)["objective"], "minimax")
+        error = tf.corner_displacement(objects.matrix_array(reg.MeasuredToCad), self.truth,
+                                       self.nominal.bbox_corners)
+        self.assertLess(error, 0.01)
+        sensitivity = registration_fit.sensitivity_of(reg)
+        self.assertIn("minimax", sensitivity["objectives"])
+        # The minimax pose's largest |deviation| of the inliers, recomputed here from the
+        # stored points by the nominal's exact distance, is no larger than least squares'.
+        points, _, inlier = objects.registration_points(reg)
+        worst = np.max(np.abs(self.nominal.signed_distance(points[inlier]).distance))
+        least_squares = [r for r in sensitivity["rows"]
+                         if r["characteristic"] == "part worst deviation"][0]
+        self.assertLessEqual(worst, abs(least_squares["by_fit"]["least-squares"]["value_mm"])
+                             + 1e-6)
+        for prop in ("Pose", "MeasuredToCad", "PoseUncertaintyMm", "RmsMm"):
+            self.assertIn("ReadOnly", reg.getEditorMode(prop), prop)
+
+    def test_bad_fit_is_an_input_error_before_registering(self):
+        before = len(self.doc.Objects)
+        with self.assertRaises(InputError):
+            replay(*actions.call_text("register", self.doc.Name, self.measurement.Name,
+                                      self.blade.Name, 0, fit="least-squares",
+                                      free="tx,warp"))
+        self.assertEqual(len(self.doc.Objects), before)
+
+    def test_default_fit_keeps_the_older_signature(self):
+        reg = self.registration
+        m = reg.Measurement
+        older = objects._signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
+                                   objects._shape_signature(reg.Nominal.Shape), reg.Seed)
+        reg.Fit = "least-squares"
+        try:
+            self.assertEqual(reg.Proxy.signature(reg), older)
+        finally:
+            reg.Fit = "minimax"
+        self.assertNotEqual(reg.Proxy.signature(reg), older)
+
+    def test_section_analysis_line_adds_the_profiles(self):
+        table = replay(*actions.call_text("section_analysis", self.doc.Name,
+                                          self.registration.Name))
+        self.assertTrue(table.sections)
+        profiles = [o for o in self.doc.Objects if o.Name.startswith("SectionProfiles")]
+        self.assertTrue(profiles)
+        self.assertIn("ReadOnly", profiles[-1].getEditorMode("Sections"))
+
+    def test_scan_line_opens_the_rig_it_names_and_adds_the_points(self):
+        out_dir = os.path.join(self.tmp, "scan")
+        line = actions.call_text("scan", self.doc.Name, out_dir, rig_spec="sim", rig_seed=3,
+                                 nominal=self.blade.Name, n_sections=2, point_spacing=1.0)
+        measurement = replay(*line)
+        rows = np.loadtxt(os.path.join(out_dir, "points.csv"), delimiter=",", skiprows=1,
+                          usecols=(0, 1, 2), ndmin=2)
+        np.testing.assert_array_equal(objects.pointset_of(measurement).xyz, rows)
+        self.assertEqual(measurement.SourceFile, os.path.join(out_dir, "points.csv"))
+
+    def test_airfoil_line_objects_lie_in_their_planes_and_survive_reopening(self):
+        stage = replay(*actions.call_text("airfoil", self.doc.Name, self.registration.Name,
+                                          draws=0))
+        group = airfoil_objects.find_analysis(self.doc)
+        made = list(group.Group)
+        self.assertEqual(len(made), 2 * sum(
+            (s.nominal is not None) + (s.measured is not None) for s in stage.sections))
+        blocks = {b["label"]: b for b in stage.blocks}
+        for obj in made:
+            origin, normal = np.array(obj.PlaneOrigin), np.array(obj.PlaneNormal)
+            heights = [(np.array([v.X, v.Y, v.Z]) - origin) @ normal for v in obj.Shape.Vertexes]
+            self.assertLess(np.max(np.abs(heights)), 1e-6, obj.Label)
+            values = blocks[obj.SectionLabel][obj.Profile]
+            if objects.proxy_type(obj) == airfoil_objects.EdgeCircles.Type:
+                for edge, key in zip(obj.Shape.Edges, ("le_radius_mm", "te_radius_mm")):
+                    # The circle's own geometry, from OCC, is the block's radius.
+                    self.assertAlmostEqual(edge.Curve.Radius, values[key], places=9)
+                    self.assertAlmostEqual(abs(np.dot(np.array(edge.Curve.Axis), normal)), 1.0,
+                                           places=9)
+            else:
+                ends = [obj.Shape.Vertexes[0].Point, obj.Shape.Vertexes[-1].Point]
+                self.assertLess((ends[0] - obj.LePoint).Length, 1e-6)
+                self.assertLess((ends[1] - obj.TePoint).Length, 1e-6)
+                self.assertAlmostEqual(obj.MaxThicknessMm, values["max_thickness_mm"], 9)
+                self.assertIn("ReadOnly", obj.getEditorMode("LengthMm"))
+        shapes = {o.Name: (o.Shape.Length, o.InputSignature) for o in made}
+        path = os.path.join(self.tmp, "airfoil.FCStd")
+        self.doc.saveCopy(path)
+        copy = FreeCAD.openDocument(path, hidden=True)
+        self.assertNotEqual(copy.Name, self.doc.Name)
+        try:
+            for name, (length, signature) in shapes.items():
+                obj = copy.getObject(name)
+                self.assertAlmostEqual(obj.Shape.Length, length, places=9)
+                self.assertEqual(obj.Proxy.signature(obj), signature)   # nothing to recompute
+            # A recompute forced by a changed input rebuilds the same circle from the CAD.
+            circles = [copy.getObject(n) for n in shapes if n.startswith("EdgeCircles")
+                       and n.endswith("nominal")][0]
+            radius = circles.LeRadiusMm
+            circles.InputSignature = ""
+            circles.Proxy.execute(circles)
+            self.assertAlmostEqual(circles.LeRadiusMm, radius, places=9)
+        finally:
+            FreeCAD.closeDocument(copy.Name)
+
+
+if __name__ == "__main__":
+    unittest.main()
