@@ -53,6 +53,7 @@ class Options:
     characteristics_file: str = None
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
     seed: int = 0
+    le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
 
 
 @dataclass
@@ -63,6 +64,18 @@ class Tolerance:
     upper: float
     nominal: float = None        # overrides the CAD's value when given
     row: int = 0
+
+
+# Which end of the nominal profile is the LE when the CAD's faces do not name it:
+# "engine-axis" -- the flow runs along +engine axis, so the LE is the upstream end (the end
+# furthest along -engine axis in the plane); "larger-radius" -- the blunter end (the kernel's
+# rule without a direction; it picks Rotor 67's TE at 10 % span, whose radius is the larger).
+LE_RULES = ("engine-axis", "larger-radius")
+LE_RULE_TEXT = {"engine-axis": "the upstream end: the flow runs along +engine axis",
+                "larger-radius": "the end with the larger edge radius (the engine axis when "
+                                 "the radii agree within their uncertainty)"}
+# The plane frame's x axis is the engine axis (cad/airfoil_sections.py): upstream is -x.
+UPSTREAM_2D = (-1.0, 0.0)
 
 
 # ---------------------------------------------------------------- options from the CLI
@@ -167,9 +180,13 @@ def read_characteristics(path):
 
 
 def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
-                      edge_offsets=None):
+                      edge_offsets=None, le_rule=None):
     """Options from the command line's text values (None: the default)."""
     opts = Options()
+    if le_rule is not None:
+        if le_rule not in LE_RULES:
+            raise InputError("--le-rule: %r is not one of %s" % (le_rule, ", ".join(LE_RULES)))
+        opts.le_rule = le_rule
     if engine_axis is not None:
         opts.engine_axis = parse_engine_axis(engine_axis)
     if characteristics is not None:
@@ -329,9 +346,11 @@ def _section(nominal, plane, opts, result, rng):
     try:
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
+        upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
         nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
                                      chord_method=opts.chord_method,
-                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint)
+                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint,
+                                     le_upstream=upstream)
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
@@ -536,6 +555,9 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                                            "; ".join(failed)))}
     settings = {"engine_axis": list(map(float, opts.engine_axis)),
                 "chord_method": opts.chord_method,
+                "le_rule": opts.le_rule,
+                "le_rule_meaning": LE_RULE_TEXT[opts.le_rule] + " (unless the CAD's faces "
+                                   "name the LE: the block's le_rule says \"given\")",
                 "edge_offsets_mm": list(map(float, opts.edge_offsets_mm)),
                 "characteristics_file": opts.characteristics_file,
                 "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
