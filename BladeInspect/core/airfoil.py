@@ -558,13 +558,21 @@ def _farthest_pair(profile):
         u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
         start = u.copy()
         for _ in range(_NEWTON_ITERATIONS):
-            u = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+            new = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+            done = abs(new[0] - u[0]) < 1e-13 * profile.length
+            u = new
+            if done:
+                break
         return u
 
     ui = furthest_from(uj)
     for _ in range(6):
+        before = (ui[0], uj[0])
         uj = furthest_from(ui)
         ui = furthest_from(uj)
+        if abs(ui[0] - before[0]) < 1e-13 * profile.length \
+                and abs(uj[0] - before[1]) < 1e-13 * profile.length:
+            break   # each end the furthest point from the other: the pair is settled
     return ui[0], uj[0], profile.eval(ui)[0], profile.eval(uj)[0]
 
 

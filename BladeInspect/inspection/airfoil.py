@@ -16,6 +16,7 @@ scatter over repeated simulated scans).
 """
 
 import csv
+import dataclasses
 import os
 from dataclasses import dataclass, field
 
@@ -23,6 +24,7 @@ import numpy as np
 
 from ..core import airfoil as kernel
 from ..core import contracts
+from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 
@@ -41,7 +43,7 @@ MIN_SECTION_POINTS = 60
 # A measured point is round an edge within this many edge radii of the edge circle's centre.
 EDGE_NEIGHBOURHOOD = 1.5
 CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
-              "lower", "upper", "verdict")
+              "lower", "upper", "U_k2", "decision_rule", "verdict")
 
 
 @dataclass
@@ -54,6 +56,7 @@ class Options:
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
     seed: int = 0
     le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
+    decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
 
 
 @dataclass
@@ -450,15 +453,39 @@ def _tolerance_for(tolerances, label, key):
     return best
 
 
-def _judge(block, tolerances, measured_part=True):
-    """Deviation, tolerance and verdict of each characteristic of one section block; returns
-    the keys that failed."""
+# Expanded uncertainty of a judged characteristic: k times its standard uncertainty (the
+# ``uncertainty`` block, by re-fitting perturbed points).
+COVERAGE_FACTOR = 2.0
+# A characteristic judged with no stated uncertainty (Options.draws = 0) is decided by simple
+# acceptance, and says so: the ISO rule needs a U.
+NO_U_RULE = "simple"
+JUDGED = (decision_mod.PASS, decision_mod.FAIL, decision_mod.NOT_PROVEN, "not measured")
+
+
+def _decision(deviation, u, t, rule):
+    """The decision on one characteristic's deviation against its tolerance row: U = k u under
+    ``rule``; without u, simple acceptance (NO_U_RULE), named in the result."""
+    if u is not None and np.isfinite(u):
+        U, used = COVERAGE_FACTOR * float(u), rule
+    else:
+        U, used = None, NO_U_RULE
+    d = decision_mod.decide(deviation, 0.0 if U is None else U, t.lower, t.upper, rule=used)
+    tur = d.test_uncertainty_ratio
+    return {"verdict": d.verdict, "rule": used, "U": U, "k": COVERAGE_FACTOR,
+            "tur": None if tur is None or not np.isfinite(tur) else float(tur)}
+
+
+def _judge(block, tolerances, measured_part=True, rule="iso14253"):
+    """Deviation, tolerance and verdict of each characteristic of one section block (the
+    decision rule ``rule`` with U = k u, core.decision); returns (the keys that failed, the
+    keys not proven)."""
     if block["nominal"] is None:
-        block.update(tolerance={}, verdicts={}, verdict="not measured")
-        return []
+        block.update(tolerance={}, verdicts={}, decisions={}, verdict="not measured")
+        return [], []
     nominal = _flat(block["nominal"])
     measured = _flat(block["measured"]) if block["measured"] else {}
-    deviation, tol_out, verdicts, failed = {}, {}, {}, []
+    sd = _flat(block["uncertainty"]) if block.get("uncertainty") else {}
+    deviation, tol_out, verdicts, decisions, failed, unproven = {}, {}, {}, {}, [], []
     for key in nominal:
         t = _tolerance_for(tolerances, block["label"], key)
         if t is not None and t.nominal is not None:
@@ -477,19 +504,22 @@ def _judge(block, tolerances, measured_part=True):
             verdicts[key] = "not measured"
             failed.append(key + " (not measured)")
             continue
-        ok = (t.lower is None or deviation[key] >= t.lower) and \
-            (t.upper is None or deviation[key] <= t.upper)
-        verdicts[key] = "pass" if ok else "fail"
-        if not ok:
+        decisions[key] = _decision(deviation[key], sd.get(key), t, rule)
+        verdicts[key] = decisions[key]["verdict"]
+        if verdicts[key] == decision_mod.FAIL:
             failed.append(key)
+        elif verdicts[key] == decision_mod.NOT_PROVEN:
+            unproven.append(key)
     like = block["nominal"]
     block["nominal"] = dict(like, **{k: v for k, v in _unflat(nominal, like).items()})
     block["deviation"] = _unflat(deviation, like) if measured else None
     block["tolerance"] = tol_out
     block["verdicts"] = verdicts
-    judged = [v for v in verdicts.values() if v in ("pass", "fail", "not measured")]
-    block["verdict"] = ("fail" if failed else "pass") if judged else "not judged"
-    return failed
+    block["decisions"] = decisions
+    judged = [v for v in verdicts.values() if v in JUDGED]
+    block["verdict"] = (decision_mod.combine([decision_mod.FAIL if v == "not measured" else v
+                                              for v in judged]) if judged else "not judged")
+    return failed, unproven
 
 
 @dataclass
@@ -520,6 +550,26 @@ def _lean_bow(results, span_axis):
     return lb
 
 
+def stage_verdict(results, failed, unproven):
+    """airfoil_verdict: pass only when every judged characteristic passed (None when nothing
+    is judged); ``verdict`` core.decision's combined pass / not proven / fail."""
+    n_judged = sum(v in JUDGED for r in results for v in r.block["verdicts"].values())
+    combined = (None if n_judged == 0 else decision_mod.FAIL if failed else
+                decision_mod.NOT_PROVEN if unproven else decision_mod.PASS)
+    if n_judged == 0:
+        summary = "airfoil: no characteristic toleranced"
+    elif failed:
+        summary = "airfoil: FAIL %d of %d: %s" % (len(failed), n_judged, "; ".join(failed))
+    elif unproven:
+        summary = "airfoil: NOT PROVEN %d of %d: %s" % (len(unproven), n_judged,
+                                                        "; ".join(unproven))
+    else:
+        summary = "airfoil: PASS (%d characteristics)" % n_judged
+    return {"pass": None if n_judged == 0 else combined == decision_mod.PASS,
+            "verdict": combined, "n_judged": n_judged, "failed": failed,
+            "not_proven": unproven, "summary": summary}
+
+
 def check_sections(opts, planes):
     """A tolerance row's section must be one of the planes' labels (or all)."""
     labels = {p.label for p in planes}
@@ -540,19 +590,16 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     check_sections(opts, planes)
     rng = np.random.default_rng(opts.seed)
     results = [_section(nominal, p, opts, result, rng) for p in planes]
-    failed = []
+    if opts.decision_rule not in decision_mod.RULES:
+        raise InputError("--decision-rule: unknown rule '%s' (use %s)"
+                         % (opts.decision_rule, ", ".join(decision_mod.RULES)))
+    failed, unproven = [], []
     for r in results:
-        failed += ["section %s: %s" % (r.plane.label, k)
-                   for k in _judge(r.block, opts.tolerances, result is not None)]
+        f, n = _judge(r.block, opts.tolerances, result is not None, opts.decision_rule)
+        failed += ["section %s: %s" % (r.plane.label, k) for k in f]
+        unproven += ["section %s: %s" % (r.plane.label, k) for k in n]
         r.block["notes"] = list(r.notes)
-    n_judged = sum(v in ("pass", "fail", "not measured")
-                   for r in results for v in r.block["verdicts"].values())
-    verdict = {"pass": None if n_judged == 0 else not failed, "n_judged": n_judged,
-               "failed": failed,
-               "summary": ("airfoil: no characteristic toleranced" if n_judged == 0 else
-                           "airfoil: PASS (%d characteristics)" % n_judged if not failed else
-                           "airfoil: FAIL %d of %d: %s" % (len(failed), n_judged,
-                                                           "; ".join(failed)))}
+    verdict = stage_verdict(results, failed, unproven)
     settings = {"engine_axis": list(map(float, opts.engine_axis)),
                 "chord_method": opts.chord_method,
                 "le_rule": opts.le_rule,
@@ -564,7 +611,14 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                 "uncertainty_method": "re-fit of perturbed points: pose from the registration "
                                       "covariance and sensor noise on the measured profile's "
                                       "smooth fit, %d draws" % opts.draws,
-                "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1)"}
+                "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1); a judged "
+                                        "characteristic's U = %g u (its `decisions`)"
+                                        % COVERAGE_FACTOR,
+                "decision_rule": opts.decision_rule,
+                "decision_rule_text": decision_mod.RULE_TEXT[opts.decision_rule],
+                "decision_without_u": "a characteristic with no stated u (draws 0) is "
+                                      "decided by %s: %s" % (NO_U_RULE,
+                                                             decision_mod.RULE_TEXT[NO_U_RULE])}
     return Stage(results, [r.block for r in results], _lean_bow(results, span_axis), verdict,
                  settings)
 
@@ -573,16 +627,23 @@ def attach(result, nominal, table, verdict, opts=None):
     """The stage for a report or an inspection: the section table's sections measured from
     the result, the part's verdict taking in every judged characteristic (it fails, naming
     them, when one does). The stage is kept on the table for the report's figures."""
+    opts = dataclasses.replace(opts or Options(),
+                               decision_rule=verdict.get("decision_rule", "iso14253"))
     stage = run_stage(nominal, planes_of_table(table), opts, result, table.span_axis)
     table.airfoil = stage
-    if stage.verdict["pass"] is False:
+    if stage.verdict["verdict"] == decision_mod.FAIL:
         verdict["summary"] = ("FAIL: %s; profile %s" % (stage.verdict["summary"],
                                                          verdict["summary"])
                               if verdict["pass"] else
                               "%s; %s" % (verdict["summary"], stage.verdict["summary"]))
         verdict["pass"] = False
         if "verdict" in verdict:   # the part's decision (core.decision) takes the failure in
-            verdict["verdict"] = "fail"
+            verdict["verdict"] = decision_mod.FAIL
+    elif stage.verdict["verdict"] == decision_mod.NOT_PROVEN:
+        verdict["summary"] = "%s; %s" % (verdict["summary"], stage.verdict["summary"])
+        verdict["pass"] = False    # not proven is never rounded to pass
+        if verdict.get("verdict") in (decision_mod.PASS, None):
+            verdict["verdict"] = decision_mod.NOT_PROVEN
     verdict["airfoil"] = stage.verdict
     return stage
 
@@ -606,8 +667,10 @@ def csv_rows(blocks):
         unc = _flat(b["uncertainty"]) if b.get("uncertainty") else {}
         for key in nom:
             t = b["tolerance"].get(key, {})
+            d = (b.get("decisions") or {}).get(key, {})
             rows.append([b["label"], key, nom[key], mea.get(key), dev.get(key), unc.get(key),
-                         t.get("lower"), t.get("upper"), b["verdicts"][key]])
+                         t.get("lower"), t.get("upper"), d.get("U"), d.get("rule"),
+                         b["verdicts"][key]])
     return rows
 
 
