@@ -369,17 +369,14 @@ def _section(nominal, plane, opts, result, rng):
     sr.block = block
     if result is None:
         return sr
-    idx = np.asarray(plane.point_index if plane.point_index is not None else [], dtype=int)
-    idx = idx[result.inlier[idx]] if len(idx) else idx
+    idx = _section_points(plane, result)
     if len(idx) < MIN_SECTION_POINTS:
         sr.notes.append("measured: %d points in the section, %d needed"
                         % (len(idx), MIN_SECTION_POINTS))
         return sr
-    xyz = _into_plane(result.points_cad[idx], result.normal[idx], frame.origin, frame.normal)
-    pts = frame.to_2d(xyz)
-    noise = _point_noise(pts, nom.profile)
     try:
-        ch, fit, cont, ordered = _measure(pts, nom, opts, noise, nom.le_point)
+        ch, fit, cont, ordered, noise = _measure_at(result.points_cad[idx], result.normal[idx],
+                                                    frame, nom, opts)
     except InputError as exc:
         sr.notes.append("measured: %s" % exc)
         return sr
@@ -395,6 +392,21 @@ def _section(nominal, plane, opts, result, rng):
         block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
                                             measured_values)
     return sr
+
+
+def _section_points(plane, result):
+    """Indices of the section's inlier points."""
+    idx = np.asarray(plane.point_index if plane.point_index is not None else [], dtype=int)
+    return idx[result.inlier[idx]] if len(idx) else idx
+
+
+def _measure_at(xyz, normals, frame, nom, opts):
+    """The measured characteristics of a section's points (CAD frame): slid into the plane,
+    given their noise, measured against the nominal."""
+    pts = frame.to_2d(_into_plane(xyz, normals, frame.origin, frame.normal))
+    noise = _point_noise(pts, nom.profile)
+    ch, fit, cont, ordered = _measure(pts, nom, opts, noise, nom.le_point)
+    return ch, fit, cont, ordered, noise
 
 
 def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values):
@@ -645,7 +657,96 @@ def attach(result, nominal, table, verdict, opts=None):
         if verdict.get("verdict") in (decision_mod.PASS, None):
             verdict["verdict"] = decision_mod.NOT_PROVEN
     verdict["airfoil"] = stage.verdict
+    if getattr(result, "fit_sensitivity", None):   # issue 16 item 2: the airfoil rows
+        add_to_sensitivity(result.fit_sensitivity, stage, result, opts)
     return stage
+
+
+UNITS = {"deg": "deg", "pct": "%", "mm2": "mm2", "mm": "mm"}
+
+
+def _unit_of(key):
+    base = _base_name(key)
+    return next(UNITS[u] for u in ("deg", "pct", "mm2", "mm") if base.endswith("_" + u))
+
+
+def add_to_sensitivity(doc, stage, result, opts):
+    """The airfoil characteristics as rows of ``fit_sensitivity`` (inspection.fitting): every
+    measured characteristic's deviation and verdict under each fit objective, re-measured from
+    the points moved by that objective's motion (``cad_motion_by_fit``, from the least-squares
+    start; the result stands at the chosen one's). U is the chosen fit's (the measurement's,
+    about the same under every pose). ``largest_change_airfoil`` names the row whose change
+    across the fits is largest in units of its U (k = 2), and ``airfoil_verdict_by_fit`` the
+    airfoil verdict under each fit."""
+    motions = doc.get("cad_motion_by_fit")
+    if not motions:
+        return
+    chosen = np.asarray(motions[doc["chosen"]], dtype=float)
+    back = np.linalg.inv(chosen)
+    per_fit = {}
+    quiet = dataclasses.replace(opts, draws=0)
+    for objective in doc["objectives"]:
+        if objective == doc["chosen"]:
+            per_fit[objective] = {r.plane.label: r.block for r in stage.sections}
+            continue
+        move = np.asarray(motions[objective], dtype=float) @ back
+        if np.allclose(move, np.eye(4), atol=1e-15):
+            per_fit[objective] = {r.plane.label: r.block for r in stage.sections}
+            continue
+        view = dataclasses.replace(result, points_cad=tf.apply_transform(move, result.points_cad))
+        blocks = {}
+        for r in stage.sections:
+            if r.measured is None:
+                continue
+            idx = _section_points(r.plane, view)
+            try:
+                ch, fit, cont, _, _ = _measure_at(view.points_cad[idx], view.normal[idx],
+                                                  r.frame, r.nominal, quiet)
+            except InputError:
+                continue
+            b = {"label": r.block["label"], "nominal": dict(r.block["nominal"]),
+                 "measured": _char_values(ch, r.frame, fit, cont),
+                 "uncertainty": r.block.get("uncertainty")}
+            _judge(b, opts.tolerances, True, opts.decision_rule)
+            blocks[r.plane.label] = b
+        per_fit[objective] = blocks
+    rows, largest = [], None
+    for r in stage.sections:
+        label = r.plane.label
+        base = per_fit[doc["chosen"]].get(label)
+        if base is None or not base.get("deviation"):
+            continue
+        for key in _flat(base["deviation"]):
+            cells = {}
+            for objective in doc["objectives"]:
+                b = per_fit[objective].get(label)
+                dev = _flat(b["deviation"]).get(key) if b and b.get("deviation") else None
+                d = (b or {}).get("decisions", {}).get(key, {})
+                cells[objective] = {"value": dev, "U": d.get("U"),
+                                    "verdict": (b or {}).get("verdicts", {}).get(key)}
+            values = [c["value"] for c in cells.values() if c["value"] is not None]
+            change = float(max(values) - min(values)) if values else 0.0
+            row = {"characteristic": "section %s %s" % (label, key), "unit": _unit_of(key),
+                   "by_fit": cells, "change": change, "airfoil": True}
+            rows.append(row)
+            u = _flat(base.get("uncertainty") or {}).get(key)
+            if u:
+                score = change / (COVERAGE_FACTOR * u)
+                if largest is None or score > largest["change_over_U"]:
+                    largest = {"characteristic": row["characteristic"], "change": change,
+                               "unit": row["unit"], "change_over_U": float(score)}
+    doc["rows"] = doc["rows"] + rows
+    doc["largest_change_airfoil"] = largest
+    doc["largest_change_airfoil_rule"] = ("the airfoil row whose change across the fits is "
+                                          "largest in units of its U (k = 2); none when no "
+                                          "u is stated")
+    by_fit = {}
+    for objective, blocks in per_fit.items():
+        verdicts = [v for b in blocks.values() for v in b.get("verdicts", {}).values()
+                    if v in JUDGED]
+        by_fit[objective] = decision_mod.combine(
+            [decision_mod.FAIL if v == "not measured" else v for v in verdicts])
+    doc["airfoil_verdict_by_fit"] = by_fit
 
 
 def extras_of(table):
