@@ -628,19 +628,15 @@ class CircleFit2D:
     zone_deg: float
 
 
-def fit_circle_2d(xy, start=None):
-    """Geometric least-squares circle (Gauss-Newton from Kasa's algebraic circle, or from
-    ``start`` = (centre, radius), a nearby circle: the previous zone's)."""
+def fit_circle_2d(xy):
+    """Geometric least-squares circle (Gauss-Newton from Kasa's algebraic circle)."""
     xy = np.asarray(xy, dtype=float)
     if len(xy) < 3:
         raise InputError("edge circle fit: fewer than 3 points in the edge zone")
-    if start is None:
-        A = np.column_stack([2.0 * xy, np.ones(len(xy))])
-        sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
-        c = sol[:2]
-        r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
-    else:
-        c, r = np.array(start[0], dtype=float), float(start[1])
+    A = np.column_stack([2.0 * xy, np.ones(len(xy))])
+    sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
+    c = sol[:2]
+    r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
     for _ in range(50):
         v = xy - c
         rho = np.linalg.norm(v, axis=1)
@@ -680,7 +676,7 @@ def _edge_circle(profile, end_centre, outward, edge_u, zone_deg):
             cycle = [fit for _, fit in seen[earlier[-1]:]]
             centre, radius, rms, n = max(cycle, key=lambda f: f[3])
             return CircleFit2D(centre, radius, rms, n, zone_deg)
-        centre, radius, rms = fit_circle_2d(xy, start=seen[-1][1][:2] if seen else None)
+        centre, radius, rms = fit_circle_2d(xy)
         seen.append((key, (centre, radius, rms, len(xy))))
     centre, radius, rms, n = seen[-1][1]
     return CircleFit2D(centre, radius, rms, n, zone_deg)
