@@ -68,5 +68,27 @@ class Rotor67LeadingEdge(unittest.TestCase):
             stage_mod.options_from_args(le_rule="sharper")
 
 
+class CommandLineDefaults(unittest.TestCase):
+    """report, inspect and batch compute the airfoil block unless --no-airfoil."""
+
+    def _options(self, argv):
+        from BladeInspect import cli
+        return cli._airfoil_options(cli.build_parser().parse_args(argv))
+
+    def test_on_by_default_with_the_engine_axis_rule(self):
+        from BladeInspect.core.errors import InputError
+        for base in (["report", "--cad", "c.step", "--points", "p.csv", "--out", "o"],
+                     ["inspect", "--out", "o"], ["batch", "--cad", "c.step", "--scans", "s",
+                                                 "--out", "o"]):
+            opts = self._options(base)
+            self.assertIsNotNone(opts, base)
+            self.assertEqual(opts.le_rule, "engine-axis")
+            self.assertEqual(self._options(base + ["--le-rule", "larger-radius"]).le_rule,
+                             "larger-radius")
+            self.assertIsNone(self._options(base + ["--no-airfoil"]))
+            with self.assertRaises(InputError):
+                self._options(base + ["--no-airfoil", "--engine-axis", "z"])
+
+
 if __name__ == "__main__":
     unittest.main()
