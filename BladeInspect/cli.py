@@ -319,11 +319,13 @@ def cmd_simrig(args):
 
 
 def _airfoil_arguments(parser, always):
-    # report and inspect add the airfoil characteristics on request (--airfoil or any of its
-    # options): they cost about 4 s a section with their uncertainty.
+    # report, inspect and batch add the airfoil characteristics unless --no-airfoil (issue 15:
+    # result.json always gains `airfoil`); --airfoil, the former switch, is kept and a no-op.
     if not always:
         parser.add_argument("--airfoil", action="store_true",
-                            help="add the airfoil characteristics per section (issue 15)")
+                            help="add the airfoil characteristics per section (the default)")
+        parser.add_argument("--no-airfoil", action="store_true",
+                            help="leave out the airfoil characteristics (issue 15)")
     parser.add_argument("--engine-axis", default=None,
                         help="engine axis: x, y, z, -x, ... or \"1,0,0\" (default the CAD's +X)")
     parser.add_argument("--characteristics", default=None, metavar="FILE",
@@ -333,13 +335,21 @@ def _airfoil_arguments(parser, always):
                         help="chord definition (default nose-tail)")
     parser.add_argument("--edge-offsets", default=None, metavar="MM,MM,...",
                         help="edge thickness offsets from the LE/TE points (default 0.5,1,2)")
+    parser.add_argument("--le-rule", default=None, choices=("engine-axis", "larger-radius"),
+                        help="which end is the LE when the CAD does not name it: the upstream "
+                             "end along the engine axis (default; the flow runs along +axis) "
+                             "or the larger edge radius")
 
 
 def _airfoil_options(args):
-    """inspection.airfoil.Options from the command's arguments; None when report/inspect were
-    not asked for the airfoil characteristics."""
-    given = [args.engine_axis, args.characteristics, args.chord_method, args.edge_offsets]
-    if not getattr(args, "airfoil", True) and all(v is None for v in given):
+    """inspection.airfoil.Options from the command's arguments; None with --no-airfoil."""
+    given = [args.engine_axis, args.characteristics, args.chord_method, args.edge_offsets,
+             args.le_rule]
+    if getattr(args, "no_airfoil", False):
+        if any(v is not None for v in given) or args.airfoil:
+            raise InputError("--no-airfoil: cannot be given with --airfoil or the airfoil "
+                             "options (--engine-axis, --characteristics, --chord-method, "
+                             "--edge-offsets, --le-rule)")
         return None
     from .inspection.airfoil import options_from_args
     return options_from_args(*given)

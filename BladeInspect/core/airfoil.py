@@ -47,6 +47,10 @@ _CORNER_DEG = 20.0
 _CORNER_RUN = 5
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
+_ZONE_GRID, _ZONE_GRID_ROUNDS = 256, 4
+# A resampled zone (too few input points) moves with its fitted centre and converges linearly:
+# it is settled when its bounds move by less than this (a nanometre; the radius moves far less).
+_ZONE_SETTLED_MM = 1e-6
 _ZONE_MIN_POINTS = 12
 _END_SKIP = 0.5
 # Metal angles: the camber line's end tangent is the slope at its end of a quartic in arc
@@ -554,13 +558,21 @@ def _farthest_pair(profile):
         u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
         start = u.copy()
         for _ in range(_NEWTON_ITERATIONS):
-            u = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+            new = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
+            done = abs(new[0] - u[0]) < 1e-13 * profile.length
+            u = new
+            if done:
+                break
         return u
 
     ui = furthest_from(uj)
     for _ in range(6):
+        before = (ui[0], uj[0])
         uj = furthest_from(ui)
         ui = furthest_from(uj)
+        if abs(ui[0] - before[0]) < 1e-13 * profile.length \
+                and abs(uj[0] - before[1]) < 1e-13 * profile.length:
+            break   # each end the furthest point from the other: the pair is settled
     return ui[0], uj[0], profile.eval(ui)[0], profile.eval(uj)[0]
 
 
@@ -641,38 +653,51 @@ def _edge_circle(profile, end_centre, outward, edge_u, zone_deg):
     """Circle fitted to the edge zone: the stretch of profile round the edge point (parameter
     edge_u) seen within +-zone_deg of the camber line's outward direction from the fitted
     circle's own centre (first from the last inscribed circle's centre; re-fitted until the
-    zone stops changing). The fit is to the profile curve resampled finely over the zone."""
+    zone stops changing). The fit is to the input points in the zone (_zone_points).
+
+    On measured points the zone's set of points may alternate between two sets (one fitted
+    centre sees a boundary point, the other's does not): no set is then seen from its own
+    fit's centre, and the larger of the sets in the cycle is kept (more points, the smaller
+    radius uncertainty) -- a choice independent of the number of rounds run."""
     centre = np.asarray(end_centre, dtype=float)
     zone = None
+    seen = []            # (point set key, fit) of each round, for a cycle's detection
     for _ in range(_ZONE_ROUNDS):
         lo, hi = _zone_range(profile, centre, outward, edge_u, zone_deg)
-        if zone is not None and abs(lo - zone[0]) < 1e-9 and abs(hi - zone[1]) < 1e-9:
+        settled = 1e-9 if not seen or seen[-1][0] is not None else _ZONE_SETTLED_MM
+        if zone is not None and abs(lo - zone[0]) < settled and abs(hi - zone[1]) < settled:
             break
+        xy, key = _zone_points(profile, lo, hi)
         zone = (lo, hi)
-        xy = _zone_points(profile, lo, hi)
+        earlier = [k for k, (kk, _) in enumerate(seen) if key is not None and kk == key]
+        if earlier:
+            if earlier[-1] == len(seen) - 1:      # the same points: the same fit, converged
+                break
+            cycle = [fit for _, fit in seen[earlier[-1]:]]
+            centre, radius, rms, n = max(cycle, key=lambda f: f[3])
+            return CircleFit2D(centre, radius, rms, n, zone_deg)
         centre, radius, rms = fit_circle_2d(xy)
-    return CircleFit2D(centre, radius, rms, len(xy), zone_deg)
+        seen.append((key, (centre, radius, rms, len(xy))))
+    centre, radius, rms, n = seen[-1][1]
+    return CircleFit2D(centre, radius, rms, n, zone_deg)
 
 
 def _zone_points(profile, lo, hi):
     """The input points in the parameter range [lo, hi] (unwrapped) when there are at least
     _ZONE_MIN_POINTS of them -- measured points fit without any smoothing's bias -- else the
-    profile curve resampled finely over it."""
+    profile curve resampled finely over it. Returns the points and a key of the input points
+    taken (None for a resampled curve, which moves with the range)."""
     u = np.mod(profile.point_params - lo, profile.length)
     inside = u <= hi - lo
     if inside.sum() >= _ZONE_MIN_POINTS:
-        return profile.points[inside]
-    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES))
+        return profile.points[inside], np.flatnonzero(inside).tobytes()
+    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES)), None
 
 
 def _zone_range(profile, centre, outward, edge_u, zone_deg):
     """Unwrapped parameter range round edge_u where the profile is seen from ``centre``
     within zone_deg of ``outward`` (to the exact crossing of the zone's bounding rays)."""
     cos_zone = np.cos(np.radians(zone_deg))
-
-    def inside(u):
-        return _unit(profile.eval(u) - centre) @ outward >= cos_zone
-
     n = len(profile.dense)
     h = profile.length / n
     i0 = int(np.round(np.mod(edge_u, profile.length) / h)) % n
@@ -682,12 +707,20 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     ahead = int(np.argmin(seen))                 # first sample outside, going forwards
     behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
     base = profile.dense_u[i0]
+    # Each bound lies between its last sample inside (a) and the next one out (a + step);
+    # the bracket is cut into _ZONE_GRID parts per round, both bounds in one evaluation:
+    # the resolution of 32 bisections (h / 2**32, far below a nanometre) in 4 rounds.
     a = np.array([base - behind * h, base + (ahead - 1) * h])
-    b = a + np.array([-h, h])
-    for _ in range(32):          # h / 2**32: far below a nanometre
-        m = 0.5 * (a + b)
-        ok = inside(m)
-        a, b = np.where(ok, m, a), np.where(ok, b, m)
+    step = np.array([-h, h])
+    frac = np.arange(1, _ZONE_GRID) / _ZONE_GRID
+    for _ in range(_ZONE_GRID_ROUNDS):
+        trial = a[:, None] + step[:, None] * frac[None, :]
+        ok = (_unit(profile.eval(trial.ravel()) - centre) @ outward >= cos_zone)
+        ok = ok.reshape(trial.shape)
+        # the last grid point inside before the first one outside
+        first_out = np.where(ok.all(axis=1), _ZONE_GRID - 1, np.argmin(ok, axis=1))
+        a = a + step * first_out / _ZONE_GRID
+        step = step / _ZONE_GRID
     return float(a[0]), float(a[1])
 
 

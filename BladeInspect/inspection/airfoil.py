@@ -16,6 +16,7 @@ scatter over repeated simulated scans).
 """
 
 import csv
+import dataclasses
 import os
 from dataclasses import dataclass, field
 
@@ -23,6 +24,7 @@ import numpy as np
 
 from ..core import airfoil as kernel
 from ..core import contracts
+from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 
@@ -41,7 +43,7 @@ MIN_SECTION_POINTS = 60
 # A measured point is round an edge within this many edge radii of the edge circle's centre.
 EDGE_NEIGHBOURHOOD = 1.5
 CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
-              "lower", "upper", "verdict")
+              "lower", "upper", "U_k2", "decision_rule", "verdict")
 
 
 @dataclass
@@ -53,6 +55,8 @@ class Options:
     characteristics_file: str = None
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
     seed: int = 0
+    le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
+    decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
 
 
 @dataclass
@@ -63,6 +67,18 @@ class Tolerance:
     upper: float
     nominal: float = None        # overrides the CAD's value when given
     row: int = 0
+
+
+# Which end of the nominal profile is the LE when the CAD's faces do not name it:
+# "engine-axis" -- the flow runs along +engine axis, so the LE is the upstream end (the end
+# furthest along -engine axis in the plane); "larger-radius" -- the blunter end (the kernel's
+# rule without a direction; it picks Rotor 67's TE at 10 % span, whose radius is the larger).
+LE_RULES = ("engine-axis", "larger-radius")
+LE_RULE_TEXT = {"engine-axis": "the upstream end: the flow runs along +engine axis",
+                "larger-radius": "the end with the larger edge radius (the engine axis when "
+                                 "the radii agree within their uncertainty)"}
+# The plane frame's x axis is the engine axis (cad/airfoil_sections.py): upstream is -x.
+UPSTREAM_2D = (-1.0, 0.0)
 
 
 # ---------------------------------------------------------------- options from the CLI
@@ -167,9 +183,13 @@ def read_characteristics(path):
 
 
 def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
-                      edge_offsets=None):
+                      edge_offsets=None, le_rule=None):
     """Options from the command line's text values (None: the default)."""
     opts = Options()
+    if le_rule is not None:
+        if le_rule not in LE_RULES:
+            raise InputError("--le-rule: %r is not one of %s" % (le_rule, ", ".join(LE_RULES)))
+        opts.le_rule = le_rule
     if engine_axis is not None:
         opts.engine_axis = parse_engine_axis(engine_axis)
     if characteristics is not None:
@@ -329,9 +349,11 @@ def _section(nominal, plane, opts, result, rng):
     try:
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
+        upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
         nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
                                      chord_method=opts.chord_method,
-                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint)
+                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint,
+                                     le_upstream=upstream)
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
@@ -347,17 +369,14 @@ def _section(nominal, plane, opts, result, rng):
     sr.block = block
     if result is None:
         return sr
-    idx = np.asarray(plane.point_index if plane.point_index is not None else [], dtype=int)
-    idx = idx[result.inlier[idx]] if len(idx) else idx
+    idx = _section_points(plane, result)
     if len(idx) < MIN_SECTION_POINTS:
         sr.notes.append("measured: %d points in the section, %d needed"
                         % (len(idx), MIN_SECTION_POINTS))
         return sr
-    xyz = _into_plane(result.points_cad[idx], result.normal[idx], frame.origin, frame.normal)
-    pts = frame.to_2d(xyz)
-    noise = _point_noise(pts, nom.profile)
     try:
-        ch, fit, cont, ordered = _measure(pts, nom, opts, noise, nom.le_point)
+        ch, fit, cont, ordered, noise = _measure_at(result.points_cad[idx], result.normal[idx],
+                                                    frame, nom, opts)
     except InputError as exc:
         sr.notes.append("measured: %s" % exc)
         return sr
@@ -373,6 +392,21 @@ def _section(nominal, plane, opts, result, rng):
         block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
                                             measured_values)
     return sr
+
+
+def _section_points(plane, result):
+    """Indices of the section's inlier points."""
+    idx = np.asarray(plane.point_index if plane.point_index is not None else [], dtype=int)
+    return idx[result.inlier[idx]] if len(idx) else idx
+
+
+def _measure_at(xyz, normals, frame, nom, opts):
+    """The measured characteristics of a section's points (CAD frame): slid into the plane,
+    given their noise, measured against the nominal."""
+    pts = frame.to_2d(_into_plane(xyz, normals, frame.origin, frame.normal))
+    noise = _point_noise(pts, nom.profile)
+    ch, fit, cont, ordered = _measure(pts, nom, opts, noise, nom.le_point)
+    return ch, fit, cont, ordered, noise
 
 
 def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values):
@@ -431,15 +465,39 @@ def _tolerance_for(tolerances, label, key):
     return best
 
 
-def _judge(block, tolerances, measured_part=True):
-    """Deviation, tolerance and verdict of each characteristic of one section block; returns
-    the keys that failed."""
+# Expanded uncertainty of a judged characteristic: k times its standard uncertainty (the
+# ``uncertainty`` block, by re-fitting perturbed points).
+COVERAGE_FACTOR = 2.0
+# A characteristic judged with no stated uncertainty (Options.draws = 0) is decided by simple
+# acceptance, and says so: the ISO rule needs a U.
+NO_U_RULE = "simple"
+JUDGED = (decision_mod.PASS, decision_mod.FAIL, decision_mod.NOT_PROVEN, "not measured")
+
+
+def _decision(deviation, u, t, rule):
+    """The decision on one characteristic's deviation against its tolerance row: U = k u under
+    ``rule``; without u, simple acceptance (NO_U_RULE), named in the result."""
+    if u is not None and np.isfinite(u):
+        U, used = COVERAGE_FACTOR * float(u), rule
+    else:
+        U, used = None, NO_U_RULE
+    d = decision_mod.decide(deviation, 0.0 if U is None else U, t.lower, t.upper, rule=used)
+    tur = d.test_uncertainty_ratio
+    return {"verdict": d.verdict, "rule": used, "U": U, "k": COVERAGE_FACTOR,
+            "tur": None if tur is None or not np.isfinite(tur) else float(tur)}
+
+
+def _judge(block, tolerances, measured_part=True, rule="iso14253"):
+    """Deviation, tolerance and verdict of each characteristic of one section block (the
+    decision rule ``rule`` with U = k u, core.decision); returns (the keys that failed, the
+    keys not proven)."""
     if block["nominal"] is None:
-        block.update(tolerance={}, verdicts={}, verdict="not measured")
-        return []
+        block.update(tolerance={}, verdicts={}, decisions={}, verdict="not measured")
+        return [], []
     nominal = _flat(block["nominal"])
     measured = _flat(block["measured"]) if block["measured"] else {}
-    deviation, tol_out, verdicts, failed = {}, {}, {}, []
+    sd = _flat(block["uncertainty"]) if block.get("uncertainty") else {}
+    deviation, tol_out, verdicts, decisions, failed, unproven = {}, {}, {}, {}, [], []
     for key in nominal:
         t = _tolerance_for(tolerances, block["label"], key)
         if t is not None and t.nominal is not None:
@@ -458,19 +516,22 @@ def _judge(block, tolerances, measured_part=True):
             verdicts[key] = "not measured"
             failed.append(key + " (not measured)")
             continue
-        ok = (t.lower is None or deviation[key] >= t.lower) and \
-            (t.upper is None or deviation[key] <= t.upper)
-        verdicts[key] = "pass" if ok else "fail"
-        if not ok:
+        decisions[key] = _decision(deviation[key], sd.get(key), t, rule)
+        verdicts[key] = decisions[key]["verdict"]
+        if verdicts[key] == decision_mod.FAIL:
             failed.append(key)
+        elif verdicts[key] == decision_mod.NOT_PROVEN:
+            unproven.append(key)
     like = block["nominal"]
     block["nominal"] = dict(like, **{k: v for k, v in _unflat(nominal, like).items()})
     block["deviation"] = _unflat(deviation, like) if measured else None
     block["tolerance"] = tol_out
     block["verdicts"] = verdicts
-    judged = [v for v in verdicts.values() if v in ("pass", "fail", "not measured")]
-    block["verdict"] = ("fail" if failed else "pass") if judged else "not judged"
-    return failed
+    block["decisions"] = decisions
+    judged = [v for v in verdicts.values() if v in JUDGED]
+    block["verdict"] = (decision_mod.combine([decision_mod.FAIL if v == "not measured" else v
+                                              for v in judged]) if judged else "not judged")
+    return failed, unproven
 
 
 @dataclass
@@ -501,6 +562,26 @@ def _lean_bow(results, span_axis):
     return lb
 
 
+def stage_verdict(results, failed, unproven):
+    """airfoil_verdict: pass only when every judged characteristic passed (None when nothing
+    is judged); ``verdict`` core.decision's combined pass / not proven / fail."""
+    n_judged = sum(v in JUDGED for r in results for v in r.block["verdicts"].values())
+    combined = (None if n_judged == 0 else decision_mod.FAIL if failed else
+                decision_mod.NOT_PROVEN if unproven else decision_mod.PASS)
+    if n_judged == 0:
+        summary = "airfoil: no characteristic toleranced"
+    elif failed:
+        summary = "airfoil: FAIL %d of %d: %s" % (len(failed), n_judged, "; ".join(failed))
+    elif unproven:
+        summary = "airfoil: NOT PROVEN %d of %d: %s" % (len(unproven), n_judged,
+                                                        "; ".join(unproven))
+    else:
+        summary = "airfoil: PASS (%d characteristics)" % n_judged
+    return {"pass": None if n_judged == 0 else combined == decision_mod.PASS,
+            "verdict": combined, "n_judged": n_judged, "failed": failed,
+            "not_proven": unproven, "summary": summary}
+
+
 def check_sections(opts, planes):
     """A tolerance row's section must be one of the planes' labels (or all)."""
     labels = {p.label for p in planes}
@@ -521,28 +602,35 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     check_sections(opts, planes)
     rng = np.random.default_rng(opts.seed)
     results = [_section(nominal, p, opts, result, rng) for p in planes]
-    failed = []
+    if opts.decision_rule not in decision_mod.RULES:
+        raise InputError("--decision-rule: unknown rule '%s' (use %s)"
+                         % (opts.decision_rule, ", ".join(decision_mod.RULES)))
+    failed, unproven = [], []
     for r in results:
-        failed += ["section %s: %s" % (r.plane.label, k)
-                   for k in _judge(r.block, opts.tolerances, result is not None)]
+        f, n = _judge(r.block, opts.tolerances, result is not None, opts.decision_rule)
+        failed += ["section %s: %s" % (r.plane.label, k) for k in f]
+        unproven += ["section %s: %s" % (r.plane.label, k) for k in n]
         r.block["notes"] = list(r.notes)
-    n_judged = sum(v in ("pass", "fail", "not measured")
-                   for r in results for v in r.block["verdicts"].values())
-    verdict = {"pass": None if n_judged == 0 else not failed, "n_judged": n_judged,
-               "failed": failed,
-               "summary": ("airfoil: no characteristic toleranced" if n_judged == 0 else
-                           "airfoil: PASS (%d characteristics)" % n_judged if not failed else
-                           "airfoil: FAIL %d of %d: %s" % (len(failed), n_judged,
-                                                           "; ".join(failed)))}
+    verdict = stage_verdict(results, failed, unproven)
     settings = {"engine_axis": list(map(float, opts.engine_axis)),
                 "chord_method": opts.chord_method,
+                "le_rule": opts.le_rule,
+                "le_rule_meaning": LE_RULE_TEXT[opts.le_rule] + " (unless the CAD's faces "
+                                   "name the LE: the block's le_rule says \"given\")",
                 "edge_offsets_mm": list(map(float, opts.edge_offsets_mm)),
                 "characteristics_file": opts.characteristics_file,
                 "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
                 "uncertainty_method": "re-fit of perturbed points: pose from the registration "
                                       "covariance and sensor noise on the measured profile's "
                                       "smooth fit, %d draws" % opts.draws,
-                "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1)"}
+                "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1); a judged "
+                                        "characteristic's U = %g u (its `decisions`)"
+                                        % COVERAGE_FACTOR,
+                "decision_rule": opts.decision_rule,
+                "decision_rule_text": decision_mod.RULE_TEXT[opts.decision_rule],
+                "decision_without_u": "a characteristic with no stated u (draws 0) is "
+                                      "decided by %s: %s" % (NO_U_RULE,
+                                                             decision_mod.RULE_TEXT[NO_U_RULE])}
     return Stage(results, [r.block for r in results], _lean_bow(results, span_axis), verdict,
                  settings)
 
@@ -551,18 +639,114 @@ def attach(result, nominal, table, verdict, opts=None):
     """The stage for a report or an inspection: the section table's sections measured from
     the result, the part's verdict taking in every judged characteristic (it fails, naming
     them, when one does). The stage is kept on the table for the report's figures."""
+    opts = dataclasses.replace(opts or Options(),
+                               decision_rule=verdict.get("decision_rule", "iso14253"))
     stage = run_stage(nominal, planes_of_table(table), opts, result, table.span_axis)
     table.airfoil = stage
-    if stage.verdict["pass"] is False:
+    if stage.verdict["verdict"] == decision_mod.FAIL:
         verdict["summary"] = ("FAIL: %s; profile %s" % (stage.verdict["summary"],
                                                          verdict["summary"])
                               if verdict["pass"] else
                               "%s; %s" % (verdict["summary"], stage.verdict["summary"]))
         verdict["pass"] = False
         if "verdict" in verdict:   # the part's decision (core.decision) takes the failure in
-            verdict["verdict"] = "fail"
+            verdict["verdict"] = decision_mod.FAIL
+    elif stage.verdict["verdict"] == decision_mod.NOT_PROVEN:
+        verdict["summary"] = "%s; %s" % (verdict["summary"], stage.verdict["summary"])
+        verdict["pass"] = False    # not proven is never rounded to pass
+        if verdict.get("verdict") in (decision_mod.PASS, None):
+            verdict["verdict"] = decision_mod.NOT_PROVEN
     verdict["airfoil"] = stage.verdict
+    if getattr(result, "fit_sensitivity", None):   # issue 16 item 2: the airfoil rows
+        add_to_sensitivity(result.fit_sensitivity, stage, result, opts)
     return stage
+
+
+UNITS = {"deg": "deg", "pct": "%", "mm2": "mm2", "mm": "mm"}
+
+
+def _unit_of(key):
+    base = _base_name(key)
+    return next(UNITS[u] for u in ("deg", "pct", "mm2", "mm") if base.endswith("_" + u))
+
+
+def add_to_sensitivity(doc, stage, result, opts):
+    """The airfoil characteristics as rows of ``fit_sensitivity`` (inspection.fitting): every
+    measured characteristic's deviation and verdict under each fit objective, re-measured from
+    the points moved by that objective's motion (``cad_motion_by_fit``, from the least-squares
+    start; the result stands at the chosen one's). U is the chosen fit's (the measurement's,
+    about the same under every pose). ``largest_change_airfoil`` names the row whose change
+    across the fits is largest in units of its U (k = 2), and ``airfoil_verdict_by_fit`` the
+    airfoil verdict under each fit."""
+    motions = doc.get("cad_motion_by_fit")
+    if not motions:
+        return
+    chosen = np.asarray(motions[doc["chosen"]], dtype=float)
+    back = np.linalg.inv(chosen)
+    per_fit = {}
+    quiet = dataclasses.replace(opts, draws=0)
+    for objective in doc["objectives"]:
+        if objective == doc["chosen"]:
+            per_fit[objective] = {r.plane.label: r.block for r in stage.sections}
+            continue
+        move = np.asarray(motions[objective], dtype=float) @ back
+        if np.allclose(move, np.eye(4), atol=1e-15):
+            per_fit[objective] = {r.plane.label: r.block for r in stage.sections}
+            continue
+        view = dataclasses.replace(result, points_cad=tf.apply_transform(move, result.points_cad))
+        blocks = {}
+        for r in stage.sections:
+            if r.measured is None:
+                continue
+            idx = _section_points(r.plane, view)
+            try:
+                ch, fit, cont, _, _ = _measure_at(view.points_cad[idx], view.normal[idx],
+                                                  r.frame, r.nominal, quiet)
+            except InputError:
+                continue
+            b = {"label": r.block["label"], "nominal": dict(r.block["nominal"]),
+                 "measured": _char_values(ch, r.frame, fit, cont),
+                 "uncertainty": r.block.get("uncertainty")}
+            _judge(b, opts.tolerances, True, opts.decision_rule)
+            blocks[r.plane.label] = b
+        per_fit[objective] = blocks
+    rows, largest = [], None
+    for r in stage.sections:
+        label = r.plane.label
+        base = per_fit[doc["chosen"]].get(label)
+        if base is None or not base.get("deviation"):
+            continue
+        for key in _flat(base["deviation"]):
+            cells = {}
+            for objective in doc["objectives"]:
+                b = per_fit[objective].get(label)
+                dev = _flat(b["deviation"]).get(key) if b and b.get("deviation") else None
+                d = (b or {}).get("decisions", {}).get(key, {})
+                cells[objective] = {"value": dev, "U": d.get("U"),
+                                    "verdict": (b or {}).get("verdicts", {}).get(key)}
+            values = [c["value"] for c in cells.values() if c["value"] is not None]
+            change = float(max(values) - min(values)) if values else 0.0
+            row = {"characteristic": "section %s %s" % (label, key), "unit": _unit_of(key),
+                   "by_fit": cells, "change": change, "airfoil": True}
+            rows.append(row)
+            u = _flat(base.get("uncertainty") or {}).get(key)
+            if u:
+                score = change / (COVERAGE_FACTOR * u)
+                if largest is None or score > largest["change_over_U"]:
+                    largest = {"characteristic": row["characteristic"], "change": change,
+                               "unit": row["unit"], "change_over_U": float(score)}
+    doc["rows"] = doc["rows"] + rows
+    doc["largest_change_airfoil"] = largest
+    doc["largest_change_airfoil_rule"] = ("the airfoil row whose change across the fits is "
+                                          "largest in units of its U (k = 2); none when no "
+                                          "u is stated")
+    by_fit = {}
+    for objective, blocks in per_fit.items():
+        verdicts = [v for b in blocks.values() for v in b.get("verdicts", {}).values()
+                    if v in JUDGED]
+        by_fit[objective] = decision_mod.combine(
+            [decision_mod.FAIL if v == "not measured" else v for v in verdicts])
+    doc["airfoil_verdict_by_fit"] = by_fit
 
 
 def extras_of(table):
@@ -584,8 +768,10 @@ def csv_rows(blocks):
         unc = _flat(b["uncertainty"]) if b.get("uncertainty") else {}
         for key in nom:
             t = b["tolerance"].get(key, {})
+            d = (b.get("decisions") or {}).get(key, {})
             rows.append([b["label"], key, nom[key], mea.get(key), dev.get(key), unc.get(key),
-                         t.get("lower"), t.get("upper"), b["verdicts"][key]])
+                         t.get("lower"), t.get("upper"), d.get("U"), d.get("rule"),
+                         b["verdicts"][key]])
     return rows
 
 

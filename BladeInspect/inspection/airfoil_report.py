@@ -12,7 +12,7 @@ from . import airfoil as stage_mod
 # Inscribed circles drawn per profile besides the largest one.
 N_CIRCLES = 5
 TABLE_HEADER = ["Characteristic", "Nominal", "Actual", "Deviation", "+-u (1 sigma)",
-                "Tolerance", "Verdict"]
+                "U (k=2)", "Tolerance", "Verdict"]
 
 
 def _num(v, key, sign=""):
@@ -34,9 +34,11 @@ def characteristics_rows(block):
         tol = "-" if t is None else "%s .. %s" % (
             "-inf" if t["lower"] is None else "%+g" % t["lower"],
             "+inf" if t["upper"] is None else "%+g" % t["upper"])
+        decision = (block.get("decisions") or {}).get(key, {})
         rows.append([key, _num(nom[key], key), _num(mea.get(key), key),
                      _num(dev.get(key), key, "+"),
-                     _num(unc.get(key), key), tol, block["verdicts"].get(key, "-")])
+                     _num(unc.get(key), key), _num(decision.get("U"), key), tol,
+                     block["verdicts"].get(key, "-")])
     return rows
 
 
@@ -128,11 +130,15 @@ def add_pages(pdf, parts, table):
     parts += ["<h2>Airfoil characteristics</h2>",
               "<p>%s</p>" % html.escape(stage.verdict["summary"]),
               "<p class='note'>Definitions: docs/airfoil.md; chord %s; angles from the engine "
-              "axis %s; uncertainty: %s, %s. Tolerances limit the deviation.</p>"
+              "axis %s; LE: %s; uncertainty: %s, %s. Tolerances limit the deviation; "
+              "decision rule: %s (%s).</p>"
               % (html.escape(stage.settings["chord_method"]),
                  html.escape(str(stage.settings["engine_axis"])),
+                 html.escape(stage.settings["le_rule_meaning"]),
                  html.escape(stage.settings["uncertainty_coverage"]),
-                 html.escape(stage.settings["uncertainty_method"]))]
+                 html.escape(stage.settings["uncertainty_method"]),
+                 html.escape(stage.settings["decision_rule_text"]),
+                 html.escape(stage.settings["decision_without_u"]))]
     for section in stage.sections:
         block = section.block
         rows = characteristics_rows(block)

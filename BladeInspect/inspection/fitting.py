@@ -385,7 +385,13 @@ def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
         if largest is None or change > largest["change_mm"]:
             largest = {"characteristic": name, "change_mm": change}
     verdicts = {o: columns[o]["verdict"] for o in objectives}
+    # Each objective's motion of the points from the least-squares start (CAD frame), and the
+    # chosen one's, so that later stages (the airfoil characteristics) can be re-measured
+    # under every fit.
+    motion = {o: (np.eye(4) if run is None else np.asarray(run.transform, float)).tolist()
+              for o, run in runs.runs.items()}
     return {"objectives": objectives, "rows": rows, "verdict_by_fit": verdicts,
+            "cad_motion_by_fit": motion, "chosen": choice.objective,
             "verdict_changes": len(set(verdicts.values())) > 1,
             "largest_change": largest,
             "free": choice.free or "all",
@@ -398,9 +404,14 @@ def report_rows(sensitivity_doc):
     header = ["characteristic"] + ["%s (mm, verdict)" % o for o in objectives] + ["change (mm)"]
     rows = []
     for row in sensitivity_doc["rows"]:
+        # airfoil rows (inspection.airfoil.add_to_sensitivity) carry value and unit
+        unit = "" if row.get("unit", "mm") == "mm" else " " + row["unit"]
+        value = [row["by_fit"][o].get("value_mm", row["by_fit"][o].get("value"))
+                 for o in objectives]
         rows.append([row["characteristic"]] + [
-            "%+.4f %s" % (row["by_fit"][o]["value_mm"], row["by_fit"][o]["verdict"] or "")
-            for o in objectives] + ["%.4f" % row["change_mm"]])
+            ("-" if v is None else "%+.4f%s %s" % (v, unit, row["by_fit"][o]["verdict"] or ""))
+            for v, o in zip(value, objectives)]
+            + ["%.4f%s" % (row.get("change_mm", row.get("change")), unit)])
     rows.append(["part verdict"] + [sensitivity_doc["verdict_by_fit"][o] or ""
                                     for o in objectives] + [""])
     return header, rows
