@@ -275,10 +275,13 @@ def cmd_simulate(args, cad=None):
 def cmd_demo(args):
     """The paper's whole workflow on the built-in blade and the simulated rig: blind section
     scan, reconstruction, PCA, SNR-weighted ICP, CAD-planned scan of the nominal sections,
-    report; then the pose judged against the simulator's truth."""
+    report with the airfoil characteristics (as `inspect` makes by default); then the pose
+    judged against the simulator's truth."""
+    from .inspection.airfoil import options_from_args
     from .inspection.closed_loop import run_inspect
     summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress(),
-                          document=_document_writer())
+                          document=_document_writer(),
+                          airfoil=options_from_args())
     result = summary["result"]
     _print_result(result, args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
