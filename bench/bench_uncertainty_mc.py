@@ -59,6 +59,7 @@ from BladeInspect.rig.sensor import SensorModel  # noqa: E402
 BEAM = np.array([0.0, 0.0, -1.0])
 BUMP_HEIGHT = 0.03
 BUMP_RADIUS = 6.0
+ERRORS = ("noise", "systematic", "calibration")
 CACHE = os.path.join(tempfile.gettempdir(), "bi-mc-record-%s.pkl")
 
 
@@ -95,7 +96,7 @@ def by_angle(fn, points, angles):
 def record(name, seed):
     """The planned scan's readings as the rig made them: per reading the stage, angle, true
     distance (bump included), incidence, and the true table-frame point; plus the truth."""
-    path = CACHE % name
+    path = CACHE % ("%s-%d" % (name, seed))
     if os.path.exists(path):
         with open(path, "rb") as fh:
             return pickle.load(fh)
@@ -155,7 +156,153 @@ def record(name, seed):
     return rec
 
 
-if __name__ == "__main__" and sys.argv[1:2] == ["--record-only"]:
+
+def registered(nominal, xyz, snr, init, rng):
+    """The pipeline's fine registration and its result (pipeline.register after the coarse
+    stage, which only finds the basin the true pose starts in)."""
+    fit = pipeline.fine_register(xyz, snr, nominal, init, rng=rng)
+    points_cad = tf.apply_transform(fit.transform, xyz)
+    dist = nominal.signed_distance(points_cad)
+    inlier = np.asarray(fit.inlier, dtype=bool)
+    covariance, statistical, _ = pipeline.pose_summary(fit, nominal)
+    return RegistrationResult(
+        measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
+        inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
+        columns={}, n_rows_skipped=0,
+        rms_mm=float(np.sqrt(np.mean(dist.distance[inlier] ** 2))),
+        pose_covariance=covariance, center=fit.center, pose_uncertainty_mm=float(statistical),
+        deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse={})
+
+
+class Chain:
+    """One blade's recorded scan, the rig's calibration (its covariance) and the model."""
+
+    def __init__(self, name, seed, record_seed):
+        self.name = name
+        self.nominal, self.heights = blade(name)
+        self.rec = record(name, record_seed)
+        _, self.bump = bump_at(self.nominal, self.heights[0])
+        self.sensor = SensorModel()
+        self.believed = RigKinematics()
+        calib = calibration_mod.run_calibration(None, seed=seed, axis_offset_mm=0.2,
+                                                axis_tilt_deg=0.1)["uncertainty"]
+        self.calibration = calib
+        self.axis_cov = np.asarray(calib["calibration_covariance"])
+        self.model = uncertainty_mod.MeasurementModel(
+            sensor=self.sensor, calibration_mm=calib["calibration_uncertainty_mm"],
+            calibration_source="simulated calibration")
+        truth_cad = tf.apply_transform(self.rec["table_to_cad"], self.rec["table"])
+        self.field = np.asarray(self.bump(self.nominal.signed_distance(truth_cad).closest))
+
+    def trial(self, rng, draws=0, errors=ERRORS):
+        """One measurement of the recorded scan with the model's errors drawn afresh: the
+        judged values {name: value}, their stated u (k = 1) {name: u} and the truth."""
+        from BladeInspect.measurement.calibration_uncertainty import kinematics_with
+        rec = self.rec
+        reading, snr = self.sensor.read(rec["distance"], rec["incidence"], rng)
+        ok = np.isfinite(reading)
+        error = np.where(ok, reading - rec["distance"], 0.0)
+        if "noise" not in errors:
+            error[:] = 0.0
+            snr = self.sensor.snr(rec["distance"], rec["incidence"])
+            ok = snr > 0
+        if "systematic" in errors:
+            error = error + rng.uniform(-self.sensor.accuracy, self.sensor.accuracy)
+        true_axis = self.believed
+        if "calibration" in errors:
+            d = np.linalg.cholesky(self.axis_cov + 1e-30 * np.eye(4)) @ rng.standard_normal(4)
+            true_axis = kinematics_with(self.believed, np.zeros(4) + d)
+        machine = by_angle(true_axis.machine_point_of_table, rec["table"], rec["angle"])
+        machine[:, 2] -= error
+        xyz = by_angle(self.believed.table_point, machine, rec["angle"])[ok]
+        result = registered(self.nominal, xyz, snr[ok], rec["table_to_cad"],
+                            np.random.default_rng(rng.integers(1 << 31)))
+        field = self.field[ok]
+        table = sections_mod.section_table(result, self.nominal, heights_pct=self.heights)
+        verdict = verdict_mod.judge(result, table, measurement_model=self.model)
+        values, stated, truth = {}, {}, {}
+        for sec, entry in zip(table.sections, verdict["sections"]):
+            key = "worst deviation %s" % sec.label
+            # Judged against +-T, the worst deviation's size is what decides; its sign flips
+            # between trials where two opposite points compete.
+            values[key] = abs(entry["worst_deviation_mm"])
+            stated[key] = 0.5 * entry["U_mm"]
+            truth[key] = float(np.max(np.abs(field[sec.point_index])))
+        values["worst deviation part"] = abs(verdict["part"]["worst_deviation_mm"])
+        stated["worst deviation part"] = 0.5 * verdict["part"]["U_mm"]
+        truth["worst deviation part"] = float(np.max(np.abs(field[result.inlier])))
+        opts = airfoil_mod.Options(draws=draws, seed=int(rng.integers(1 << 31)))
+        stage = airfoil_mod.run_stage(self.nominal, airfoil_mod.planes_of_table(table), opts,
+                                      result, table.span_axis)
+        for b in stage.blocks:
+            for k, v in airfoil_mod._flat(b["measured"] or {}).items():
+                values["%s %s" % (b["label"], k)] = v
+            for k, v in airfoil_mod._flat(b["uncertainty"] or {}).items():
+                stated["%s %s" % (b["label"], k)] = v
+        return values, stated, truth, result
+
+
+def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
     t0 = time.perf_counter()
-    r = record(sys.argv[2], int(sys.argv[3]))
-    print(sys.argv[2], len(r["distance"]), "readings", time.perf_counter() - t0, "s")
+    chain = Chain(name, seed, record_seed)
+    rng = np.random.default_rng(seed)
+    reference, _, _, _ = chain.trial(np.random.default_rng(0), errors=())
+    values, stated, truth = {}, {}, {}
+    pose = []
+    for k in range(trials):
+        v, s, t, result = chain.trial(rng, draws=airfoil_mod.DEFAULT_DRAWS if k < n_stated
+                                      else 0, errors=errors)
+        pose.append(result.pose_uncertainty_mm)
+        for key, x in v.items():
+            values.setdefault(key, []).append(x)
+        if k < n_stated:
+            for key, x in s.items():
+                stated.setdefault(key, []).append(x)
+        for key, x in t.items():
+            truth.setdefault(key, []).append(x)
+    seconds = time.perf_counter() - t0
+    print("\n%s (errors: %s): %d trials, seed %d, %.0f s wall; %d readings a scan; sensor accuracy %.1f um; "
+          "calibration 1 sigma at the part %.2f um; pose 1 sigma (worst corner) %.2f um"
+          % (name, ", ".join(errors), trials, seed, seconds, len(chain.rec["distance"]),
+             1e3 * chain.sensor.accuracy, 1e3 * chain.model.calibration_mm,
+             1e3 * np.mean(pose)))
+    print("%-34s %10s %10s %10s %7s %6s %10s" % ("characteristic", "stated u", "MC 1sd",
+                                                  "MC rms err", "ratio", "+-30%", "bias"))
+    rows = []
+    for key in sorted(values, key=lambda k: (not k.startswith("worst"), k)):
+        if key.endswith("centroid_mm[2]") or key not in stated:
+            continue
+        v = np.asarray(values[key], dtype=float)
+        u = float(np.mean(stated[key]))
+        sd = float(np.std(v, ddof=1))
+        ref = np.asarray(truth[key]) if key in truth else reference.get(key, np.nan)
+        err = v - ref
+        rms = float(np.sqrt(np.mean(err ** 2)))
+        ratio = u / sd if sd > 0 else np.nan
+        ok = 0.7 <= ratio <= 1.3
+        rows.append((key, u, sd, rms, ratio, ok))
+        print("%-34s %10.5f %10.5f %10.5f %7.2f %6s %+10.5f"
+              % (key, u, sd, rms, ratio, "yes" if ok else "NO", float(np.mean(err))))
+    print("%d of %d within +-30 %%" % (sum(r[-1] for r in rows), len(rows)))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--blade", choices=("demo", "rotor67", "both"), default="both")
+    ap.add_argument("--trials", type=int, default=40)
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--record-seed", type=int, default=31)
+    ap.add_argument("--stated", type=int, default=2,
+                    help="trials whose stated u is averaged (airfoil re-fits are slow)")
+    ap.add_argument("--errors", default=",".join(ERRORS),
+                    help="which of %s to draw (the others left out), to attribute a scatter"
+                    % ",".join(ERRORS))
+    args = ap.parse_args()
+    errors = tuple(e for e in args.errors.split(",") if e)
+    for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
+        run(name, args.trials, args.seed, args.stated, errors, args.record_seed)
+
+
+if __name__ == "__main__":
+    main()
