@@ -109,3 +109,64 @@ def expanded_uncertainty(result, index, model=None):
     """(n,) U = k * the combined standard uncertainty of the points' deviations (mm)."""
     terms = standard_terms(result, index, model)
     return COVERAGE_FACTOR * np.sqrt(sum(t ** 2 for t in terms.values()))
+
+
+# ---------------------------------------------------------------- the worst of several points
+
+# Points whose deviations lie within this many combined noise sigmas of the worst cannot be told
+# from it: any of them could have been the worst, and the reported one is the largest of their
+# noisy readings.
+COMPETING_SIGMAS = 2.0
+
+
+def max_of_draws(n, noise="uniform"):
+    """(mean, standard deviation) of the largest of ``n`` independent draws of the sensor's
+    noise distribution scaled to unit variance (rig.sensor: uniform, or normal clipped at
+    NORMAL_CLIP_SIGMAS), from its order statistic's distribution F(x)^n on a fine grid."""
+    from scipy.stats import norm
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    n = max(int(n), 1)
+    if noise == "uniform":
+        # max of n U(-1, 1): mean (n-1)/(n+1), variance 4n / ((n+1)^2 (n+2)); U(-1,1)*sqrt(3)
+        # has unit variance.
+        mean = (n - 1.0) / (n + 1.0)
+        var = 4.0 * n / ((n + 1.0) ** 2 * (n + 2.0))
+        return float(np.sqrt(3.0) * mean), float(np.sqrt(3.0 * var))
+    c = NORMAL_CLIP_SIGMAS
+    z = np.linspace(-c, c, 4001)
+    cdf = norm.cdf(z) ** n
+    cdf[-1] = 1.0                     # the clipped tail piles up at +c
+    p = np.diff(np.concatenate([[0.0], cdf]))
+    s = _clipped_normal_std(c)
+    mean = float(p @ z)
+    return mean / s, float(np.sqrt(max(p @ (z - mean) ** 2, 0.0))) / s
+
+
+def worst_terms(result, candidates, model=None):
+    """The worst |deviation| among the points ``candidates`` and its standard uncertainty
+    terms as the error of a maximum: (worst index, {term: mm}, number of competing points).
+
+    The terms common to neighbouring points (systematic, pose, calibration) move the worst with
+    the rest and stay as they are. The noise term is that of the largest of the n competing
+    readings (those within COMPETING_SIGMAS of the worst, the worst included): its RMS error
+    about a common true value, sigma * sqrt(mean^2 + sd^2) of max_of_draws(n) - for n = 1 the
+    single reading's sigma; for many competitors the selection bias of the maximum, which a
+    single point's sigma does not state (bench/bench_uncertainty_mc.py)."""
+    model = model or MeasurementModel()
+    candidates = np.atleast_1d(np.asarray(candidates, dtype=int))
+    dev = np.abs(np.asarray(result.deviation, dtype=float)[candidates])
+    worst = int(candidates[np.argmax(dev)])
+    noise = standard_terms(result, candidates, model)["noise_mm"]
+    w = int(np.argmax(dev))
+    competing = dev >= dev[w] - COMPETING_SIGMAS * np.sqrt(noise[w] ** 2 + noise ** 2)
+    n = int(np.count_nonzero(competing))
+    mean, sd = max_of_draws(n, model.sensor.noise)
+    terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
+    terms["noise_mm"] = float(noise[w] * np.sqrt(mean ** 2 + sd ** 2))
+    return worst, terms, n
+
+
+def worst_expanded_uncertainty(result, candidates, model=None):
+    """(worst index, U = k * the combined worst_terms, competing points)."""
+    worst, terms, n = worst_terms(result, candidates, model)
+    return worst, COVERAGE_FACTOR * float(np.sqrt(sum(t ** 2 for t in terms.values()))), n
