@@ -162,7 +162,7 @@ def record(name, seed):
 
 
 
-def registered(nominal, xyz, snr, init, rng):
+def registered(nominal, xyz, snr, init, rng, angles):
     """The pipeline's fine registration and its result (pipeline.register after the coarse
     stage, which only finds the basin the true pose starts in)."""
     fit = pipeline.fine_register(xyz, snr, nominal, init, rng=rng)
@@ -173,7 +173,8 @@ def registered(nominal, xyz, snr, init, rng):
     return RegistrationResult(
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
-        columns={}, n_rows_skipped=0,
+        columns={"angle_deg": np.asarray(angles, dtype=float)}, n_rows_skipped=0,
+        icp_weights=fit.weights,
         rms_mm=float(np.sqrt(np.mean(dist.distance[inlier] ** 2))),
         pose_covariance=covariance, center=fit.center, pose_uncertainty_mm=float(statistical),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse={})
@@ -199,7 +200,7 @@ class Chain:
         truth_cad = tf.apply_transform(self.rec["table_to_cad"], self.rec["table"])
         self.field = np.asarray(self.bump(self.nominal.signed_distance(truth_cad).closest))
 
-    def trial(self, rng, draws=0, errors=ERRORS):
+    def trial(self, rng, draws=0, errors=ERRORS, bias_mm=None):
         """One measurement of the recorded scan with the model's errors drawn afresh: the
         judged values {name: value}, their stated u (k = 1) {name: u} and the truth."""
         from BladeInspect.measurement.calibration_uncertainty import kinematics_with
@@ -211,7 +212,9 @@ class Chain:
             error[:] = 0.0
             snr = self.sensor.snr(rec["distance"], rec["incidence"])
             ok = snr > 0
-        if "systematic" in errors:
+        if bias_mm is not None:
+            error = error + bias_mm
+        elif "systematic" in errors:
             error = error + rng.uniform(-self.sensor.accuracy, self.sensor.accuracy)
         true_axis = self.believed
         if "calibration" in errors:
@@ -220,12 +223,16 @@ class Chain:
         machine = by_angle(true_axis.machine_point_of_table, rec["table"], rec["angle"])
         machine[:, 2] -= error
         xyz = by_angle(self.believed.table_point, machine, rec["angle"])[ok]
-        whole = registered(self.nominal, xyz, snr[ok], rec["table_to_cad"],
-                           np.random.default_rng(rng.integers(1 << 31)))
-        planned = rec["planned"][ok]
-        result = whole.planned_rows(planned)
-        field = self.field[ok][planned]
-        table = sections_mod.section_table(result, self.nominal, heights_pct=self.heights)
+        result = registered(self.nominal, xyz, snr[ok], rec["table_to_cad"],
+                            np.random.default_rng(rng.integers(1 << 31)), rec["angle"][ok])
+        field = self.field[ok]
+        # As the loop judges (closed_loop._judge_after_blind): Table 2 from the planned rows,
+        # indexed back into the whole result, which the verdict and the airfoil stage read.
+        rows = np.flatnonzero(rec["planned"][ok])
+        table = sections_mod.section_table(result.planned_rows(rows), self.nominal,
+                                           heights_pct=self.heights)
+        for sec in table.sections:
+            sec.point_index = rows[sec.point_index]
         verdict = verdict_mod.judge(result, table, measurement_model=self.model)
         values, stated, truth = {}, {}, {}
         for sec, entry in zip(table.sections, verdict["sections"]):
@@ -319,6 +326,25 @@ def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
     return rows
 
 
+def systematic_sensitivity(name, seed, record_seed=31):
+    """What the sensor's systematic term really does to each judged value through the whole
+    chain: noise-free scans with a reading bias of +-accuracy, the registration included. For
+    a rectangular bias the standard uncertainty is |d value / d bias| * accuracy / sqrt(3);
+    the model states accuracy / sqrt(3) for a deviation (sensitivity 1) and nothing for an
+    airfoil characteristic."""
+    chain = Chain(name, seed, record_seed)
+    a = chain.sensor.accuracy
+    up, _, _, _ = chain.trial(np.random.default_rng(0), errors=(), bias_mm=a)
+    down, _, _, _ = chain.trial(np.random.default_rng(0), errors=(), bias_mm=-a)
+    print("\n%s: the systematic term through the chain (noise-free scans, bias +-%.1f um)"
+          % (name, 1e3 * a))
+    print("%-34s %12s %12s" % ("characteristic", "d value/d b", "u_sys (mm)"))
+    for key in sorted(up, key=lambda k: (not k.startswith("worst"), k)):
+        if key in down and not key.endswith("centroid_mm[2]"):
+            c = (up[key] - down[key]) / (2.0 * a)
+            print("%-34s %12.3f %12.5f" % (key, c, abs(c) * a / np.sqrt(3.0)))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--blade", choices=("demo", "rotor67", "both"), default="both")
@@ -330,7 +356,13 @@ def main():
     ap.add_argument("--errors", default=",".join(ERRORS),
                     help="which of %s to draw (the others left out), to attribute a scatter"
                     % ",".join(ERRORS))
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="print the systematic term's sensitivities through the chain instead")
     args = ap.parse_args()
+    if args.sensitivity:
+        for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
+            systematic_sensitivity(name, args.seed, args.record_seed)
+        return
     errors = tuple(e for e in args.errors.split(",") if e)
     for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
         run(name, args.trials, args.seed, args.stated, errors, args.record_seed)

@@ -5,8 +5,14 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
 
 - noise: the sensor's random error of that reading, sigma(SNR) of rig.sensor.SensorModel
   (its sigma at SNR_ref scaled by sqrt(SNR_ref / SNR)); sigma_ref when the point has no SNR;
-- systematic: the sensor's stated accuracy taken as a bias of unknown sign, a rectangular
-  distribution of half-width ``accuracy``: accuracy / sqrt(3);
+- systematic: the sensor's stated accuracy taken as a bias of unknown sign common to every
+  reading, a rectangular distribution of half-width ``accuracy``: s_i * accuracy / sqrt(3).
+  The bias lengthens every reading alike, moving each point along its beam; the registration
+  then takes up part of it, so a deviation moves by s_i = beta_i - J_i (J^T W J)^-1 J^T W beta
+  per unit bias, beta = beam . n of each point and W the fit's weights (systematic_coefficients).
+  The beams follow from the points' rotary angles (the ``angle_deg`` column an inspection and
+  points.csv carry); without them s_i = 1, the bias taken whole (an upper estimate: on the demo
+  blade's loop the fit takes up more than half of it, bench/bench_uncertainty_mc.py);
 - pose: the registration's pose covariance Sigma (result.pose_covariance, 6x6 [t mm, w rad]
   about result.center) propagated to the point along its normal: J Sigma J^T with
   J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c);
@@ -29,6 +35,9 @@ from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 
 COVERAGE_FACTOR = 2.0
+# The sensor looks down machine -Z: a reading d puts the point at (X, Y, Z - d)
+# (rig.kinematics.machine_point).
+BEAM_MACHINE = np.array([0.0, 0.0, -1.0])
 
 
 @dataclass
@@ -43,7 +52,9 @@ class MeasurementModel:
             "noise": "sensor sigma(SNR): %.4g mm at SNR %g, times sqrt(SNR_ref / SNR)"
                      % (self.sensor.sigma_ref, self.sensor.snr_ref),
             "systematic_mm": self.systematic_mm,
-            "systematic": "stated accuracy %.4g mm as a rectangular bias: accuracy / sqrt(3)"
+            "systematic": "stated accuracy %.4g mm as a rectangular bias of every reading: "
+                          "s * accuracy / sqrt(3), s the deviation's change per unit bias "
+                          "after the registration (1 when the beams are not known)"
                           % self.sensor.accuracy,
             "pose": "pose covariance propagated along the normal, J S J^T, J = [n, (p-c) x n]",
             "calibration_mm": self.calibration_mm,
@@ -98,11 +109,53 @@ def standard_terms(result, index, model=None):
     with np.errstate(invalid="ignore"):
         pose_var = np.einsum("ij,jk,ik->i", J, cov, J) if np.all(np.isfinite(cov)) \
             else np.full(n, np.inf)
-    terms = {"noise_mm": noise, "systematic_mm": np.full(n, model.systematic_mm),
+    coefficient = systematic_coefficients(result)
+    coefficient = np.ones(n) if coefficient is None else np.abs(coefficient[index])
+    terms = {"noise_mm": noise, "systematic_mm": coefficient * model.systematic_mm,
              "pose_mm": np.sqrt(np.maximum(pose_var, 0.0))}
     if model.calibration_mm is not None:
         terms["calibration_mm"] = np.full(n, model.calibration_mm)
     return terms
+
+
+def beam_directions(result):
+    """(N, 3) unit beam directions of the points in the CAD frame, from their rotary angles
+    (the nominal axis: a calibrated axis is within a fraction of a degree of it, which moves
+    these directions by as little), or None without an ``angle_deg`` column."""
+    from ..rig.kinematics import RigKinematics
+    angles = (result.columns or {}).get("angle_deg")
+    if angles is None:
+        return None
+    angles = np.asarray(angles, dtype=float)
+    if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
+        return None
+    kinematics = RigKinematics()
+    to_cad = np.asarray(result.measured_to_cad, dtype=float)[:3, :3]
+    beams = np.empty((len(angles), 3))
+    for a in np.unique(angles):
+        # table_point turns machine vectors back by the angle: R(a)^T v
+        beams[angles == a] = to_cad @ (kinematics.rotation(a).T @ BEAM_MACHINE)
+    return beams
+
+
+def systematic_coefficients(result):
+    """(N,) change of each point's deviation per unit reading bias, after the registration has
+    taken up what a rigid motion can (module notes), or None when the beams are not known."""
+    beams = beam_directions(result)
+    if beams is None:
+        return None
+    normal = np.asarray(result.normal, dtype=float)
+    beta = np.einsum("ij,ij->i", beams, normal)
+    weights = result.icp_weights if result.icp_weights is not None else result.snr
+    weights = (np.ones(len(beta)) if weights is None else
+               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
+    weights = weights * np.asarray(result.inlier, dtype=bool)
+    arm = np.asarray(result.points_cad, dtype=float) - np.asarray(result.center)
+    J = np.hstack([normal, np.cross(arm, normal)])
+    JW = J.T * weights
+    # lstsq: a pose direction the points do not measure takes up nothing of the bias
+    response = np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0]
+    return beta - J @ response
 
 
 def expanded_uncertainty(result, index, model=None):
