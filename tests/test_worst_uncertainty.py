@@ -71,3 +71,38 @@ class WorstTermsTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SystematicThroughTheFitTest(unittest.TestCase):
+    """The systematic term's coefficients (uncertainty.systematic_coefficients, a linearised
+    fit) against the pipeline's own ICP run on points moved along their beams by a known bias:
+    each deviation's change after the re-fit is s_i * bias."""
+
+    def test_against_a_refit_with_a_known_bias(self):
+        from BladeInspect.core import transforms as tf
+        from BladeInspect.inspection import pipeline
+        from BladeInspect.rig.kinematics import RigKinematics
+        nominal = fx.demo_nominal()
+        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
+        normal = nominal.signed_distance(on).normal
+        # Each point read from the rotary angle (10 deg steps) that sees it most head-on.
+        angles = np.arange(0.0, 360.0, 10.0)
+        k = RigKinematics()
+        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
+        pick = np.argmin(normal @ beams.T, axis=1)
+        seen = (normal @ beams.T)[np.arange(len(on)), pick] < -0.3
+        on, pick = on[seen], pick[seen]
+        result = fx.make_result(nominal, on, columns={"angle_deg": angles[pick]})
+        np.testing.assert_allclose(U.beam_directions(result), beams[pick], atol=1e-12)
+        bias = 0.005
+        moved = on + bias * beams[pick]
+        fit = pipeline.fine_register(moved, None, nominal, np.eye(4))
+        # The weights the fit ran with (its robust weights drop the points it rejected), as a
+        # RegistrationResult carries them.
+        s = U.systematic_coefficients(dataclasses.replace(result, icp_weights=fit.weights))
+        after = nominal.signed_distance(tf.apply_transform(fit.transform, moved)).distance
+        change = after - result.deviation
+        self.assertLess(np.max(np.abs(change - s * bias)), 0.05 * bias)
+        # The fit takes up part of the bias: the coefficients are not simply beam . n.
+        beta = np.einsum("ij,ij->i", beams[pick], result.normal)
+        self.assertGreater(np.max(np.abs(s - beta)), 0.1)
