@@ -69,9 +69,6 @@ class WorstTermsTest(unittest.TestCase):
         self.assertGreater(terms["noise_mm"], 1.5 * self.sigma)
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 class SystematicThroughTheFitTest(unittest.TestCase):
     """The systematic term's coefficients (uncertainty.systematic_coefficients, a linearised
@@ -106,3 +103,7 @@ class SystematicThroughTheFitTest(unittest.TestCase):
         # The fit takes up part of the bias: the coefficients are not simply beam . n.
         beta = np.einsum("ij,ij->i", beams[pick], result.normal)
         self.assertGreater(np.max(np.abs(s - beta)), 0.1)
+
+
+if __name__ == "__main__":
+    unittest.main()
