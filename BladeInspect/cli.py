@@ -427,6 +427,8 @@ def cmd_calibrate(args):
               % (result["axis_tilt_about_z_deg"], result["axis_tilt_about_x_deg"],
                  result["measured_diameter_mm"], result["sphere_diameter_mm"],
                  result["circle_residual_rms_mm"]))
+    out.write("  calibration uncertainty (1 sigma at the part, written to RIG.json): %.2f um\n"
+              % (1e3 * result["calibration_uncertainty_mm"]))
     error = result.get("truth_error")
     if error:
         out.write("  against the simulator's truth: position %.2f um, direction %.5f deg\n"

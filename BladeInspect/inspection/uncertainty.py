@@ -5,8 +5,14 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
 
 - noise: the sensor's random error of that reading, sigma(SNR) of rig.sensor.SensorModel
   (its sigma at SNR_ref scaled by sqrt(SNR_ref / SNR)); sigma_ref when the point has no SNR;
-- systematic: the sensor's stated accuracy taken as a bias of unknown sign, a rectangular
-  distribution of half-width ``accuracy``: accuracy / sqrt(3);
+- systematic: the sensor's stated accuracy taken as a bias of unknown sign common to every
+  reading, a rectangular distribution of half-width ``accuracy``: s_i * accuracy / sqrt(3).
+  The bias lengthens every reading alike, moving each point along its beam; the registration
+  then takes up part of it, so a deviation moves by s_i = beta_i - J_i (J^T W J)^-1 J^T W beta
+  per unit bias, beta = beam . n of each point and W the fit's weights (systematic_coefficients).
+  The beams follow from the points' rotary angles (the ``angle_deg`` column an inspection and
+  points.csv carry); without them s_i = 1, the bias taken whole (an upper estimate: on the demo
+  blade's loop the fit takes up more than half of it, bench/bench_uncertainty_mc.py);
 - pose: the registration's pose covariance Sigma (result.pose_covariance, 6x6 [t mm, w rad]
   about result.center) propagated to the point along its normal: J Sigma J^T with
   J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c);
@@ -29,6 +35,9 @@ from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 
 COVERAGE_FACTOR = 2.0
+# The sensor looks down machine -Z: a reading d puts the point at (X, Y, Z - d)
+# (rig.kinematics.machine_point).
+BEAM_MACHINE = np.array([0.0, 0.0, -1.0])
 
 
 @dataclass
@@ -43,7 +52,9 @@ class MeasurementModel:
             "noise": "sensor sigma(SNR): %.4g mm at SNR %g, times sqrt(SNR_ref / SNR)"
                      % (self.sensor.sigma_ref, self.sensor.snr_ref),
             "systematic_mm": self.systematic_mm,
-            "systematic": "stated accuracy %.4g mm as a rectangular bias: accuracy / sqrt(3)"
+            "systematic": "stated accuracy %.4g mm as a rectangular bias of every reading: "
+                          "s * accuracy / sqrt(3), s the deviation's change per unit bias "
+                          "after the registration (1 when the beams are not known)"
                           % self.sensor.accuracy,
             "pose": "pose covariance propagated along the normal, J S J^T, J = [n, (p-c) x n]",
             "calibration_mm": self.calibration_mm,
@@ -98,14 +109,117 @@ def standard_terms(result, index, model=None):
     with np.errstate(invalid="ignore"):
         pose_var = np.einsum("ij,jk,ik->i", J, cov, J) if np.all(np.isfinite(cov)) \
             else np.full(n, np.inf)
-    terms = {"noise_mm": noise, "systematic_mm": np.full(n, model.systematic_mm),
+    coefficient = systematic_coefficients(result)
+    coefficient = np.ones(n) if coefficient is None else np.abs(coefficient[index])
+    terms = {"noise_mm": noise, "systematic_mm": coefficient * model.systematic_mm,
              "pose_mm": np.sqrt(np.maximum(pose_var, 0.0))}
     if model.calibration_mm is not None:
         terms["calibration_mm"] = np.full(n, model.calibration_mm)
     return terms
 
 
+def beam_directions(result):
+    """(N, 3) unit beam directions of the points in the CAD frame, from their rotary angles
+    (the nominal axis: a calibrated axis is within a fraction of a degree of it, which moves
+    these directions by as little), or None without an ``angle_deg`` column."""
+    from ..rig.kinematics import RigKinematics
+    angles = (result.columns or {}).get("angle_deg")
+    if angles is None:
+        return None
+    angles = np.asarray(angles, dtype=float)
+    if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
+        return None
+    kinematics = RigKinematics()
+    to_cad = np.asarray(result.measured_to_cad, dtype=float)[:3, :3]
+    beams = np.empty((len(angles), 3))
+    for a in np.unique(angles):
+        # table_point turns machine vectors back by the angle: R(a)^T v
+        beams[angles == a] = to_cad @ (kinematics.rotation(a).T @ BEAM_MACHINE)
+    return beams
+
+
+def systematic_coefficients(result):
+    """(N,) change of each point's deviation per unit reading bias, after the registration has
+    taken up what a rigid motion can (module notes), or None when the beams are not known."""
+    beams = beam_directions(result)
+    if beams is None:
+        return None
+    normal = np.asarray(result.normal, dtype=float)
+    beta = np.einsum("ij,ij->i", beams, normal)
+    weights = result.icp_weights if result.icp_weights is not None else result.snr
+    weights = (np.ones(len(beta)) if weights is None else
+               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
+    weights = weights * np.asarray(result.inlier, dtype=bool)
+    arm = np.asarray(result.points_cad, dtype=float) - np.asarray(result.center)
+    J = np.hstack([normal, np.cross(arm, normal)])
+    JW = J.T * weights
+    # lstsq: a pose direction the points do not measure takes up nothing of the bias
+    response = np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0]
+    return beta - J @ response
+
+
 def expanded_uncertainty(result, index, model=None):
     """(n,) U = k * the combined standard uncertainty of the points' deviations (mm)."""
     terms = standard_terms(result, index, model)
     return COVERAGE_FACTOR * np.sqrt(sum(t ** 2 for t in terms.values()))
+
+
+# ---------------------------------------------------------------- the worst of several points
+
+# Points whose deviations lie within this many combined noise sigmas of the worst cannot be told
+# from it: any of them could have been the worst, and the reported one is the largest of their
+# noisy readings.
+COMPETING_SIGMAS = 2.0
+
+
+def max_of_draws(n, noise="uniform"):
+    """(mean, standard deviation) of the largest of ``n`` independent draws of the sensor's
+    noise distribution scaled to unit variance (rig.sensor: uniform, or normal clipped at
+    NORMAL_CLIP_SIGMAS), from its order statistic's distribution F(x)^n on a fine grid."""
+    from scipy.stats import norm
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    n = max(int(n), 1)
+    if noise == "uniform":
+        # max of n U(-1, 1): mean (n-1)/(n+1), variance 4n / ((n+1)^2 (n+2)); U(-1,1)*sqrt(3)
+        # has unit variance.
+        mean = (n - 1.0) / (n + 1.0)
+        var = 4.0 * n / ((n + 1.0) ** 2 * (n + 2.0))
+        return float(np.sqrt(3.0) * mean), float(np.sqrt(3.0 * var))
+    c = NORMAL_CLIP_SIGMAS
+    z = np.linspace(-c, c, 4001)
+    cdf = norm.cdf(z) ** n
+    cdf[-1] = 1.0                     # the clipped tail piles up at +c
+    p = np.diff(np.concatenate([[0.0], cdf]))
+    s = _clipped_normal_std(c)
+    mean = float(p @ z)
+    return mean / s, float(np.sqrt(max(p @ (z - mean) ** 2, 0.0))) / s
+
+
+def worst_terms(result, candidates, model=None):
+    """The worst |deviation| among the points ``candidates`` and its standard uncertainty
+    terms as the error of a maximum: (worst index, {term: mm}, number of competing points).
+
+    The terms common to neighbouring points (systematic, pose, calibration) move the worst with
+    the rest and stay as they are. The noise term is that of the largest of the n competing
+    readings (those within COMPETING_SIGMAS of the worst, the worst included): its RMS error
+    about a common true value, sigma * sqrt(mean^2 + sd^2) of max_of_draws(n) - for n = 1 the
+    single reading's sigma; for many competitors the selection bias of the maximum, which a
+    single point's sigma does not state (bench/bench_uncertainty_mc.py)."""
+    model = model or MeasurementModel()
+    candidates = np.atleast_1d(np.asarray(candidates, dtype=int))
+    dev = np.abs(np.asarray(result.deviation, dtype=float)[candidates])
+    worst = int(candidates[np.argmax(dev)])
+    noise = standard_terms(result, candidates, model)["noise_mm"]
+    w = int(np.argmax(dev))
+    competing = dev >= dev[w] - COMPETING_SIGMAS * np.sqrt(noise[w] ** 2 + noise ** 2)
+    n = int(np.count_nonzero(competing))
+    mean, sd = max_of_draws(n, model.sensor.noise)
+    terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
+    terms["noise_mm"] = float(noise[w] * np.sqrt(mean ** 2 + sd ** 2))
+    return worst, terms, n
+
+
+def worst_expanded_uncertainty(result, candidates, model=None):
+    """(worst index, U = k * the combined worst_terms, competing points)."""
+    worst, terms, n = worst_terms(result, candidates, model)
+    return worst, COVERAGE_FACTOR * float(np.sqrt(sum(t ** 2 for t in terms.values()))), n

@@ -11,6 +11,8 @@ Why a sphere: its centre is the one point of a part that every viewing angle mea
 and with the diameter known the centre follows from a cap seen from above alone.
 """
 
+import json
+
 import numpy as np
 
 from ..core import fitting
@@ -19,6 +21,7 @@ from ..core.errors import InputError
 from ..rig.kinematics import RigKinematics
 from ..rig.serial_rig import SerialRig
 from ..rig.simulated import SimulatedRig
+from .calibration_uncertainty import calibration_uncertainty
 
 DEFAULT_DIAMETER = 25.0
 # Twelve angles round the full turn: the centres then span the whole circle, which makes the
@@ -197,7 +200,7 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
     prior = kinematics if kinematics is not None else RigKinematics()
     radius = 0.5 * float(sphere_diameter)
     standoff = float(rig.sensor.standoff)
-    centres, per_angle, diameters = [], [], []
+    centres, per_angle, diameters, centre_covariances = [], [], [], []
     for i, a in enumerate(angles):
         progress(i / len(angles), "calibration: sphere at A=%.1f deg" % a)
         predicted = prior.machine_point_of_table(np.asarray(sphere_position, float), a)[0]
@@ -206,6 +209,7 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
         free = fitting.fit_sphere(pts)
         diameters.append(2.0 * free.radius)
         centres.append(centre)
+        centre_covariances.append(fit.covariance)
         per_angle.append({"angle_deg": a, "centre": centre.tolist(),
                           "points": info["passes"][-1]["points"],
                           "passes": len(info["passes"]),
@@ -217,8 +221,11 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
                          % (sphere_diameter, measured_d))
     axis = axis_from_centres(centres, angles)
     calibrated = _with_axis(prior, axis["point"], axis["direction"])
+    # hook: the calibration's own uncertainty (issue 16), written into RIG.json beside the axis
+    own = calibration_uncertainty(centres, centre_covariances, angles, calibrated,
+                                  sphere_position)
     if out_path is not None:
-        _write_atomically(out_path, calibrated)
+        _write_atomically(out_path, calibrated, own.to_json())
     progress(1.0, "calibration: axis through (%.4f, 0, %.4f), %.4f deg from +Y"
              % (axis["point"][0], axis["point"][2],
                 np.degrees(np.arccos(np.clip(axis["direction"][1], -1, 1)))))
@@ -237,6 +244,8 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
         "simulated_s": float(rig.elapsed_s),
         "rig_file": out_path,
         "kinematics": calibrated,
+        "uncertainty": own.to_json(),
+        "calibration_uncertainty_mm": own.at_part_mm,
     }
 
 
@@ -248,7 +257,7 @@ def _with_axis(kinematics, point, direction):
     return out
 
 
-def _write_atomically(path, kinematics):
+def _write_atomically(path, kinematics, extra=None):
     import os
     import tempfile
     folder = os.path.dirname(os.path.abspath(path))
@@ -257,7 +266,12 @@ def _write_atomically(path, kinematics):
     fd, tmp = tempfile.mkstemp(prefix=".rig-", suffix=".json", dir=folder)
     os.close(fd)
     try:
-        kinematics.to_json(tmp)
+        if extra:
+            with open(tmp, "w") as fh:
+                json.dump(dict(kinematics.to_dict(), **extra), fh, indent=2)
+                fh.write("\n")
+        else:
+            kinematics.to_json(tmp)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

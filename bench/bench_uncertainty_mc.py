@@ -1,0 +1,376 @@
+"""Monte Carlo over the whole measurement chain against the stated expanded uncertainty U (issue
+16 item 5): does inspection/uncertainty.py's model (and inspection/airfoil.py's airfoil u) state
+the scatter that the chain really has?
+
+One `inspect` loop on the blade (simulated rig, default sensor, a 30 um bump on the suction side
+at the first section, sections at 30 and 70 % span) is recorded once, reading by reading: the
+stage position, rotary angle, true distance along the beam and incidence of every reading of the
+blind scan and of the planned one. Each trial then measures those readings again with every error
+the model states, drawn from its distribution:
+
+- the sensor's noise, gross errors, rounding and gating (rig.sensor.SensorModel.read on the
+  recorded true distances and incidences, a fresh stream per trial);
+- the sensor's stated accuracy as a systematic term: one bias per trial, uniform in
+  +-accuracy, added to every reading;
+- the rig calibration's error: the rotary axis the rig really has differs from the believed one
+  by an error drawn from `calibrate`'s own covariance (one simulated calibration run here);
+
+and goes on as the loop does: believed kinematics -> table-frame points -> SNR-weighted ICP of the
+blind and planned points together (started at the true pose: the coarse stage finds the basin,
+not the answer) -> Table 2 from the planned rows -> verdict on the whole result (each section's
+worst deviation and the part's worst, with U) -> airfoil characteristics (no re-fits in the
+trials). The stated u (k = 1) is U / 2 of the verdict, and the airfoil stage's own u (its
+default re-fits), averaged over the first STATED trials.
+
+The worst deviation is a maximum over points: where several points compete for it the maximum
+is biased up and scatters less than one reading. The table therefore gives, beside the
+scatter (1 sd), the RMS error against the truth (the injected field's largest |value| over the
+same points; for an airfoil characteristic, the noise-free chain's value), and rows "max-aware"
+with U as the error of a maximum (uncertainty.worst_terms). Trials more than 5 robust sigmas
+from the median are counted (column "out"), not averaged in. `--sensitivity` prints instead
+what the systematic term really does to each value through the chain (noise-free scans with a
+bias of +-accuracy).
+
+    scripts/fcpython bench/bench_uncertainty_mc.py [--blade demo|rotor67|both] [--trials 40]
+        [--seed 2026] [--stated 2] [--errors noise,systematic,calibration] [--sensitivity]
+"""
+import argparse
+import os
+import pickle
+import shutil
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from BladeInspect.core import stats as stats_mod  # noqa: E402
+from BladeInspect.core import transforms as tf  # noqa: E402
+from BladeInspect.inspection import airfoil as airfoil_mod  # noqa: E402
+from BladeInspect.inspection import pipeline  # noqa: E402
+from BladeInspect.inspection import sections as sections_mod  # noqa: E402
+from BladeInspect.inspection import uncertainty as uncertainty_mod  # noqa: E402
+from BladeInspect.inspection import verdict as verdict_mod  # noqa: E402
+from BladeInspect.inspection.result import RegistrationResult  # noqa: E402
+from BladeInspect.measurement import calibration as calibration_mod  # noqa: E402
+from BladeInspect.rig.kinematics import RigKinematics  # noqa: E402
+from BladeInspect.rig.sensor import SensorModel  # noqa: E402
+
+BEAM = np.array([0.0, 0.0, -1.0])
+BUMP_HEIGHT = 0.03
+BUMP_RADIUS = 6.0
+OUTLIER_SIGMAS = 5.0
+ERRORS = ("noise", "systematic", "calibration")
+CACHE = os.path.join(tempfile.gettempdir(), "bi-mc-record-%s.pkl")
+
+
+def blade(name):
+    if name == "demo":
+        return pipeline.load_nominal(None), (30.0, 70.0)
+    from BladeInspect.cad.load import load_nominal
+    from tests.helpers import ROTOR67_SECTIONS
+    return load_nominal(ROTOR67_SECTIONS), (30.0, 70.0)
+
+
+def bump_at(nominal, height_pct):
+    """A bump on the suction side where the plane at ``height_pct`` crosses it (as
+    tests/test_rotor67_loop.py builds it)."""
+    from BladeInspect.rig.simulated import make_bump
+    axis, (lo, hi) = sections_mod.span_axis_of(nominal)
+    s = nominal.samples
+    level = lo + (hi - lo) * height_pct / 100.0
+    near = np.isin(s.face, nominal.roles["suction"]) & (np.abs(s.xyz @ axis - level) < 0.5)
+    pts = s.xyz[near]
+    centre = pts[np.argmin(np.linalg.norm(pts - pts.mean(axis=0), axis=1))]
+    return axis, make_bump(centre, BUMP_RADIUS, BUMP_HEIGHT)
+
+
+def by_angle(fn, points, angles):
+    """fn(points, angle) applied to the points of each rotary angle."""
+    out = np.empty_like(points)
+    for a in np.unique(angles):
+        sel = angles == a
+        out[sel] = fn(points[sel], a)
+    return out
+
+
+def record(name, seed):
+    """The planned scan's readings as the rig made them: per reading the stage, angle, true
+    distance (bump included), incidence, and the true table-frame point; plus the truth."""
+    path = CACHE % ("%s-%d" % (name, seed))
+    if os.path.exists(path):
+        with open(path, "rb") as fh:
+            return pickle.load(fh)
+    from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+    import json
+    nominal, heights = blade(name)
+    axis, bump = bump_at(nominal, heights[0])
+    corners = nominal.bbox_corners
+    truth = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
+                                cad_center=0.5 * (corners.min(0) + corners.max(0)))
+    log = {}
+    context = {}
+
+    class RecordingSensor(SensorModel):
+        def read(self, true_distance, incidence_rad, rng):
+            log[context["index"]] = (context["stage"], context["angle"],
+                                     np.array(true_distance, float),
+                                     np.array(incidence_rad, float))
+            return SensorModel.read(self, true_distance, incidence_rad, rng)
+
+    rig = SimulatedRig(nominal, truth, sensor=RecordingSensor(), error_field=bump, seed=seed)
+    measure = rig.measure
+
+    def recording(stage_xyz, angle_deg, pass_index):
+        context.update(index=int(pass_index), stage=np.atleast_2d(stage_xyz).astype(float),
+                       angle=float(angle_deg))
+        return measure(stage_xyz, angle_deg, pass_index)
+    rig.measure = recording
+    tmp = tempfile.mkdtemp(prefix="bi-mc-")
+    try:
+        run_inspect(None, tmp + "/out", rig=rig, nominal=nominal, section_heights=heights,
+                    seed=seed, document=False, scan_options={"n_sections": 3})
+        with open(os.path.join(tmp, "out", "scan.json")) as fh:
+            scan = json.load(fh)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    # The loop's final fit takes the blind scan's points with the planned ones (closed_loop):
+    # the passes before the first planned one are the blind scan's.
+    planned = sorted({p["pass_index"] for p in scan["phases"]["planned"]["paths"]})
+    blind = [i for i in sorted(log) if i < planned[0]]
+    stage, angle, dist, inc, phase = [], [], [], [], []
+    for i in blind + planned:
+        s, a, d, c = log[i]
+        stage.append(s)
+        angle.append(np.full(len(s), a))
+        dist.append(d)
+        inc.append(c)
+        phase.append(np.full(len(s), i in planned))
+    rec = {"stage": np.vstack(stage), "angle": np.concatenate(angle),
+           "distance": np.concatenate(dist), "incidence": np.concatenate(inc),
+           "planned": np.concatenate(phase), "table_to_cad": truth, "heights": heights}
+    nominal_k = RigKinematics()
+    hit = np.isfinite(rec["distance"])
+    for key in ("stage", "angle", "distance", "incidence", "planned"):
+        rec[key] = rec[key][hit]
+    machine = nominal_k.machine_point(rec["stage"], rec["distance"])
+    rec["table"] = by_angle(nominal_k.table_point, machine, rec["angle"])
+    with open(path, "wb") as fh:
+        pickle.dump(rec, fh)
+    return rec
+
+
+
+def registered(nominal, xyz, snr, init, rng, angles):
+    """The pipeline's fine registration and its result (pipeline.register after the coarse
+    stage, which only finds the basin the true pose starts in)."""
+    fit = pipeline.fine_register(xyz, snr, nominal, init, rng=rng)
+    points_cad = tf.apply_transform(fit.transform, xyz)
+    dist = nominal.signed_distance(points_cad)
+    inlier = np.asarray(fit.inlier, dtype=bool)
+    covariance, statistical, _ = pipeline.pose_summary(fit, nominal)
+    return RegistrationResult(
+        measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
+        inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
+        columns={"angle_deg": np.asarray(angles, dtype=float)}, n_rows_skipped=0,
+        icp_weights=fit.weights,
+        rms_mm=float(np.sqrt(np.mean(dist.distance[inlier] ** 2))),
+        pose_covariance=covariance, center=fit.center, pose_uncertainty_mm=float(statistical),
+        deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse={})
+
+
+class Chain:
+    """One blade's recorded scan, the rig's calibration (its covariance) and the model."""
+
+    def __init__(self, name, seed, record_seed):
+        self.name = name
+        self.nominal, self.heights = blade(name)
+        self.rec = record(name, record_seed)
+        _, self.bump = bump_at(self.nominal, self.heights[0])
+        self.sensor = SensorModel()
+        self.believed = RigKinematics()
+        calib = calibration_mod.run_calibration(None, seed=seed, axis_offset_mm=0.2,
+                                                axis_tilt_deg=0.1)["uncertainty"]
+        self.calibration = calib
+        self.axis_cov = np.asarray(calib["calibration_covariance"])
+        self.model = uncertainty_mod.MeasurementModel(
+            sensor=self.sensor, calibration_mm=calib["calibration_uncertainty_mm"],
+            calibration_source="simulated calibration")
+        truth_cad = tf.apply_transform(self.rec["table_to_cad"], self.rec["table"])
+        self.field = np.asarray(self.bump(self.nominal.signed_distance(truth_cad).closest))
+
+    def trial(self, rng, draws=0, errors=ERRORS, bias_mm=None):
+        """One measurement of the recorded scan with the model's errors drawn afresh: the
+        judged values {name: value}, their stated u (k = 1) {name: u} and the truth."""
+        from BladeInspect.measurement.calibration_uncertainty import kinematics_with
+        rec = self.rec
+        reading, snr = self.sensor.read(rec["distance"], rec["incidence"], rng)
+        ok = np.isfinite(reading)
+        error = np.where(ok, reading - rec["distance"], 0.0)
+        if "noise" not in errors:
+            error[:] = 0.0
+            snr = self.sensor.snr(rec["distance"], rec["incidence"])
+            ok = snr > 0
+        if bias_mm is not None:
+            error = error + bias_mm
+        elif "systematic" in errors:
+            error = error + rng.uniform(-self.sensor.accuracy, self.sensor.accuracy)
+        true_axis = self.believed
+        if "calibration" in errors:
+            d = np.linalg.cholesky(self.axis_cov + 1e-30 * np.eye(4)) @ rng.standard_normal(4)
+            true_axis = kinematics_with(self.believed, np.zeros(4) + d)
+        machine = by_angle(true_axis.machine_point_of_table, rec["table"], rec["angle"])
+        machine[:, 2] -= error
+        xyz = by_angle(self.believed.table_point, machine, rec["angle"])[ok]
+        result = registered(self.nominal, xyz, snr[ok], rec["table_to_cad"],
+                            np.random.default_rng(rng.integers(1 << 31)), rec["angle"][ok])
+        field = self.field[ok]
+        # As the loop judges (closed_loop._judge_after_blind): Table 2 from the planned rows,
+        # indexed back into the whole result, which the verdict and the airfoil stage read.
+        rows = np.flatnonzero(rec["planned"][ok])
+        table = sections_mod.section_table(result.planned_rows(rows), self.nominal,
+                                           heights_pct=self.heights)
+        for sec in table.sections:
+            sec.point_index = rows[sec.point_index]
+        verdict = verdict_mod.judge(result, table, measurement_model=self.model)
+        values, stated, truth = {}, {}, {}
+        for sec, entry in zip(table.sections, verdict["sections"]):
+            key = "worst deviation %s" % sec.label
+            # Judged against +-T, the worst deviation's size is what decides; its sign flips
+            # between trials where two opposite points compete.
+            values[key] = abs(entry["worst_deviation_mm"])
+            stated[key] = 0.5 * entry["U_mm"]
+            truth[key] = float(np.max(np.abs(field[sec.point_index])))
+            # The same value with U as the error of a maximum (uncertainty.worst_terms).
+            # The verdict's worst is over the section's points less its isolated outliers,
+            # which lie above any worst within the tolerance.
+            idx = sec.point_index
+            counted = idx[np.abs(result.deviation[idx]) <= values[key] + 1e-12]
+            _, U, _ = uncertainty_mod.worst_expanded_uncertainty(result, counted, self.model)
+            values[key + " max-aware"] = values[key]
+            stated[key + " max-aware"] = 0.5 * U
+            truth[key + " max-aware"] = truth[key]
+        values["worst deviation part"] = abs(verdict["part"]["worst_deviation_mm"])
+        stated["worst deviation part"] = 0.5 * verdict["part"]["U_mm"]
+        truth["worst deviation part"] = float(np.max(np.abs(field[result.inlier])))
+        _, U, _ = uncertainty_mod.worst_expanded_uncertainty(
+            result, np.flatnonzero(result.inlier), self.model)
+        values["worst deviation part max-aware"] = values["worst deviation part"]
+        stated["worst deviation part max-aware"] = 0.5 * U
+        truth["worst deviation part max-aware"] = truth["worst deviation part"]
+        opts = airfoil_mod.Options(draws=draws, seed=int(rng.integers(1 << 31)))
+        stage = airfoil_mod.run_stage(self.nominal, airfoil_mod.planes_of_table(table), opts,
+                                      result, table.span_axis)
+        for b in stage.blocks:
+            for k, v in airfoil_mod._flat(b["measured"] or {}).items():
+                values["%s %s" % (b["label"], k)] = v
+            for k, v in airfoil_mod._flat(b["uncertainty"] or {}).items():
+                stated["%s %s" % (b["label"], k)] = v
+        return values, stated, truth, result
+
+
+def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
+    t0 = time.perf_counter()
+    chain = Chain(name, seed, record_seed)
+    rng = np.random.default_rng(seed)
+    reference, _, _, _ = chain.trial(np.random.default_rng(0), errors=())
+    values, stated, truth = {}, {}, {}
+    pose = []
+    for k in range(trials):
+        v, s, t, result = chain.trial(rng, draws=airfoil_mod.DEFAULT_DRAWS if k < n_stated
+                                      else 0, errors=errors)
+        pose.append(result.pose_uncertainty_mm)
+        for key, x in v.items():
+            values.setdefault(key, []).append(x)
+        if k < n_stated:
+            for key, x in s.items():
+                stated.setdefault(key, []).append(x)
+        for key, x in t.items():
+            truth.setdefault(key, []).append(x)
+    seconds = time.perf_counter() - t0
+    with open(os.path.join(tempfile.gettempdir(), "bi-mc-%s-%s.pkl" % (name, "+".join(errors))),
+              "wb") as fh:       # the trials' raw values, for a second look at the figures
+        pickle.dump({"values": values, "stated": stated, "truth": truth,
+                     "reference": reference}, fh)
+    print("\n%s (errors: %s): %d trials, seed %d, %.0f s wall; %d readings a scan; sensor accuracy %.1f um; "
+          "calibration 1 sigma at the part %.2f um; pose 1 sigma (worst corner) %.2f um"
+          % (name, ", ".join(errors), trials, seed, seconds, len(chain.rec["distance"]),
+             1e3 * chain.sensor.accuracy, 1e3 * chain.model.calibration_mm,
+             1e3 * np.mean(pose)))
+    print("%-30s %9s %9s %6s %5s %9s %6s %5s %9s %4s"
+          % ("characteristic", "stated u", "MC 1sd", "ratio", "30%", "MC rmserr", "ratio",
+             "30%", "bias", "out"))
+    rows = []
+    for key in sorted(values, key=lambda k: (not k.startswith("worst"), k)):
+        if key.endswith("centroid_mm[2]") or key not in stated:
+            continue
+        v = np.asarray(values[key], dtype=float)
+        u = float(np.mean(stated[key]))
+        ref = np.asarray(truth[key]) if key in truth else reference.get(key, np.nan)
+        err = v - ref
+        # Trials beyond OUTLIER_SIGMAS robust sigmas of the median are counted, not averaged
+        # in: a gross failure of one trial (an edge not found) is not the chain's scatter.
+        mad = 1.4826 * np.median(np.abs(err - np.median(err)))
+        keep = np.abs(err - np.median(err)) <= OUTLIER_SIGMAS * max(mad, 1e-12)
+        sd = float(np.std(v[keep], ddof=1))
+        rms = float(np.sqrt(np.mean(err[keep] ** 2)))
+        ratio, ratio_rms = u / sd if sd > 0 else np.nan, u / rms if rms > 0 else np.nan
+        ok, ok_rms = 0.7 <= ratio <= 1.3, 0.7 <= ratio_rms <= 1.3
+        rows.append((key, u, sd, ratio, ok, rms, ratio_rms, ok_rms))
+        print("%-30s %9.5f %9.5f %6.2f %5s %9.5f %6.2f %5s %+9.5f %4d"
+              % (key, u, sd, ratio, "yes" if ok else "NO", rms, ratio_rms,
+                 "yes" if ok_rms else "NO", float(np.mean(err[keep])), int((~keep).sum())))
+    print("%d of %d within +-30 %% of the scatter, %d of %d of the RMS error against the truth"
+          % (sum(r[4] for r in rows), len(rows), sum(r[7] for r in rows), len(rows)))
+    return rows
+
+
+def systematic_sensitivity(name, seed, record_seed=31):
+    """What the sensor's systematic term really does to each judged value through the whole
+    chain: noise-free scans with a reading bias of +-accuracy, the registration included. For
+    a rectangular bias the standard uncertainty is |d value / d bias| * accuracy / sqrt(3);
+    the model states accuracy / sqrt(3) for a deviation (sensitivity 1) and nothing for an
+    airfoil characteristic."""
+    chain = Chain(name, seed, record_seed)
+    a = chain.sensor.accuracy
+    up, _, _, _ = chain.trial(np.random.default_rng(0), errors=(), bias_mm=a)
+    down, _, _, _ = chain.trial(np.random.default_rng(0), errors=(), bias_mm=-a)
+    print("\n%s: the systematic term through the chain (noise-free scans, bias +-%.1f um)"
+          % (name, 1e3 * a))
+    print("%-34s %12s %12s" % ("characteristic", "d value/d b", "u_sys (mm)"))
+    for key in sorted(up, key=lambda k: (not k.startswith("worst"), k)):
+        if key in down and not key.endswith("centroid_mm[2]"):
+            c = (up[key] - down[key]) / (2.0 * a)
+            print("%-34s %12.3f %12.5f" % (key, c, abs(c) * a / np.sqrt(3.0)))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--blade", choices=("demo", "rotor67", "both"), default="both")
+    ap.add_argument("--trials", type=int, default=40)
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--record-seed", type=int, default=31)
+    ap.add_argument("--stated", type=int, default=2,
+                    help="trials whose stated u is averaged (airfoil re-fits are slow)")
+    ap.add_argument("--errors", default=",".join(ERRORS),
+                    help="which of %s to draw (the others left out), to attribute a scatter"
+                    % ",".join(ERRORS))
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="print the systematic term's sensitivities through the chain instead")
+    args = ap.parse_args()
+    if args.sensitivity:
+        for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
+            systematic_sensitivity(name, args.seed, args.record_seed)
+        return
+    errors = tuple(e for e in args.errors.split(",") if e)
+    for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
+        run(name, args.trials, args.seed, args.stated, errors, args.record_seed)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,109 @@
+"""The uncertainty of a worst deviation as the error of a maximum (inspection.uncertainty
+worst_terms, max_of_draws), against independent truth: the order statistics of the sensor's
+noise by direct sampling, and constructed clouds where the worst stands alone (the single
+reading's sigma) or shares a plateau with others (the largest of their noisy readings)."""
+import dataclasses
+import unittest
+
+import numpy as np
+
+from BladeInspect.inspection import uncertainty as U
+from BladeInspect.rig.sensor import NORMAL_CLIP_SIGMAS, SensorModel
+from tests import inspection_fixtures as fx
+from tests.test_fit_pipeline import demo_cloud
+
+DRAWS = 40000
+
+
+class MaxOfDrawsTest(unittest.TestCase):
+    def test_against_sampled_order_statistics(self):
+        rng = np.random.default_rng(11)
+        for noise in ("uniform", "normal"):
+            sensor = SensorModel(noise=noise)
+            for n in (1, 3, 12, 200):
+                if noise == "uniform":
+                    x = rng.uniform(-sensor.accuracy, sensor.accuracy, (DRAWS, n))
+                else:
+                    sd = sensor.accuracy / NORMAL_CLIP_SIGMAS
+                    x = np.clip(sd * rng.standard_normal((DRAWS, n)), -sensor.accuracy,
+                                sensor.accuracy)
+                top = x.max(axis=1) / sensor.sigma_ref
+                mean, sd_max = U.max_of_draws(n, noise)
+                with self.subTest(noise=noise, n=n):
+                    self.assertAlmostEqual(mean, top.mean(), delta=0.02)
+                    self.assertAlmostEqual(sd_max, top.std(), delta=0.02)
+
+
+class WorstTermsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.nominal = fx.demo_nominal()
+        cls.on = demo_cloud(cls.nominal, lambda p: np.zeros(len(p)))
+        cls.sigma = SensorModel().sigma_ref
+
+    def result_with(self, dev):
+        r = fx.make_result(self.nominal, fx.displaced(self.nominal, self.on, dev))
+        return dataclasses.replace(r, pose_covariance=np.zeros((6, 6)))
+
+    def test_a_lone_worst_is_a_single_reading(self):
+        dev = np.zeros(len(self.on))
+        dev[7] = 0.03                       # far above every other point's noise band
+        worst, terms, n = U.worst_terms(self.result_with(dev), np.arange(len(dev)))
+        self.assertEqual((worst, n), (7, 1))
+        single = U.standard_terms(self.result_with(dev), 7)
+        self.assertAlmostEqual(terms["noise_mm"], single["noise_mm"][0], places=12)
+        self.assertAlmostEqual(terms["systematic_mm"], single["systematic_mm"][0], places=12)
+
+    def test_a_plateau_is_the_largest_of_its_readings(self):
+        # 25 points tied at the top (a flat defect): the reported worst is the largest of 25
+        # noisy readings; its RMS error about the plateau, sampled here, is the stated term.
+        dev = np.zeros(len(self.on))
+        dev[:25] = 0.02
+        _, terms, n = U.worst_terms(self.result_with(dev), np.arange(len(dev)))
+        self.assertEqual(n, 25)
+        rng = np.random.default_rng(4)
+        a = SensorModel().accuracy
+        err = rng.uniform(-a, a, (DRAWS, 25)).max(axis=1)
+        self.assertAlmostEqual(terms["noise_mm"], np.sqrt(np.mean(err ** 2)),
+                               delta=0.02 * terms["noise_mm"])
+        self.assertGreater(terms["noise_mm"], 1.5 * self.sigma)
+
+
+
+class SystematicThroughTheFitTest(unittest.TestCase):
+    """The systematic term's coefficients (uncertainty.systematic_coefficients, a linearised
+    fit) against the pipeline's own ICP run on points moved along their beams by a known bias:
+    each deviation's change after the re-fit is s_i * bias."""
+
+    def test_against_a_refit_with_a_known_bias(self):
+        from BladeInspect.core import transforms as tf
+        from BladeInspect.inspection import pipeline
+        from BladeInspect.rig.kinematics import RigKinematics
+        nominal = fx.demo_nominal()
+        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
+        normal = nominal.signed_distance(on).normal
+        # Each point read from the rotary angle (10 deg steps) that sees it most head-on.
+        angles = np.arange(0.0, 360.0, 10.0)
+        k = RigKinematics()
+        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
+        pick = np.argmin(normal @ beams.T, axis=1)
+        seen = (normal @ beams.T)[np.arange(len(on)), pick] < -0.3
+        on, pick = on[seen], pick[seen]
+        result = fx.make_result(nominal, on, columns={"angle_deg": angles[pick]})
+        np.testing.assert_allclose(U.beam_directions(result), beams[pick], atol=1e-12)
+        bias = 0.005
+        moved = on + bias * beams[pick]
+        fit = pipeline.fine_register(moved, None, nominal, np.eye(4))
+        # The weights the fit ran with (its robust weights drop the points it rejected), as a
+        # RegistrationResult carries them.
+        s = U.systematic_coefficients(dataclasses.replace(result, icp_weights=fit.weights))
+        after = nominal.signed_distance(tf.apply_transform(fit.transform, moved)).distance
+        change = after - result.deviation
+        self.assertLess(np.max(np.abs(change - s * bias)), 0.05 * bias)
+        # The fit takes up part of the bias: the coefficients are not simply beam . n.
+        beta = np.einsum("ij,ij->i", beams[pick], result.normal)
+        self.assertGreater(np.max(np.abs(s - beta)), 0.1)
+
+
+if __name__ == "__main__":
+    unittest.main()
