@@ -8,9 +8,10 @@ raster band 0.25 mm off the plane moves along the part, not off it. A planned sc
 within ~1 um of the plane, where the two agree.
 
 Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
-draw moves the section's points by a pose drawn from the registration's covariance and lays
+draw moves the section's points by a pose drawn from the registration's covariance, lays
 fresh sensor noise (the section's own point-to-point scatter) on the measured profile's smooth
-fit at the same places; the standard deviation of each characteristic over the draws is its
+fit at the same places, and adds one reading bias within the sensor's stated accuracy carried
+through the registration as inspection.uncertainty carries it for the deviations; the standard deviation of each characteristic over the draws is its
 uncertainty (a parametric bootstrap; bench/bench_airfoil_uncertainty.py compares it with the
 scatter over repeated simulated scans).
 """
@@ -27,6 +28,8 @@ from ..core import contracts
 from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
+from ..rig.sensor import SensorModel
+from . import uncertainty as uncertainty_mod
 
 # Scalar characteristics, list-valued ones, and which of them have no CAD value (the section's
 # position and contour against the nominal: zero on the nominal by definition).
@@ -54,6 +57,9 @@ class Options:
     tolerances: list = field(default_factory=list)     # of Tolerance
     characteristics_file: str = None
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
+    # the sensor's stated accuracy, a reading bias of unknown sign (half-width, mm); None: the
+    # sensor model's, as inspection.uncertainty takes it for the deviations
+    accuracy_mm: float = None
     seed: int = 0
     le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
     decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
@@ -427,12 +433,19 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
         w, V = np.linalg.eigh(cov)
         chol = V * np.sqrt(np.clip(w, 0, None))
     centre = np.asarray(result.center, dtype=float)
+    # The sensor's systematic error: one reading bias b per draw (rectangular within the stated
+    # accuracy), each point's deviation moved by b s_i, s_i what is left of a unit bias along
+    # its beam after the registration has taken up what a rigid motion can (1 without beams).
+    accuracy = (SensorModel().accuracy if opts.accuracy_mm is None else float(opts.accuracy_mm))
+    response = uncertainty_mod.systematic_coefficients(result)
+    response = np.ones(len(idx)) if response is None else np.asarray(response)[idx]
     draws = []
     for _ in range(max(int(opts.draws), 2)):
         d = chol @ rng.standard_normal(6)
         R = tf.rotation_from_vector(d[3:])
         moved = (smooth3 - centre) @ R.T + centre + d[:3]
         moved = moved + out_normal * (noise * rng.standard_normal(len(moved)))[:, None]
+        moved = moved + n0 * (rng.uniform(-accuracy, accuracy) * response)[:, None]
         p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
         try:
             c, f, k, _ = _measure(p2, nom, opts, noise, nom.le_point)
