@@ -196,10 +196,12 @@ class Nominal:
 
     # ------------------------------------------------------------------ exact distance
 
-    def signed_distance(self, points):
-        """Exact signed distance of (N,3) points to the CAD faces -> DistanceResult."""
+    def signed_distance(self, points, start=None):
+        """Exact signed distance of (N,3) points to the CAD faces -> DistanceResult.
+        ``start``: a core.closest.FootStart of these points, e.g. a previous result's for the
+        same points before they moved a little: it saves work, the answer is the same."""
         points = _as_points(points, "signed_distance: points")
-        out, hard = self.face_set.closest(points)
+        out, hard = self.face_set.closest(points, start)
         # OCC is only called afterwards, from this thread.
         if len(hard):
             self._occ_into(points[hard], out, hard, solid_test=False)

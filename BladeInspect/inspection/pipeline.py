@@ -20,6 +20,7 @@ from ..core import pca as pca_mod
 from ..core import ranking
 from ..core import stats as stats_mod
 from ..core import transforms as tf
+from ..core.closest import FootStart
 from ..core.icp import MAD_TO_SIGMA
 from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
@@ -322,14 +323,32 @@ def exact_closest_fn(nominal):
     return closest
 
 
+class TrackedDistance:
+    """An ICP closest_fn over one fixed set of points (rows in the same order at every call):
+    each call is warm-started from the previous one (core.closest.FootStart), which saves
+    work - the distances are the exact ones, as exact_closest_fn's. ``start`` is the
+    FootStart of the next call (None: cold)."""
+
+    def __init__(self, nominal, start=None):
+        self.nominal = nominal
+        self.start = start
+
+    def __call__(self, points):
+        res = self.nominal.signed_distance(points, self.start)
+        self.start = FootStart.of(points, res)
+        return res.closest, res.normal, res.distance
+
+
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
-                  time_limit_s=FINE_TIME_LIMIT_S):
+                  time_limit_s=FINE_TIME_LIMIT_S, full_distance=None):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
     information (and its covariance is the whole cloud's). Both runs together get
-    ``time_limit_s``; an InputError says so when it is spent."""
+    ``time_limit_s``; an InputError says so when it is spent. ``full_distance``: the
+    TrackedDistance of all the points to use (so that the caller can start its deviations
+    from the fit's last foot points), or None."""
     rng = np.random.default_rng(1) if rng is None else rng
-    closest = exact_closest_fn(nominal)
+    full_distance = full_distance or TrackedDistance(nominal)
     deadline = time.monotonic() + time_limit_s
 
     def remaining():
@@ -339,10 +358,14 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     if n > FINE_SUBSAMPLE:
         sub = _subsample(n, FINE_SUBSAMPLE, rng)
         progress(0.1, "fine registration on %d of %d points" % (len(sub), n))
-        fit = icp_mod.icp(measured_xyz[sub], None if snr is None else snr[sub], closest, T,
-                          icp_mod.ICPOptions(time_limit_s=remaining()))
+        sub_distance = TrackedDistance(nominal)
+        fit = icp_mod.icp(measured_xyz[sub], None if snr is None else snr[sub], sub_distance,
+                          T, icp_mod.ICPOptions(time_limit_s=remaining()))
         _check_time(fit, time_limit_s)
         T = fit.transform
+        # The subsample's last foot points start its rows of the full cloud's first call.
+        full_distance.start = FootStart.none(n)
+        full_distance.start.set_rows(sub, sub_distance.start)
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
                                      trans_tol=FULL_CLOUD_TOL_MM, rot_tol=FULL_CLOUD_TOL_RAD,
                                      linear_update_mm=FULL_CLOUD_TOL_MM,
@@ -351,7 +374,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     else:
         options = icp_mod.ICPOptions(time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
-    fit = icp_mod.icp(measured_xyz, snr, closest, T, options)
+    fit = icp_mod.icp(measured_xyz, snr, full_distance, T, options)
     _check_time(fit, time_limit_s)
     return fit
 
@@ -425,9 +448,11 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         warnings.append(coarse["warning"])
 
     t0 = time.perf_counter()
+    full_distance = TrackedDistance(nominal)
     try:
         fit = fine_register(xyz, snr, nominal, coarse["measured_to_cad"], rng=rng,
-                            progress=lambda f, m: progress(0.3 + 0.6 * f, m))
+                            progress=lambda f, m: progress(0.3 + 0.6 * f, m),
+                            full_distance=full_distance)
     except InputError as exc:
         raise InputError("%s: against %s: %s" % (source, cad_label, exc)) from None
     timing["fine"] = time.perf_counter() - t0
@@ -438,7 +463,8 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     progress(0.92, "signed deviations of %d points" % len(xyz))
     points_cad = tf.apply_transform(fit.transform, xyz)
-    dist = nominal.signed_distance(points_cad)
+    # The fit's last foot points are micrometres from these: Newton starts there.
+    dist = nominal.signed_distance(points_cad, full_distance.start)
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
