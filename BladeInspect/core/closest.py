@@ -101,6 +101,11 @@ class FootStart:
         return cls(np.zeros((n, 3)), np.full(n, -1), np.zeros((n, 2)), np.full(n, -np.inf),
                    np.zeros(n))
 
+    def take(self, rows):
+        """The FootStart of rows ``rows`` alone."""
+        return FootStart(self.points[rows], self.face[rows], self.uv[rows], self.lead[rows],
+                         self.nearest[rows])
+
     def set_rows(self, rows, other):
         """Rows ``rows`` take the starts of ``other``, a FootStart of those points."""
         self.points[rows], self.face[rows], self.uv[rows] = other.points, other.face, other.uv
