@@ -69,6 +69,8 @@ class DistanceResult:
     # a lower bound of the distance to the nearest sample (mm).
     lead: Optional[np.ndarray] = None
     nearest: Optional[np.ndarray] = None
+    # ... and a lower bound of the foot point's (u, v) distance to its face's trimmed boundary.
+    boundary: Optional[np.ndarray] = None
 
     @property
     def fallback_fraction(self):
@@ -86,6 +88,7 @@ class FootStart:
     uv: np.ndarray         # (N, 2)
     lead: np.ndarray       # (N,) DistanceResult.lead
     nearest: np.ndarray    # (N,) DistanceResult.nearest
+    boundary: np.ndarray   # (N,) DistanceResult.boundary
 
     @classmethod
     def of(cls, points, result):
@@ -93,23 +96,26 @@ class FootStart:
         n = len(points)
         lead = result.lead if result.lead is not None else np.full(n, -np.inf)
         nearest = result.nearest if result.nearest is not None else np.zeros(n)
-        return cls(np.array(points, dtype=float), result.face, result.uv, lead, nearest)
+        boundary = result.boundary if result.boundary is not None else np.zeros(n)
+        return cls(np.array(points, dtype=float), result.face, result.uv, lead, nearest,
+                   boundary)
 
     @classmethod
     def none(cls, n):
         """No start for any of n points."""
         return cls(np.zeros((n, 3)), np.full(n, -1), np.zeros((n, 2)), np.full(n, -np.inf),
-                   np.zeros(n))
+                   np.zeros(n), np.zeros(n))
 
     def take(self, rows):
         """The FootStart of rows ``rows`` alone."""
         return FootStart(self.points[rows], self.face[rows], self.uv[rows], self.lead[rows],
-                         self.nearest[rows])
+                         self.nearest[rows], self.boundary[rows])
 
     def set_rows(self, rows, other):
         """Rows ``rows`` take the starts of ``other``, a FootStart of those points."""
         self.points[rows], self.face[rows], self.uv[rows] = other.points, other.face, other.uv
         self.lead[rows], self.nearest[rows] = other.lead, other.nearest
+        self.boundary[rows] = other.boundary
 
 
 @dataclass
@@ -118,6 +124,33 @@ class FaceDomain:
     index: Optional[TrimDomain]      # the discretised boundary, or None for the whole box
     margin: float                    # uv distance to the boundary below which we do not decide
     planar_scale: Optional[float]    # length per parameter unit when the face is a plane
+
+
+def patch_boxes(surf):
+    """(lo (P, 3), hi (P, 3)): a box around each of the surface's polynomial patches (knot
+    spans) that meet its parameter box: the bounding box of the patch's poles, which holds
+    the patch by the convex hull property (a rational surface's weights must be positive;
+    otherwise one box of infinite extent)."""
+    if surf.weights is not None and not np.all(surf.weights > 0):
+        return np.full((1, 3), -np.inf), np.full((1, 3), np.inf)
+    spans = []
+    for knots, degree, (lo, hi) in ((surf.knots_u, surf.degree_u, surf.u_range),
+                                    (surf.knots_v, surf.degree_v, surf.v_range)):
+        i = np.arange(degree, len(knots) - degree - 1)
+        spans.append(i[(knots[i + 1] > knots[i]) & (knots[i + 1] >= lo) & (knots[i] <= hi)])
+    lo, hi = [], []
+    for i in spans[0]:
+        for j in spans[1]:
+            poles = surf.poles[i - surf.degree_u:i + 1, j - surf.degree_v:j + 1].reshape(-1, 3)
+            lo.append(poles.min(axis=0))
+            hi.append(poles.max(axis=0))
+    return np.array(lo), np.array(hi)
+
+
+def box_distance(points, lo, hi):
+    """(N, P) distance of each point to each box (0 inside)."""
+    gap = np.maximum(np.maximum(lo[None] - points[:, None], points[:, None] - hi[None]), 0.0)
+    return np.linalg.norm(gap, axis=2)
 
 
 def point_in_domain(domain, uv):
@@ -139,10 +172,21 @@ class FaceSet:
         self.reversed = np.asarray(reversed_, bool)
         self.samples = samples
         self.tree = cKDTree(samples.xyz)
+        self._patch_boxes = None
 
     def nearest_sample(self, points):
         """Index of each point's nearest sample."""
         return self.tree.query(points)[1]
+
+    def faces_within_reach(self, points):
+        """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
+        the faces, so the nearest one's distance bounds the closest point's from above; a
+        face whose patch boxes (patch_boxes) are all farther cannot hold it."""
+        if self._patch_boxes is None:
+            self._patch_boxes = [patch_boxes(surf) for surf in self.surfaces]
+        reach = self.tree.query(points)[0]
+        return np.column_stack([box_distance(points, lo, hi).min(axis=1) <= reach
+                                for lo, hi in self._patch_boxes])
 
     def closest(self, points, start=None):
         """The fast path on (N, 3) points -> (DistanceResult with the decided rows filled and
@@ -151,7 +195,7 @@ class FaceSet:
         n = len(points)
         out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
                              np.empty((n, 3)), np.empty(n), np.zeros(n, bool),
-                             np.full(n, -np.inf), np.zeros(n))
+                             np.full(n, -np.inf), np.zeros(n), np.zeros(n))
 
         def work(s):
             rows = np.arange(s, min(s + POINT_CHUNK, n))
@@ -183,22 +227,39 @@ class FaceSet:
             diff = S - p
             d = np.linalg.norm(diff, axis=1)
             nrm, degenerate = self.unit_normal(f, Su, Sv)
-            inside, bdist = point_in_domain(self.domains[f], np.column_stack([u, v]))
+            uv = np.column_stack([u, v])
+            inside, bdist = self.still_inside(f, uv, start.uv[r], start.boundary[r])
             nearest = start.nearest[r] - moved[sel]
             ok = (conv & inside & (bdist > self.domains[f].margin) & ~degenerate
                   & ~self.clamped(surf, u, v, diff, Su, Sv, d) & (d <= nearest + SAMPLE_SLACK))
             r, i = r[ok], sel[ok]
             out.closest[r] = S[ok]
             out.face[r] = f
-            out.uv[r] = np.column_stack([u[ok], v[ok]])
+            out.uv[r] = uv[ok]
             out.normal[r] = nrm[ok]
             out.distance[r] = np.where(np.einsum("ij,ij->i", diff[ok], nrm[ok]) > 0, -1.0,
                                        1.0) * d[ok]
             out.fallback[r] = False
             out.lead[r] = start.lead[r] - 2.0 * moved[i]
             out.nearest[r] = nearest[ok]
+            out.boundary[r] = bdist[ok]
             done[i] = True
         return rows[~done]
+
+    def still_inside(self, f, uv, uv_before, boundary_before):
+        """point_in_domain of face f at ``uv``, where the foot points were inside at
+        ``uv_before``, at least ``boundary_before`` from the boundary: a move shorter than
+        the margin left needs no query (it crosses no boundary, and the distance to it falls
+        by at most the move's length)."""
+        domain = self.domains[f]
+        step = np.linalg.norm(uv - uv_before, axis=1)
+        bdist = boundary_before - step
+        known = bdist > domain.margin
+        inside = known.copy()
+        if not known.all():
+            ask = np.flatnonzero(~known)
+            inside[ask], bdist[ask] = point_in_domain(domain, uv[ask])
+        return inside, bdist
 
     def unit_normal(self, f, Su, Sv):
         """(outward unit normals (N,3), degenerate (N,) bool: Su x Sv vanishes) on face f."""
@@ -239,6 +300,7 @@ class FaceSet:
         closest = np.empty((m, 3))
         uv = np.empty((m, 2))
         normal = np.empty((m, 3))
+        boundary = np.empty(m)
         for f in np.unique(pf):
             sel = np.flatnonzero(pf == f)
             surf = self.surfaces[f]
@@ -250,6 +312,7 @@ class FaceSet:
             nrm, degenerate = self.unit_normal(f, Su, Sv)
             inside, bdist = point_in_domain(self.domains[f], np.column_stack([u, v]))
             decided = bdist > self.domains[f].margin
+            boundary[sel] = bdist
             ok = conv & inside & decided & ~degenerate
             dist[sel], closest[sel], uv[sel, 0], uv[sel, 1], normal[sel] = d, S, u, v, nrm
             trusted[sel] = ok
@@ -318,6 +381,7 @@ class FaceSet:
         out.fallback[decided] = False
         out.lead[decided] = np.where(e, -np.inf, lead[good])
         out.nearest[decided] = sample_dist[good, 0]
+        out.boundary[decided] = boundary[b]
         return rows[np.flatnonzero(need)]
 
     @staticmethod
