@@ -8,6 +8,19 @@ Newton on every candidate face (vectorised per face), the smallest distance wins
 only trusted when Newton converged to a point inside the face's trimmed domain, away from its
 boundary; a point whose winner lies on a face edge (clamped at the parameter box) without one
 partner face across it, or that a doubtful candidate might beat, is left undecided.
+
+Warm starts: ICP and the deviations that follow it evaluate the same points again and again,
+each time moved rigidly by less than the last (micrometres at the end). A FootStart carries a
+previous call's answer for the same points. A point that call decided inside a face (not at an
+edge), with every other candidate face farther by its ``lead`` (a lower bound), needs no new
+candidates while it has moved by delta < lead / 2: every distance is 1-Lipschitz in the point,
+so no candidate can overtake the winner. Newton then runs on that face alone from the previous
+(u, v) (one or two iterations), and the point is decided by the same tests as a cold one
+(converged, inside the trimmed domain away from its boundary, not at the parameter box, no
+farther than the nearest sample, whose distance is bounded by the previous one less delta).
+Any other point takes the cold path, Newton starting at its previous (u, v) on the faces it
+shared with the previous call. Only the candidates a cold call would list from the same k-d
+tree are ever considered, so the answer is the cold one, to Newton's tolerance (~1e-10 mm).
 """
 
 from concurrent.futures import ThreadPoolExecutor
@@ -51,6 +64,13 @@ class DistanceResult:
     normal: np.ndarray     # (N, 3) outward unit normal there (at an edge: the direction p - c, signed)
     distance: np.ndarray   # (N,) signed distance, + outside material / on the normal's side
     fallback: Optional[np.ndarray] = None   # (N,) True where OCC decided
+    # For a warm start of the next call (see the module docstring), -inf where none may be
+    # taken: how much farther than the winner any other candidate face is at least (mm), and
+    # a lower bound of the distance to the nearest sample (mm).
+    lead: Optional[np.ndarray] = None
+    nearest: Optional[np.ndarray] = None
+    # ... and a lower bound of the foot point's (u, v) distance to its face's trimmed boundary.
+    boundary: Optional[np.ndarray] = None
 
     @property
     def fallback_fraction(self):
@@ -60,11 +80,77 @@ class DistanceResult:
 
 
 @dataclass
+class FootStart:
+    """A previous closest() call's answer for the same points (rows in the same order), to
+    warm-start the next call after they have moved a little. A row with face -1 has none."""
+    points: np.ndarray     # (N, 3) the points of that call
+    face: np.ndarray       # (N,) int
+    uv: np.ndarray         # (N, 2)
+    lead: np.ndarray       # (N,) DistanceResult.lead
+    nearest: np.ndarray    # (N,) DistanceResult.nearest
+    boundary: np.ndarray   # (N,) DistanceResult.boundary
+
+    @classmethod
+    def of(cls, points, result):
+        """The FootStart of a DistanceResult of ``points``."""
+        n = len(points)
+        lead = result.lead if result.lead is not None else np.full(n, -np.inf)
+        nearest = result.nearest if result.nearest is not None else np.zeros(n)
+        boundary = result.boundary if result.boundary is not None else np.zeros(n)
+        return cls(np.array(points, dtype=float), result.face, result.uv, lead, nearest,
+                   boundary)
+
+    @classmethod
+    def none(cls, n):
+        """No start for any of n points."""
+        return cls(np.zeros((n, 3)), np.full(n, -1), np.zeros((n, 2)), np.full(n, -np.inf),
+                   np.zeros(n), np.zeros(n))
+
+    def take(self, rows):
+        """The FootStart of rows ``rows`` alone."""
+        return FootStart(self.points[rows], self.face[rows], self.uv[rows], self.lead[rows],
+                         self.nearest[rows], self.boundary[rows])
+
+    def set_rows(self, rows, other):
+        """Rows ``rows`` take the starts of ``other``, a FootStart of those points."""
+        self.points[rows], self.face[rows], self.uv[rows] = other.points, other.face, other.uv
+        self.lead[rows], self.nearest[rows] = other.lead, other.nearest
+        self.boundary[rows] = other.boundary
+
+
+@dataclass
 class FaceDomain:
     """A face's trimmed domain in its SurfaceData's (u, v)."""
     index: Optional[TrimDomain]      # the discretised boundary, or None for the whole box
     margin: float                    # uv distance to the boundary below which we do not decide
     planar_scale: Optional[float]    # length per parameter unit when the face is a plane
+
+
+def patch_boxes(surf):
+    """(lo (P, 3), hi (P, 3)): a box around each of the surface's polynomial patches (knot
+    spans) that meet its parameter box: the bounding box of the patch's poles, which holds
+    the patch by the convex hull property (a rational surface's weights must be positive;
+    otherwise one box of infinite extent)."""
+    if surf.weights is not None and not np.all(surf.weights > 0):
+        return np.full((1, 3), -np.inf), np.full((1, 3), np.inf)
+    spans = []
+    for knots, degree, (lo, hi) in ((surf.knots_u, surf.degree_u, surf.u_range),
+                                    (surf.knots_v, surf.degree_v, surf.v_range)):
+        i = np.arange(degree, len(knots) - degree - 1)
+        spans.append(i[(knots[i + 1] > knots[i]) & (knots[i + 1] >= lo) & (knots[i] <= hi)])
+    lo, hi = [], []
+    for i in spans[0]:
+        for j in spans[1]:
+            poles = surf.poles[i - surf.degree_u:i + 1, j - surf.degree_v:j + 1].reshape(-1, 3)
+            lo.append(poles.min(axis=0))
+            hi.append(poles.max(axis=0))
+    return np.array(lo), np.array(hi)
+
+
+def box_distance(points, lo, hi):
+    """(N, P) distance of each point to each box (0 inside)."""
+    gap = np.maximum(np.maximum(lo[None] - points[:, None], points[:, None] - hi[None]), 0.0)
+    return np.linalg.norm(gap, axis=2)
 
 
 def point_in_domain(domain, uv):
@@ -86,19 +172,37 @@ class FaceSet:
         self.reversed = np.asarray(reversed_, bool)
         self.samples = samples
         self.tree = cKDTree(samples.xyz)
+        self._patch_boxes = None
 
     def nearest_sample(self, points):
         """Index of each point's nearest sample."""
         return self.tree.query(points)[1]
 
-    def closest(self, points):
+    def faces_within_reach(self, points):
+        """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
+        the faces, so the nearest one's distance bounds the closest point's from above; a
+        face whose patch boxes (patch_boxes) are all farther cannot hold it."""
+        if self._patch_boxes is None:
+            self._patch_boxes = [patch_boxes(surf) for surf in self.surfaces]
+        reach = self.tree.query(points)[0]
+        return np.column_stack([box_distance(points, lo, hi).min(axis=1) <= reach
+                                for lo, hi in self._patch_boxes])
+
+    def closest(self, points, start=None):
         """The fast path on (N, 3) points -> (DistanceResult with the decided rows filled and
-        ``fallback`` False there, the undecided rows (M,) for an exact solver to fill)."""
+        ``fallback`` False there, the undecided rows (M,) for an exact solver to fill).
+        ``start``: a FootStart of these points (see the module docstring), or None."""
         n = len(points)
         out = DistanceResult(np.empty((n, 3)), np.empty(n, int), np.empty((n, 2)),
-                             np.empty((n, 3)), np.empty(n), np.zeros(n, bool))
+                             np.empty((n, 3)), np.empty(n), np.zeros(n, bool),
+                             np.full(n, -np.inf), np.zeros(n), np.zeros(n))
+
+        def work(s):
+            rows = np.arange(s, min(s + POINT_CHUNK, n))
+            if start is not None:
+                rows = self.warm_chunk(points, rows, out, start)
+            return self.closest_chunk(points[rows], out, rows, start)
         starts = range(0, n, POINT_CHUNK)
-        work = lambda s: self.closest_chunk(points[s:s + POINT_CHUNK], out, s)
         # numpy releases the GIL in its array loops: chunks on two threads use both cores.
         if len(starts) > 1:
             with ThreadPoolExecutor(max_workers=THREADS) as pool:
@@ -107,10 +211,71 @@ class FaceSet:
             hard = [work(s) for s in starts]
         return out, (np.concatenate(hard) if hard else np.zeros(0, int))
 
-    def closest_chunk(self, points, out, offset):
-        """The fast path on one chunk of points: fills ``out``'s rows offset + i it decides
-        and returns the rows (offset + i) it leaves to the exact fallback."""
+    def warm_chunk(self, points, rows, out, start):
+        """The warm path (module docstring) on ``points[rows]``: fills ``out``'s rows it
+        decides and returns the others, for the cold path."""
+        moved = np.linalg.norm(points[rows] - start.points[rows], axis=1)
+        face = start.face[rows]
+        warm = (face >= 0) & (start.lead[rows] > 2.0 * moved)
+        done = np.zeros(len(rows), bool)
+        for f in np.unique(face[warm]):
+            sel = np.flatnonzero(warm & (face == f))
+            r = rows[sel]
+            surf = self.surfaces[f]
+            p = points[r]
+            u, v, S, Su, Sv, conv = bspline.project(surf, p, start.uv[r, 0], start.uv[r, 1])
+            diff = S - p
+            d = np.linalg.norm(diff, axis=1)
+            nrm, degenerate = self.unit_normal(f, Su, Sv)
+            uv = np.column_stack([u, v])
+            inside, bdist = self.still_inside(f, uv, start.uv[r], start.boundary[r])
+            nearest = start.nearest[r] - moved[sel]
+            ok = (conv & inside & (bdist > self.domains[f].margin) & ~degenerate
+                  & ~self.clamped(surf, u, v, diff, Su, Sv, d) & (d <= nearest + SAMPLE_SLACK))
+            r, i = r[ok], sel[ok]
+            out.closest[r] = S[ok]
+            out.face[r] = f
+            out.uv[r] = uv[ok]
+            out.normal[r] = nrm[ok]
+            out.distance[r] = np.where(np.einsum("ij,ij->i", diff[ok], nrm[ok]) > 0, -1.0,
+                                       1.0) * d[ok]
+            out.fallback[r] = False
+            out.lead[r] = start.lead[r] - 2.0 * moved[i]
+            out.nearest[r] = nearest[ok]
+            out.boundary[r] = bdist[ok]
+            done[i] = True
+        return rows[~done]
+
+    def still_inside(self, f, uv, uv_before, boundary_before):
+        """point_in_domain of face f at ``uv``, where the foot points were inside at
+        ``uv_before``, at least ``boundary_before`` from the boundary: a move shorter than
+        the margin left needs no query (it crosses no boundary, and the distance to it falls
+        by at most the move's length)."""
+        domain = self.domains[f]
+        step = np.linalg.norm(uv - uv_before, axis=1)
+        bdist = boundary_before - step
+        known = bdist > domain.margin
+        inside = known.copy()
+        if not known.all():
+            ask = np.flatnonzero(~known)
+            inside[ask], bdist[ask] = point_in_domain(domain, uv[ask])
+        return inside, bdist
+
+    def unit_normal(self, f, Su, Sv):
+        """(outward unit normals (N,3), degenerate (N,) bool: Su x Sv vanishes) on face f."""
+        nrm = np.cross(Su, Sv)
+        nlen = np.linalg.norm(nrm, axis=1)
+        degenerate = nlen <= 1e-12 * np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1) + 1e-300
+        nrm /= np.where(nlen > 0, nlen, 1.0)[:, None]
+        return (-nrm if self.reversed[f] else nrm), degenerate
+
+    def closest_chunk(self, points, out, rows, foot_start=None):
+        """The cold fast path on the points of ``out``'s rows ``rows``: fills the rows it
+        decides and returns those it leaves to the exact fallback. ``foot_start``: a
+        FootStart of all of ``out``'s points, for Newton's starts, or None."""
         n = len(points)
+        if n == 0:
+            return rows
         k = min(K_CANDIDATES, len(self.samples.xyz))
         sample_dist, idx = self.tree.query(points, k=k)
         if k == 1:
@@ -123,6 +288,9 @@ class FaceSet:
         pi, cj = np.nonzero(first)
         pf = faces[pi, cj]
         start = self.samples.uv[idx[pi, cj]]
+        if foot_start is not None:
+            warm = foot_start.face[rows[pi]] == pf
+            start[warm] = foot_start.uv[rows[pi[warm]]]
         m = len(pi)
         dist = np.full(m, np.inf)
         lower = np.full(m, np.inf)       # a lower bound of the candidate's true face distance
@@ -132,6 +300,7 @@ class FaceSet:
         closest = np.empty((m, 3))
         uv = np.empty((m, 2))
         normal = np.empty((m, 3))
+        boundary = np.empty(m)
         for f in np.unique(pf):
             sel = np.flatnonzero(pf == f)
             surf = self.surfaces[f]
@@ -140,14 +309,10 @@ class FaceSet:
             r = S - p
             d = np.linalg.norm(r, axis=1)
             clamped = self.clamped(surf, u, v, r, Su, Sv, d)
-            nrm = np.cross(Su, Sv)
-            nlen = np.linalg.norm(nrm, axis=1)
-            degenerate = nlen <= 1e-12 * np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1) + 1e-300
-            nrm /= np.where(nlen > 0, nlen, 1.0)[:, None]
-            if self.reversed[f]:
-                nrm = -nrm
+            nrm, degenerate = self.unit_normal(f, Su, Sv)
             inside, bdist = point_in_domain(self.domains[f], np.column_stack([u, v]))
             decided = bdist > self.domains[f].margin
+            boundary[sel] = bdist
             ok = conv & inside & decided & ~degenerate
             dist[sel], closest[sel], uv[sel, 0], uv[sel, 1], normal[sel] = d, S, u, v, nrm
             trusted[sel] = ok
@@ -192,7 +357,12 @@ class FaceSet:
         need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
         good = ~need
         b = best[good]
-        rows = offset + np.flatnonzero(good)
+        # The lead of a point decided inside a face: the least gap from its winner to another
+        # candidate's lower bound (none at an edge, where the partner face is as near).
+        lead = np.full(n, np.inf)
+        other = np.arange(m) != bp
+        np.minimum.at(lead, pi[other], lower[other] - best_d[pi[other]])
+        decided = rows[good]
         c = closest[b]
         nrm = normal[b].copy()
         e = edge[good]
@@ -203,13 +373,16 @@ class FaceSet:
             # At an edge the distance runs along p - c, not along either face's normal.
             de = np.maximum(dist[b][e], 1e-300)
             nrm[e] = sign[e, None] * diff[e] / de[:, None]
-        out.closest[rows] = c
-        out.face[rows] = pf[b]
-        out.uv[rows] = uv[b]
-        out.normal[rows] = nrm
-        out.distance[rows] = sign * dist[b]
-        out.fallback[rows] = False
-        return offset + np.flatnonzero(need)
+        out.closest[decided] = c
+        out.face[decided] = pf[b]
+        out.uv[decided] = uv[b]
+        out.normal[decided] = nrm
+        out.distance[decided] = sign * dist[b]
+        out.fallback[decided] = False
+        out.lead[decided] = np.where(e, -np.inf, lead[good])
+        out.nearest[decided] = sample_dist[good, 0]
+        out.boundary[decided] = boundary[b]
+        return rows[np.flatnonzero(need)]
 
     @staticmethod
     def clamped(surf, u, v, r, Su, Sv, d):
