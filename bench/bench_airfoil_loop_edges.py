@@ -166,6 +166,17 @@ def main():
                   % (blade, es, args.spacing, args.accuracy, 1e3 * sensor.sigma_ref,
                      "whole loop" if args.loop else "true pose", args.scans, wall,
                      read[0][1], read[0][0]))
+            info = plan.info.get("edge_density")
+            if info:
+                print("edge rule: n = %d points per +-%g deg zone (x %.2f), noise %.2f um, "
+                      "sigma_R %.1f um" % (info["points_per_zone"], info["zone_deg"],
+                                           info["margin"], 1e3 * info["noise_mm"],
+                                           1e3 * info["radius_sigma_mm"]))
+                for sec, edges in zip(plan.sections, info["sections"]):
+                    print("  %g %%: %s" % (sec.height_pct, "; ".join(
+                        "%s r %.3f mm spacing %.2f um" % (e["edge"], e["radius_mm"],
+                                                          1e3 * e["spacing_mm"])
+                        for e in edges)))
             print("%-6s %-14s %10s %10s %10s  %s" % ("sect", "char", "bias um", "1sd um",
                                                     "max|d| um", "nominal / zone pts, inc"))
             for b, c in zip(stage.blocks, counts):
