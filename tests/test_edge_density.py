@@ -158,6 +158,15 @@ class EdgeDensityInTheInspectPlan(unittest.TestCase):
             self.assertIn("--edge-radius-sigma", str(ctx.exception))
         self.assertIsNone(planning.edge_radius_sigma(0))
 
+    def test_an_edge_under_two_spots_is_said(self):
+        spot = self.sensor.spot
+        edges = [[{"edge": "LE", "radius_mm": 0.2, "spacing_mm": 1e-3},
+                  {"edge": "TE", "radius_mm": 1.5 * spot, "spacing_mm": 1e-4}]]
+        info = planning.edge_density_info((self.sensor.sigma_ref, 0.002), edges, [90.0], spot)
+        self.assertEqual(len(info["warnings"]), 1)
+        self.assertIn("TE radius", info["warnings"][0])
+        self.assertEqual(self.runs[0][1].info["edge_density"]["warnings"], [])
+
     def test_perfect_part_edge_radii_within_5_um_of_the_cad(self):
         for rig, plan in self.runs:
             result = read_plan(self.nominal, rig, plan)

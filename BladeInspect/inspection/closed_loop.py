@@ -551,6 +551,10 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     t0 = time.perf_counter()
     columns, result = _result_of_all(nominal, blind, blind_sections, measured, phase.name, xyz,
                                      snr, fit, first, timing, cad_label, phase.source)
+    # issue 15 item 7: the plan's edges a sensor spot averages away are said, not hidden
+    edge_rule = (getattr(plan, "info", None) or {}).get("edge_density")
+    if edge_rule:
+        result.warnings += edge_rule["warnings"]
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_measured, heights,

@@ -205,6 +205,9 @@ EDGE_DENSIFY_MARGIN = 1.25
 # `inspect` plans its sections with this edge-radius 1-sigma target (issue 15 item 7; its
 # --edge-radius-sigma changes it, 0 or off turns the rule off).
 DEFAULT_EDGE_RADIUS_SIGMA_MM = 0.002
+# An edge whose radius is under this many spot diameters is averaged away by the spot (the
+# simulated sensor has none, so its figures cannot show it).
+EDGE_SPOT_RADII = 2.0
 
 
 def _edge_spacing(loop, plane_point, plane_normal, spacing, noise_mm, radius_sigma_mm,
@@ -523,7 +526,8 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     info = {"max_incidence_deg": max_incidence_deg, "angle_step_deg": ANGLE_STEP_DEG,
             "body_radius_mm": BODY_RADIUS_MM,
             "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections],
-            "edge_density": edge_density_info(densify, edges)}
+            "edge_density": edge_density_info(densify, edges, heights,
+                                              float(getattr(sensor, "spot", 0.0)))}
     return Plan(sections=sections, paths=paths, table_to_cad=table_to_cad, span_axis=axis,
                 span_range=(lo, hi), axis_point=kinematics.axis_point.copy(),
                 axis_direction=kinematics.axis_direction.copy(),
@@ -547,13 +551,21 @@ def edge_radius_sigma(value):
     return v
 
 
-def edge_density_info(densify, edges):
-    """plan.json's and result.json's record of the edge rule a plan used (None: off)."""
+def edge_density_info(densify, edges, heights, spot_mm):
+    """plan.json's and result.json's record of the edge rule a plan used (None: off), with a
+    warning for each edge whose radius is under EDGE_SPOT_RADII sensor spots: the rule counts
+    readings as independent points, a real reading averages the surface over its spot."""
     if densify is None:
         return None
     from ..core import airfoil
     noise, target = densify
-    return {"radius_sigma_mm": target, "noise_mm": noise,
+    warnings = ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
+                "reading averages the edge over its spot, so this edge's radius is not "
+                "measured by this sensor, however dense the points"
+                % (h, e["edge"], e["radius_mm"], EDGE_SPOT_RADII, spot_mm)
+                for h, section in zip(heights, edges) for e in section
+                if e["radius_mm"] < EDGE_SPOT_RADII * spot_mm]
+    return {"radius_sigma_mm": target, "noise_mm": noise, "warnings": warnings,
             "zone_deg": airfoil.DEFAULT_EDGE_ZONE_DEG,
             "points_per_zone": airfoil.edge_points_needed(noise, target),
             "margin": EDGE_DENSIFY_MARGIN, "reach_radii": EDGE_DENSIFY_REACH,
