@@ -207,7 +207,7 @@ EDGE_DENSIFY_MARGIN = 1.25
 DEFAULT_EDGE_RADIUS_SIGMA_MM = 0.002
 # An edge whose radius is under this many spot diameters is averaged away by the spot (the
 # simulated sensor has none, so its figures cannot show it).
-EDGE_SPOT_RADII = 2.0
+EDGE_MIN_SPOTS = 2.0
 
 
 def _edge_spacing(loop, plane_point, plane_normal, spacing, noise_mm, radius_sigma_mm,
@@ -553,7 +553,7 @@ def edge_radius_sigma(value):
 
 def edge_density_info(densify, edges, heights, spot_mm):
     """plan.json's and result.json's record of the edge rule a plan used (None: off), with a
-    warning for each edge whose radius is under EDGE_SPOT_RADII sensor spots: the rule counts
+    warning for each edge whose radius is under EDGE_MIN_SPOTS sensor spots: the rule counts
     readings as independent points, a real reading averages the surface over its spot."""
     if densify is None:
         return None
@@ -562,9 +562,9 @@ def edge_density_info(densify, edges, heights, spot_mm):
     warnings = ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
                 "reading averages the edge over its spot, so this edge's radius is not "
                 "measured by this sensor, however dense the points"
-                % (h, e["edge"], e["radius_mm"], EDGE_SPOT_RADII, spot_mm)
+                % (h, e["edge"], e["radius_mm"], EDGE_MIN_SPOTS, spot_mm)
                 for h, section in zip(heights, edges) for e in section
-                if e["radius_mm"] < EDGE_SPOT_RADII * spot_mm]
+                if e["radius_mm"] < EDGE_MIN_SPOTS * spot_mm]
     return {"radius_sigma_mm": target, "noise_mm": noise, "warnings": warnings,
             "zone_deg": airfoil.DEFAULT_EDGE_ZONE_DEG,
             "points_per_zone": airfoil.edge_points_needed(noise, target),
