@@ -560,8 +560,9 @@ def edge_density_info(densify, edges, heights, spot_mm):
     from ..core import airfoil
     noise, target = densify
     warnings = ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
-                "reading averages the edge over its spot, so this edge's radius is not "
-                "measured by this sensor, however dense the points"
+                "reading averages the edge over its spot, so this edge's radius, edge point "
+                "and the chord through it are not measured by this sensor, however dense "
+                "the points"
                 % (h, e["edge"], e["radius_mm"], EDGE_MIN_SPOTS, spot_mm)
                 for h, section in zip(heights, edges) for e in section
                 if e["radius_mm"] < EDGE_MIN_SPOTS * spot_mm]
