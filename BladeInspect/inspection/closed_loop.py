@@ -41,7 +41,7 @@ from ..core import stats as stats_mod
 from ..core.pointio import PointSet, write_points_csv
 from ..measurement import scan as scan_mod
 from ..measurement.complete import check_step, plan_complete, scan_complete
-from ..measurement.planning import plan_sections
+from ..measurement.planning import DEFAULT_EDGE_RADIUS_SIGMA_MM, edge_radius_sigma, plan_sections
 from ..rig.kinematics import RigKinematics
 from . import airfoil as airfoil_mod
 from . import pipeline
@@ -198,7 +198,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
                 seed=0, rig_file=None,
                 progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=None,
                 scan_options=None, on_plan=None, resume=False, flip_faces=(),
-                allow_mismatch=False, airfoil=None, fit_choice=None, measurement_model=None):
+                allow_mismatch=False, airfoil=None, fit_choice=None, measurement_model=None,
+                edge_radius_sigma_mm=DEFAULT_EDGE_RADIUS_SIGMA_MM):
     """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
     replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
     ``scan_options``: options of the blind scan (measurement.scan.scan_to_dir, e.g. n_sections).
@@ -209,6 +210,8 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     blind scan that does not fit the CAD, with the warning (pipeline.register). ``airfoil``: an
     inspection.airfoil.Options to add the airfoil characteristics (issue 15; None: none).
     ``fit_choice``, ``measurement_model``: the fit and the decision, as for `report`.
+    ``edge_radius_sigma_mm``: the planned sections' edge-density target (issue 15 item 7,
+    measurement.planning; None, 0 or "off": the rule off).
     ``document``: the writer of inspection.FCStd (app.document.write_inspection_document, which
     this layer cannot import), or None for no document. Returns a summary dict.
     The result files appear in out_dir together, or none: on a
@@ -222,6 +225,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     if complete:
         pitch = check_step(pitch, "--pitch")
     cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
+    edge_radius_sigma_mm = edge_radius_sigma(edge_radius_sigma_mm)
     if scan_options is not None or not resume:
         scan_options = dict(scan_options or {})
         scan_options.setdefault("epsilon", epsilon)
@@ -246,8 +250,10 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
                                 "weights": getattr(fit_choice, "weights", None)}  # issue 16
             judge_options = {"fit_choice": fit_choice,   # hook: issue 16
                              "measurement_model": measurement_model}
-            phase_of = _RasterPhase if complete else _SectionsPhase
-            phase = phase_of(nominal, checkpoint.rig, kinematics, epsilon, pitch)
+            phase = (_RasterPhase(nominal, checkpoint.rig, kinematics, epsilon, pitch)
+                     if complete else
+                     _SectionsPhase(nominal, checkpoint.rig, kinematics, epsilon, pitch,
+                                    edge_radius_sigma_mm))
             try:
                 summary = _loop(phase, nominal, checkpoint.rig, kinematics, heights, seed,
                                 cmm_data, tolerance, out, checkpoint, timing, progress,
@@ -333,8 +339,9 @@ class _SectionsPhase:
     source = "inspect: blind and planned scans"
     title = "BladeInspect inspection (CAD-planned sections)"
 
-    def __init__(self, nominal, rig, kinematics, epsilon, pitch):
+    def __init__(self, nominal, rig, kinematics, epsilon, pitch, edge_radius_sigma_mm=None):
         self.nominal, self.rig, self.kinematics, self.epsilon = nominal, rig, kinematics, epsilon
+        self.edge_radius_sigma_mm = edge_radius_sigma_mm
 
     def fresh_state(self, pose):
         return {"phase": self.name, "attempt": 0, "plan_pose": pose.tolist(),
@@ -347,7 +354,8 @@ class _SectionsPhase:
     def plan(self, pose, attempt, heights, span_axis, progress):
         progress(0.45 + 0.05 * attempt, "planning the nominal sections from the CAD")
         return plan_sections(self.nominal, pose, heights, self.rig.sensor, self.rig.limits,
-                             span_axis=span_axis, kinematics=self.kinematics)
+                             span_axis=span_axis, kinematics=self.kinematics,
+                             edge_radius_sigma_mm=self.edge_radius_sigma_mm)  # issue 15 item 7
 
     def scan(self, plan, attempt, first, on_unit, progress):
         scan_plan(self.rig, plan, self.kinematics,
@@ -393,7 +401,8 @@ class _SectionsPhase:
 
     def result_json(self, plan, n_read, state, rig_s, timing):
         return {"replans": state["replans"], "n_points_by_phase": {"blind": None,
-                                                                    self.name: n_read}}
+                                                                    self.name: n_read},
+                "edge_density": plan.info.get("edge_density")}  # issue 15 item 7
 
     def summary(self, plan, state, rig_s, timing):
         return {"replans": state["replans"]}
@@ -551,6 +560,10 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     columns, result = _result_of_all(nominal, blind, blind_sections, measured, phase.name, xyz,
                                      snr, fit, first, timing, cad_label, phase.source)
     result.weights = weights_record   # hook: issue 16 item 3
+    # issue 15 item 7: the plan's edges a sensor spot averages away are said, not hidden
+    edge_rule = (getattr(plan, "info", None) or {}).get("edge_density")
+    if edge_rule:
+        result.warnings += edge_rule["warnings"]
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(result, nominal, n_blind, n_measured, heights,

@@ -186,22 +186,35 @@ EDGE_DENSIFY_REACH = 2.0
 # the fitted circle: this many times the rule's points (measured on the demo blade: 1.0 gave
 # sigma_R 2.23 um for a 2 um target).
 EDGE_DENSIFY_MARGIN = 1.25
+# `inspect` plans its sections with this edge-radius 1-sigma target (issue 15 item 7; its
+# --edge-radius-sigma changes it, 0 or off turns the rule off).
+DEFAULT_EDGE_RADIUS_SIGMA_MM = 0.002
+# An edge whose radius is under this many spot diameters is averaged away by the spot (the
+# simulated sensor has none, so its figures cannot show it).
+EDGE_MIN_SPOTS = 2.0
 
 
-def _edge_spacing(loop, plane_point, plane_normal, spacing, noise_mm, radius_sigma_mm):
+def _edge_spacing(loop, plane_point, plane_normal, spacing, noise_mm, radius_sigma_mm,
+                  record=None):
     """Spacing wanted at each vertex of a closed loop: ``spacing``, or within
     EDGE_DENSIFY_REACH radii of an edge circle (core/airfoil.py's LE/TE fit on the cut) the
-    spacing that gives its +-45 degree zone edge_points_needed(noise, sigma_R) points."""
+    spacing that gives its +-45 degree zone edge_points_needed(noise, sigma_R) points.
+    ``record``: a list that gets each edge's circle and spacing (the plan's info)."""
     from ..cad.airfoil_sections import plane_frame
     from ..core import airfoil
     frame = plane_frame(plane_point, plane_normal)
     xy = frame.to_2d(loop)
     ch = airfoil.characteristics(xy)
     h = np.full(len(loop), float(spacing))
-    for circle in (ch.le_circle, ch.te_circle):
+    for name, circle in (("LE", ch.le_circle), ("TE", ch.te_circle)):
         near = np.linalg.norm(xy - circle.center, axis=1) <= EDGE_DENSIFY_REACH * circle.radius
-        h[near] = np.minimum(h[near], airfoil.edge_spacing_mm(
-            circle.radius, noise_mm, radius_sigma_mm) / EDGE_DENSIFY_MARGIN)
+        edge_h = airfoil.edge_spacing_mm(circle.radius, noise_mm,
+                                         radius_sigma_mm) / EDGE_DENSIFY_MARGIN
+        h[near] = np.minimum(h[near], edge_h)
+        if record is not None:
+            record.append({"edge": name, "radius_mm": float(circle.radius),
+                           "center_cad": frame.to_3d(circle.center)[0].tolist(),
+                           "spacing_mm": float(min(edge_h, spacing))})
     return h
 
 
@@ -218,12 +231,13 @@ def _resample_graded(loop, h):
     return np.column_stack([np.interp(t, arc, pts[:, k]) for k in range(3)])
 
 
-def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=None):
+def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=None,
+                    edge_record=None):
     """Points every ``spacing`` mm along the CAD's cut by the plane, each exactly on the CAD and
     on the plane, with outward normals, in contour order. Returns (points, normals, contours),
     contours a list of (first index, end index, closed). InputError when the plane misses.
     ``edge_densify`` = (noise_mm, radius_sigma_mm): closed contours get points closer round
-    their LE and TE (``_edge_spacing``)."""
+    their LE and TE (``_edge_spacing``, which adds each edge to the list ``edge_record``)."""
     from ..cad.sections import cut   # cad/ needs FreeCAD; measurement/ imports without it
     n = np.asarray(plane_normal, dtype=float)
     n = n / np.linalg.norm(n)
@@ -233,7 +247,7 @@ def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=No
         closed = len(line) > 2 and np.linalg.norm(line[0] - line[-1]) < 1e-9
         if closed and edge_densify is not None:
             p = _resample_graded(line[:-1], _edge_spacing(line[:-1], o, n, spacing,
-                                                          *edge_densify))
+                                                          *edge_densify, record=edge_record))
         else:
             p = _resample(line[:-1] if closed else line, closed, spacing)
         contours.append((start, start + len(p), closed))
@@ -457,14 +471,16 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     kinematics = kinematics if kinematics is not None else RigKinematics()
     samples_table = tf.apply_transform(cad_to_table, nominal.samples.xyz)
 
-    works = []
+    edge_radius_sigma_mm = edge_radius_sigma(edge_radius_sigma_mm)
+    densify = (None if edge_radius_sigma_mm is None
+               else (float(sensor.sigma_ref), edge_radius_sigma_mm))
+    works, edges = [], []
     for k, h in enumerate(heights):
         plane_point = origin + axis * (lo + (hi - lo) * h / 100.0)
+        edges.append([])
         try:
-            densify = (None if edge_radius_sigma_mm is None
-                       else (float(sensor.sigma_ref), float(edge_radius_sigma_mm)))
             target, normal, contours = nominal_section(nominal, plane_point, axis, spacing,
-                                                       densify)
+                                                       densify, edges[-1])
         except InputError as exc:
             raise InputError("--section-heights %g: %s" % (h, exc)) from None
         works.append(_SectionWork(k, h, plane_point, axis, target, normal, contours,
@@ -493,11 +509,55 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
             last_stage = stage[run[-1]]
     info = {"max_incidence_deg": max_incidence_deg, "angle_step_deg": ANGLE_STEP_DEG,
             "body_radius_mm": BODY_RADIUS_MM,
-            "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections]}
+            "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections],
+            "edge_density": edge_density_info(densify, edges, heights,
+                                              float(getattr(sensor, "spot", 0.0)))}
     return Plan(sections=sections, paths=paths, table_to_cad=table_to_cad, span_axis=axis,
                 span_range=(lo, hi), axis_point=kinematics.axis_point.copy(),
                 axis_direction=kinematics.axis_direction.copy(),
                 standoff_mm=float(sensor.standoff), spacing_mm=float(spacing), info=info)
+
+
+def edge_radius_sigma(value):
+    """The edge rule's target sigma_R in mm from a caller's or the command line's value: None,
+    0 or "off" turn the rule off (None returned); InputError for anything else not positive."""
+    if value is None or (isinstance(value, str) and value.strip().lower() == "off"):
+        return None
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = float("nan")
+    if v == 0:
+        return None
+    if not (np.isfinite(v) and v > 0):
+        raise InputError("--edge-radius-sigma: expected a positive 1-sigma in mm, 0 or off, "
+                         "got %r" % (value,))
+    return v
+
+
+def edge_density_info(densify, edges, heights, spot_mm):
+    """plan.json's and result.json's record of the edge rule a plan used (None: off), with a
+    warning for each edge whose radius is under EDGE_MIN_SPOTS sensor spots: the rule counts
+    readings as independent points, a real reading averages the surface over its spot."""
+    if densify is None:
+        return None
+    from ..core import airfoil
+    noise, target = densify
+    warnings = ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
+                "reading averages the edge over its spot, so this edge's radius, edge point "
+                "and the chord through it are not measured by this sensor, however dense "
+                "the points"
+                % (h, e["edge"], e["radius_mm"], EDGE_MIN_SPOTS, spot_mm)
+                for h, section in zip(heights, edges) for e in section
+                if e["radius_mm"] < EDGE_MIN_SPOTS * spot_mm]
+    return {"radius_sigma_mm": target, "noise_mm": noise, "warnings": warnings,
+            "zone_deg": airfoil.DEFAULT_EDGE_ZONE_DEG,
+            "points_per_zone": airfoil.edge_points_needed(noise, target),
+            "margin": EDGE_DENSIFY_MARGIN, "reach_radii": EDGE_DENSIFY_REACH,
+            "rule": "n = ceil((noise / radius_sigma * f(zone))^2) points in each +-zone edge "
+                    "zone, times margin, spread within reach_radii edge radii of the edge "
+                    "circle's centre (docs/airfoil.md)",
+            "sections": edges}
 
 
 def _cad_from_machine(table_to_cad, kinematics, angle_deg):
