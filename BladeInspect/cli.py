@@ -502,7 +502,12 @@ def run_program():
     command = next((a for a in sys.argv[1:] if not a.startswith("-")), "")
     _record_status(status_file, "started %s\tFreeCAD %s, Python %s"
                    % (command, versions["freecad"], versions["python"]))
-    code = main()
+    try:
+        code = main()
+    except SystemExit as stop:   # argparse's --help (0) and usage errors (2) end here
+        code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+        if not isinstance(stop.code, (int, type(None))):
+            sys.stderr.write("%s\n" % stop.code)
     _record_status(status_file, "finished %d" % code)
     return code
 

@@ -134,5 +134,19 @@ class CrashIsNeverSilent(unittest.TestCase):
             self.assertIn("Fatal Python error", fh.read())
 
 
+class HelpAndUsageAreNoCrash(unittest.TestCase):
+    """argparse ends --help and a usage error with SystemExit: the run finished, it did not
+    crash (the wrapper once said 'crashed' after every --help)."""
+
+    def test_help_and_a_usage_error(self):
+        for args, status, words in ((["report", "--help"], 0, "usage:"),
+                                    (["report", "--no-such-option"], 2, "required")):
+            done = subprocess.run([BLADEINSPECT] + args, capture_output=True, text=True,
+                                  timeout=120)
+            self.assertEqual(done.returncode, status, done.stderr)
+            self.assertIn(words, done.stdout + done.stderr)
+            self.assertNotIn("crashed", done.stdout + done.stderr)
+
+
 if __name__ == "__main__":
     unittest.main()
