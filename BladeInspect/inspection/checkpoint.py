@@ -223,9 +223,11 @@ def _saved_checkpoint(record_path):
     return state
 
 
-def inspection_identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan_options):
+def inspection_identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan_options,
+                        edge_radius_sigma_mm=None):
     """What a resumed inspection must share with the interrupted one to measure the same
-    points (JSON-ready). ``scan_options`` None: whatever the interrupted run used."""
+    points (JSON-ready). ``scan_options`` None: whatever the interrupted run used;
+    ``edge_radius_sigma_mm`` the planned sections' edge-density target (None: off)."""
     options = None
     if scan_options is not None:
         options = contracts.json_ready(scan_options)
@@ -233,13 +235,16 @@ def inspection_identity(nominal, seed, heights, complete, pitch, epsilon, kinema
             "seed": int(seed), "section_heights": [float(h) for h in heights],
             "complete": bool(complete), "pitch_mm": float(pitch) if complete else None,
             "epsilon_mm": float(epsilon), "kinematics": kinematics.to_dict(),
-            "scan_options": options}
+            "scan_options": options,
+            "edge_radius_sigma_mm": (None if edge_radius_sigma_mm is None
+                                     else float(edge_radius_sigma_mm))}
 
 
 IDENTITY_FLAGS = (("cad_bbox", "the CAD (its bounding box)"), ("seed", "--seed"),
                   ("section_heights", "--section-heights"), ("complete", "--complete"),
                   ("pitch_mm", "--pitch"), ("epsilon_mm", "epsilon"),
-                  ("kinematics", "--rig-file"), ("scan_options", "the blind scan's options"))
+                  ("kinematics", "--rig-file"), ("scan_options", "the blind scan's options"),
+                  ("edge_radius_sigma_mm", "--edge-radius-sigma"))
 
 
 def _same_identity(saved, given, out_dir):

@@ -235,7 +235,7 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
         nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
     kinematics = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
     identity = inspection_identity(nominal, seed, heights, complete, pitch, epsilon,
-                                   kinematics, scan_options)
+                                   kinematics, scan_options, edge_radius_sigma_mm)
     opened = rig is None
     if opened:
         rig = scan_mod.open_rig(rig_spec, nominal=nominal, seed=seed, kinematics=kinematics)
