@@ -26,15 +26,12 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from BladeInspect.core import airfoil as kernel  # noqa: E402
-from BladeInspect.core import stats  # noqa: E402
-from BladeInspect.core import transforms as tf  # noqa: E402
 from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
 from BladeInspect.inspection import sections as sections_mod  # noqa: E402
-from BladeInspect.inspection.result import RegistrationResult  # noqa: E402
 from BladeInspect.measurement.planning import plan_sections  # noqa: E402
 from BladeInspect.rig.sensor import SensorModel  # noqa: E402
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose  # noqa: E402
+from tests.helpers import planned_readings_result  # noqa: E402
 
 HEIGHTS = (10.0, 50.0, 90.0)
 ROTOR67 = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..",
@@ -55,31 +52,6 @@ def truth_pose(nominal, seed):
     c = nominal.bbox_corners
     return random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
                                cad_center=0.5 * (c.min(0) + c.max(0)))
-
-
-def direct_result(nominal, rig, plan):
-    """The planned paths read on the rig, mapped into the CAD by the true pose: a
-    RegistrationResult as the loop's (no registration error)."""
-    k = rig.kinematics
-    xyz, snr, planned = [], [], []
-    for path in plan.paths:
-        r = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
-        d = np.asarray(r.reading_mm, dtype=float)
-        ok = np.isfinite(d)
-        table = k.table_point(k.machine_point(np.asarray(r.stage_xyz)[ok], d[ok]),
-                              path.angle_deg)
-        xyz.append(tf.apply_transform(rig.table_to_cad, table))
-        snr.append(np.asarray(r.snr)[ok])
-        planned.append(np.column_stack([np.full(ok.sum(), path.section), path.points[ok]]))
-    xyz, snr = np.vstack(xyz), np.concatenate(snr)
-    dist = nominal.signed_distance(xyz)
-    result = RegistrationResult(
-        measured_to_cad=np.eye(4), points_cad=xyz, deviation=dist.distance,
-        inlier=np.ones(len(xyz), bool), closest=dist.closest, normal=dist.normal,
-        face=dist.face, snr=snr, columns={}, n_rows_skipped=0, rms_mm=0.0,
-        pose_covariance=np.zeros((6, 6)), center=xyz.mean(axis=0), pose_uncertainty_mm=0.0,
-        deviation_stats=stats.deviation_statistics(dist.distance), coarse={})
-    return result, np.vstack(planned)
 
 
 def loop_result(nominal, rig, heights, edge_sigma, seed):
@@ -146,7 +118,7 @@ def main():
                                          span_axis=sections_mod.span_axis_of(nominal)[0],
                                          spacing=args.spacing, kinematics=rig.kinematics,
                                          edge_radius_sigma_mm=edge_sigma)
-                    result, _ = direct_result(nominal, rig, plan)
+                    result, _ = planned_readings_result(nominal, rig, plan)
                     table = sections_mod.section_table(result, nominal, heights_pct=heights)
                     stage = stage_mod.run_stage(nominal, stage_mod.planes_of_table(table),
                                                 opts, result, table.span_axis)

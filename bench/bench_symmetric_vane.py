@@ -17,8 +17,6 @@ checkout of it first on PYTHONPATH (and this bench's tests/symmetric_vane.py int
 import argparse
 import time
 
-import numpy as np
-
 from BladeInspect.inspection import pipeline
 from BladeInspect.inspection.simulate import pose_error
 from tests.symmetric_vane import ISSUE_VANE, OTHER_VANE, scan_vane, vane_nominal

@@ -56,6 +56,7 @@ from BladeInspect.inspection import sections as sections_mod  # noqa: E402
 from BladeInspect.inspection import uncertainty as uncertainty_mod  # noqa: E402
 from BladeInspect.inspection import verdict as verdict_mod  # noqa: E402
 from BladeInspect.inspection.result import RegistrationResult  # noqa: E402
+from tests.helpers import suction_bump_at  # noqa: E402
 from BladeInspect.measurement import calibration as calibration_mod  # noqa: E402
 from BladeInspect.rig.kinematics import RigKinematics  # noqa: E402
 from BladeInspect.rig.sensor import SensorModel  # noqa: E402
@@ -79,14 +80,7 @@ def blade(name):
 def bump_at(nominal, height_pct):
     """A bump on the suction side where the plane at ``height_pct`` crosses it (as
     tests/test_rotor67_loop.py builds it)."""
-    from BladeInspect.rig.simulated import make_bump
-    axis, (lo, hi) = sections_mod.span_axis_of(nominal)
-    s = nominal.samples
-    level = lo + (hi - lo) * height_pct / 100.0
-    near = np.isin(s.face, nominal.roles["suction"]) & (np.abs(s.xyz @ axis - level) < 0.5)
-    pts = s.xyz[near]
-    centre = pts[np.argmin(np.linalg.norm(pts - pts.mean(axis=0), axis=1))]
-    return axis, make_bump(centre, BUMP_RADIUS, BUMP_HEIGHT)
+    return suction_bump_at(nominal, height_pct, BUMP_RADIUS, BUMP_HEIGHT)
 
 
 def by_angle(fn, points, angles):

@@ -204,3 +204,45 @@ def face_points(face, n, rng, margin=0.05):
     p = np.array([tuple(face.valueAt(a, b)) for a, b in uv])
     nrm = np.array([tuple(face.normalAt(a, b)) for a, b in uv])
     return p, nrm / np.linalg.norm(nrm, axis=1)[:, None], uv
+
+
+def planned_readings_result(nominal, rig, plan):
+    """The plan's paths read on a simulated rig and mapped into the CAD by the rig's true pose:
+    (a RegistrationResult with no registration error, (n, 2) planned [section, point] of each
+    reading)."""
+    from BladeInspect.core import stats
+    from BladeInspect.inspection.result import RegistrationResult
+    k = rig.kinematics
+    xyz, snr, planned = [], [], []
+    for path in plan.paths:
+        r = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
+        d = np.asarray(r.reading_mm, dtype=float)
+        ok = np.isfinite(d)
+        table = k.table_point(k.machine_point(np.asarray(r.stage_xyz)[ok], d[ok]),
+                              path.angle_deg)
+        xyz.append(tf.apply_transform(rig.table_to_cad, table))
+        snr.append(np.asarray(r.snr)[ok])
+        planned.append(np.column_stack([np.full(ok.sum(), path.section), path.points[ok]]))
+    xyz, snr = np.vstack(xyz), np.concatenate(snr)
+    dist = nominal.signed_distance(xyz)
+    result = RegistrationResult(
+        measured_to_cad=np.eye(4), points_cad=xyz, deviation=dist.distance,
+        inlier=np.ones(len(xyz), bool), closest=dist.closest, normal=dist.normal,
+        face=dist.face, snr=snr, columns={}, n_rows_skipped=0, rms_mm=0.0,
+        pose_covariance=np.zeros((6, 6)), center=xyz.mean(axis=0), pose_uncertainty_mm=0.0,
+        deviation_stats=stats.deviation_statistics(dist.distance), coarse={})
+    return result, np.vstack(planned)
+
+
+def suction_bump_at(nominal, height_pct, radius_mm, height_mm):
+    """(span axis, a rig.simulated bump) centred on the suction side where the plane at
+    ``height_pct`` of the span crosses it, halfway along the chord."""
+    from BladeInspect.inspection.sections import span_axis_of
+    from BladeInspect.rig.simulated import make_bump
+    axis, (lo, hi) = span_axis_of(nominal)
+    s = nominal.samples
+    level = lo + (hi - lo) * height_pct / 100.0
+    near = np.isin(s.face, nominal.roles["suction"]) & (np.abs(s.xyz @ axis - level) < 0.5)
+    pts = s.xyz[near]
+    centre = pts[np.argmin(np.linalg.norm(pts - pts.mean(axis=0), axis=1))]
+    return axis, make_bump(centre, radius_mm, height_mm)

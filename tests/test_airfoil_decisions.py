@@ -4,7 +4,6 @@ import unittest
 
 import numpy as np
 
-from BladeInspect.core import decision as decision_mod
 from BladeInspect.core import transforms as tf
 from BladeInspect.inspection import airfoil as stage_mod
 from tests.helpers import demo_nominal

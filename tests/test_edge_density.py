@@ -14,15 +14,12 @@ from scipy.optimize import least_squares
 from BladeInspect.cad.airfoil_sections import airfoil_section
 from BladeInspect.cad.sections import cut
 from BladeInspect.core import airfoil as kernel
-from BladeInspect.core import stats
-from BladeInspect.core import transforms as tf
 from BladeInspect.inspection import airfoil as stage_mod
 from BladeInspect.inspection import sections as sections_mod
-from BladeInspect.inspection.result import RegistrationResult
 from BladeInspect.measurement import planning
 from BladeInspect.rig.sensor import SensorModel
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
-from tests.helpers import demo_nominal
+from tests.helpers import demo_nominal, planned_readings_result
 
 HEIGHTS = (15.0, 85.0)
 ZONE_DEG = 45.0
@@ -79,28 +76,6 @@ def cad_edges(nominal, frame, nominal_chars):
             centre, radius = fit_circle(xy[mask])
         out.append((centre, radius, axis))
     return out
-
-
-def read_plan(nominal, rig, plan):
-    """The planned paths read on the rig, mapped into the CAD by its true pose: a
-    RegistrationResult with no registration error."""
-    k = rig.kinematics
-    xyz = []
-    for path in plan.paths:
-        r = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
-        d = np.asarray(r.reading_mm, dtype=float)
-        ok = np.isfinite(d)
-        table = k.table_point(k.machine_point(np.asarray(r.stage_xyz)[ok], d[ok]),
-                              path.angle_deg)
-        xyz.append(tf.apply_transform(rig.table_to_cad, table))
-    xyz = np.vstack(xyz)
-    dist = nominal.signed_distance(xyz)
-    return RegistrationResult(
-        measured_to_cad=np.eye(4), points_cad=xyz, deviation=dist.distance,
-        inlier=np.ones(len(xyz), bool), closest=dist.closest, normal=dist.normal,
-        face=dist.face, snr=None, columns={}, n_rows_skipped=0, rms_mm=0.0,
-        pose_covariance=np.zeros((6, 6)), center=xyz.mean(axis=0), pose_uncertainty_mm=0.0,
-        deviation_stats=stats.deviation_statistics(dist.distance), coarse={})
 
 
 class EdgeDensityInTheInspectPlan(unittest.TestCase):
@@ -169,7 +144,7 @@ class EdgeDensityInTheInspectPlan(unittest.TestCase):
 
     def test_perfect_part_edge_radii_within_5_um_of_the_cad(self):
         for rig, plan in self.runs:
-            result = read_plan(self.nominal, rig, plan)
+            result, _ = planned_readings_result(self.nominal, rig, plan)
             table = sections_mod.section_table(result, self.nominal, heights_pct=HEIGHTS,
                                                span_axis=self.axis)
             stage = stage_mod.run_stage(self.nominal, stage_mod.planes_of_table(table),

@@ -134,7 +134,6 @@ class FitSectionCurve(unittest.TestCase):
 
 class CompatibleAndLoft(unittest.TestCase):
     def setUp(self):
-        rng = np.random.default_rng(5)
         self.curves = []
         for k, z in enumerate((0.0, 10.0, 25.0, 30.0)):
             x = np.linspace(0, 40 - 2 * k, 300)

@@ -9,7 +9,7 @@ import numpy as np
 import Part
 
 from BladeInspect.core import bspline
-from tests.test_bspline import V, occ_derivatives, random_surface, surface_data
+from tests.test_bspline import occ_derivatives, random_surface, surface_data
 
 NAMES = ["S", "Su", "Sv", "Suu", "Suv", "Svv"]
 

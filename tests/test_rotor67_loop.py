@@ -26,7 +26,7 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import transforms as tf
-from tests.helpers import ROTOR67_SECTIONS, have_rotor67, sensor_pose_bound
+from tests.helpers import ROTOR67_SECTIONS, have_rotor67, sensor_pose_bound, suction_bump_at
 
 STANDOFF = 44.0
 EPSILON = 2.0
@@ -153,15 +153,7 @@ class TestBlindScanRegisters(unittest.TestCase):
 def _bump_at_section(nominal, height_pct):
     """A bump centred on the suction side where the loop's plane at ``height_pct`` crosses it,
     halfway along the chord."""
-    from BladeInspect.inspection.sections import span_axis_of
-    from BladeInspect.rig.simulated import make_bump
-    axis, (lo, hi) = span_axis_of(nominal)
-    s = nominal.samples
-    level = lo + (hi - lo) * height_pct / 100.0
-    near = np.isin(s.face, nominal.roles["suction"]) & (np.abs(s.xyz @ axis - level) < 0.5)
-    pts = s.xyz[near]
-    centre = pts[np.argmin(np.linalg.norm(pts - pts.mean(axis=0), axis=1))]
-    return axis, make_bump(centre, BUMP_RADIUS, BUMP_HEIGHT)
+    return suction_bump_at(nominal, height_pct, BUMP_RADIUS, BUMP_HEIGHT)
 
 
 @unittest.skipUnless(have_rotor67(), "Rotor 67 data not present")

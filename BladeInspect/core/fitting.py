@@ -7,7 +7,7 @@ of the Gauss-Newton iterations. Optional weights are inverse variances (the sens
 docs/contracts.md "The sensor and its noise"). Degenerate input raises InputError.
 """
 
-from typing import NamedTuple, Optional
+from typing import NamedTuple
 
 import numpy as np
 

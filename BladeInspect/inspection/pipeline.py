@@ -23,7 +23,7 @@ from ..core import transforms as tf
 from ..core.closest import FootStart
 from ..core.icp import MAD_TO_SIGMA
 from ..core.errors import InputError
-from ..core.pointio import MIN_POINTS, PointSet, check_magnitude
+from ..core.pointio import MIN_POINTS, check_magnitude
 from . import checks, weighting
 from .result import RegistrationResult
 from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
