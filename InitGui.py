@@ -14,6 +14,9 @@ class BladeInspectWorkbench(FreeCADGui.Workbench):
         # The module folder is found through the package, since this file has no __file__.
         from BladeInspect.gui import resources
         self.__class__.Icon = resources.icon_path("BladeInspect")
+        # FreeCAD loads BladeInspect_<its language>.qm from here, as for its own workbenches
+        FreeCADGui.addLanguagePath(resources.TRANSLATIONS_DIR)
+        FreeCADGui.updateLocale()
 
     def Initialize(self):
         from BladeInspect.gui import commands, loop_commands

@@ -4,6 +4,8 @@ import os
 
 MODULE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ICON_DIR = os.path.join(MODULE_DIR, "resources", "icons")
+# BladeInspect.ts (scripts/update-translations) and the translators' BladeInspect_<lang>.qm
+TRANSLATIONS_DIR = os.path.join(MODULE_DIR, "resources", "translations")
 
 
 def icon_path(name):

@@ -1,0 +1,810 @@
+<?xml version="1.0" encoding="utf-8"?>
+<!DOCTYPE TS>
+<TS version="2.1">
+<context>
+    <name>BladeInspect</name>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>%s. Pose uncertainty %.2f um after the planned scan (%.2f um after the blind scan). Files in %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>%s: cancelled</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>%s: done</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>2 turns the part over to scan the other side</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>A letter (x, y, z, -x, ...) or a vector</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Add CMM file</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Against the simulator's truth: axis position %.2f um, direction %.5f deg.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Airfoil analysis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Airfoil characteristics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Axis offset (simulated)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Axis tilt (simulated)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>BladeInspect</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>BladeInspect: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>BladeInspect: %s cancelled</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect: rig connected (%s)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>BladeInspect: the measured sections are kept in %s; './bladeinspect inspect --resume --out %s' with the same CAD, rig and options continues the inspection</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>CAD files (*.step *.stp *.iges *.igs *.brep *.brp *.FCStd *.dat);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>CMM file</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>CMM files (*.csv *.txt *.dat);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>CMM: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>CSV: characteristic,section,lower,upper[,nominal]; empty: every characteristic reported, none judged</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Calibrate</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Calibrate rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>Cancel</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Characteristics file</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord: %s; U = 2 x the %s (%s).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Connect rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Decision rule</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Demo blade</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/legend.py"/>
+        <source>Deviation [mm]</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Deviation map</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Distance between sections; 0 spreads them over the span</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Fit</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Fit sensitivity</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Fixture pose of the simulated rig and the registration's sampling</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Free DOF</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Free degrees of freedom, any of tx,ty,tz,rx,ry,rz and t_stacking,r_stacking,t_engine,r_engine; empty: all six</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Import points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Inspect</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Inspection: Table 2 at the nominal sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Largest change: %s, %.4f mm; the verdict %s with the fit.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Lean and bow: largest bow at section %s.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Least-squares region weights, e.g. LE=2,TE=2,suction=1,pressure=1</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Load CAD</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Measured points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Measurement error</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Nominal CAD</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Nominal sections to measure, % of the span from hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Objective</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Outlier fraction</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Point files (*.csv *.xyz *.asc *.txt *.ply *.pcd);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Point spacing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Port</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Pose error %.3f um = %.2f x its bound (%.3f um). Residual RMS %.4f mm (injected %.4f), min %.4f, max %.4f mm; paper: RMS 0.0019, min -0.0053, max 0.006.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>RIG.json from Calibrate; empty: the nominal kinematics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Random seed of the coarse stage</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Reconstruct</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Register</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Registration: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Report</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Report folder</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Rescan a section until every point is within this distance of the sensor's standoff</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Rig calibration</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Rig calibration (*.json);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Rig: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Rotary axis through (%.4f, %.4f, %.4f) mm, direction (%.7f, %.7f, %.7f).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Scan</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Section analysis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Section heights (%)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Section spacing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Seed</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Seed (simulated)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Serial port</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sides</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Simulated rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Simulation test bed</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Sphere diameter</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Standoff criterion ε</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>Stop %s; the document keeps what it had before</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Surface points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Table 2: optical and CMM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Tilt from +Y: %.4f deg about Z, %.4f deg about X. Sphere measured %.4f mm (nominal %.4f); circle residual RMS %.4f mm.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Write the rig calibration</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Written to %s.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Zone weights</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>actual</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>all six</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>building the demo blade</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>changes</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>characteristic</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>deviation</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>does not change</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>fitting section curves</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>internal error: %s: %s (details in the report view's log)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>iso14253: pass / not proven / fail (ISO 14253-1); simple: simple acceptance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>least-squares: the robust ICP's pose; minimax: minimum zone; tolerance: largest margin inside the tolerance; datum: the CAD's datum faces</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>nominal</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>none</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>opening %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>reading %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>reading %s and cutting the sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>simulated (none connected)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>simulated rig: load a CAD or build the demo blade first</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/progress.py"/>
+        <source>starting</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>storing %d curves, %d surfaces</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>verdict</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>±U (k=2)</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_AddCmm</name>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Add CMM file...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Compare a CMM file's sections with the optical ones (Table 2): for an inspection, at its nominal sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Airfoil</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Airfoil analysis...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Airfoil characteristics per section (chord, stagger, thickness, edge radii, angles, shift, twist) nominal and measured, judged against a characteristics file; the mean camber lines and edge circles added to the document</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Calibrate</name>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Calibrate rig...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Measure a reference sphere at several rotary angles, find the rotary axis and write RIG.json (simulated rig or a serial port)</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_ConnectRig</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Connect rig...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Connect the four-axis rig: the simulated rig (needs a nominal) or a serial port</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_DemoBlade</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Build the parametric demo blade as the nominal CAD (parameters in a task panel)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Demo blade</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_DeviationMap</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Colour the registered points by signed deviation (limits from the preferences)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Deviation map</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_ImportPoints</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Import a measured point cloud (csv/xyz/asc/txt with optional SNR, ply, pcd)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Import points...</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Inspect</name>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Inspect...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>The whole loop: blind section scan, registration, paths planned from the CAD at its nominal sections (drawn before they run), their scan, Table 2 and verdict</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_LoadCad</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Load CAD...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Load the nominal blade from a STEP, IGES, BREP or FCStd file (or a section table)</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Preferences</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Preferences...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Sensor and rig parameters, tolerance and colour limits</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Reconstruct</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Fit cubic B-spline section curves to the measurement and loft them into surfaces</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Reconstruct</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Register</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Register</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Register the measurement to the nominal with no starting pose (PCA, then SNR-weighted ICP), move it to the chosen fit and show the pose with its uncertainty and the fit-sensitivity table</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Report</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Report...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Write the inspection report (HTML and PDF, result.json, deviations.csv) to a folder</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Scan</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Scan the blade section by section with the connected rig (progress and abort)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Scan...</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_SectionAnalysis</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Section analysis</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Simulate</name>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Simulation test bed...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>The paper's simulation test bed: points from the CAD (or the demo blade) at a random pose with measurement error, registered blind; pose error against its bound</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>Workbench</name>
+    <message>
+        <location filename="../../InitGui.py"/>
+        <source>BladeInspect</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../InitGui.py"/>
+        <source>Register optical scans of turbine blades to their CAD and map the deviations</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+</TS>
