@@ -412,16 +412,21 @@ def _number(value, signed=False):
 
 def airfoil_rows(blocks):
     """The characteristics table: per section and characteristic, nominal, actual, deviation,
-    the expanded uncertainty U = 2u of the block's standard uncertainty, the tolerance and the
-    verdict (inspection.airfoil.csv_rows)."""
+    the expanded uncertainty U (k = 2; the decision's, else 2u of the block's standard
+    uncertainty), the tolerance and the verdict (inspection.airfoil.csv_rows)."""
     rows = []
-    for label, key, nominal, measured, deviation, u, lower, upper, verdict in \
-            airfoil_mod.csv_rows(blocks):
+    for row in airfoil_mod.csv_rows(blocks):
+        # by the CSV's column names, so that a column added to airfoil.csv does not shift these
+        r = dict(zip(airfoil_mod.CSV_HEADER, row))
+        lower, upper, u = r["lower"], r["upper"], r["uncertainty"]
+        expanded = r.get("U_k2") if r.get("U_k2") is not None else (
+            None if u is None else 2.0 * u)
         tolerance = "" if lower is None and upper is None else "%s .. %s" % (
             _number(lower, True) or "-", _number(upper, True) or "+")
-        rows.append([label, key, _number(nominal), _number(measured),
-                     _number(deviation, True), "" if u is None else "%.4f" % (2.0 * u),
-                     tolerance, translate("BladeInspect", verdict)])
+        rows.append([r["section"], r["characteristic"], _number(r["nominal"]),
+                     _number(r["measured"]), _number(r["deviation"], True),
+                     "" if expanded is None else "%.4f" % expanded, tolerance,
+                     translate("BladeInspect", r["verdict"])])
     return rows
 
 
