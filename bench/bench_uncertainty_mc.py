@@ -69,6 +69,21 @@ ERRORS = ("noise", "systematic", "calibration")
 CACHE = os.path.join(tempfile.gettempdir(), "bi-mc-record-%s.pkl")
 
 
+def code_version():
+    """A digest of the package's sources: a recording is reused only by the code that made it
+    (a loop planned by older code, e.g. before the edge-density rule, is another scan)."""
+    import hashlib
+    digest = hashlib.sha1()
+    root = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                        "BladeInspect")
+    for folder, _, files in sorted(os.walk(root)):
+        for name in sorted(files):
+            if name.endswith(".py"):
+                with open(os.path.join(folder, name), "rb") as fh:
+                    digest.update(name.encode() + fh.read())
+    return digest.hexdigest()[:12]
+
+
 def blade(name):
     if name == "demo":
         return pipeline.load_nominal(None), (30.0, 70.0)
@@ -95,7 +110,7 @@ def by_angle(fn, points, angles):
 def record(name, seed):
     """The planned scan's readings as the rig made them: per reading the stage, angle, true
     distance (bump included), incidence, and the true table-frame point; plus the truth."""
-    path = CACHE % ("%s-%d" % (name, seed))
+    path = CACHE % ("%s-%d-%s" % (name, seed, code_version()))
     if os.path.exists(path):
         with open(path, "rb") as fh:
             return pickle.load(fh)
