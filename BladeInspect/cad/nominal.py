@@ -20,7 +20,7 @@ import Part
 from ..core import bspline
 from ..core.bspline import SurfaceData
 from ..core.closest import DistanceResult, FaceDomain, FaceSet, Samples, point_in_domain
-from ..core.edges import CurveData, FaceEdges
+from ..core.edges import CurveData, FaceEdges, evaluate_curve
 from ..core.errors import InputError
 from ..core.raycast import Tessellation
 from ..core.trim import TrimDomain
@@ -87,6 +87,24 @@ def _surface_of_face(nface):
     return surf
 
 
+def _pcurve_values(curve):
+    """A function of parameters t (N,) -> (N, 2) points of a face's curve in its surface's
+    (u, v): in numpy for B-splines and lines (what NurbsConvert leaves), else by OCC."""
+    if isinstance(curve, Part.Geom2d.BSplineCurve2d) and not curve.isPeriodic():
+        weights = np.array(curve.getWeights(), dtype=float)
+        data = CurveData(degree=curve.Degree,
+                         knots=_flat_knots(curve.getKnots(), curve.getMultiplicities()),
+                         poles=np.array([[q.x, q.y] for q in curve.getPoles()], dtype=float),
+                         weights=weights if curve.isRational() else None,
+                         t_range=np.array([curve.FirstParameter, curve.LastParameter]))
+        return lambda t: evaluate_curve(data, t, order=0)[0]
+    if isinstance(curve, Part.Geom2d.Line2d):
+        origin = np.array([curve.Location.x, curve.Location.y])
+        direction = np.array([curve.Direction.x, curve.Direction.y])
+        return lambda t: origin + np.asarray(t)[:, None] * direction
+    return lambda t: np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
+
+
 def _face_domain(nface, surf, planar):
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
     su, sv = u1 - u0, v1 - v0
@@ -100,11 +118,12 @@ def _face_domain(nface, surf, planar):
             if pc is None:
                 raise InputError("CAD face has an edge without a curve on its surface")
             curve, a, b = pc
+            values = _pcurve_values(curve)
             count = PCURVE_SAMPLES
             while True:
                 t = np.linspace(a, b, count + 1)
-                pts = np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
-                mids = np.array([[q.x, q.y] for q in (curve.value(x) for x in 0.5 * (t[1:] + t[:-1]))])
+                pts = values(t)
+                mids = values(0.5 * (t[1:] + t[:-1]))
                 chord = float(np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1).max())
                 # The margin of undecided points grows with the chord error: refine until small.
                 if chord <= CHORD_TARGET * max(su, sv) or count >= MAX_PCURVE_SAMPLES:

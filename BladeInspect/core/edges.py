@@ -28,30 +28,31 @@ STEP_TOL = 1e-12
 class CurveData:
     degree: int
     knots: np.ndarray          # flat, with multiplicity
-    poles: np.ndarray          # (n, 3)
+    poles: np.ndarray          # (n, 3), or (n, 2) for a curve in a surface's (u, v)
     weights: np.ndarray        # (n,) or None for a polynomial curve
     t_range: np.ndarray        # (2,) the edge's parameter range
 
 
-def evaluate_curve(curve, t):
-    """(C, C', C'') (each (N, 3)) of a curve at parameters t."""
+def evaluate_curve(curve, t, order=2):
+    """[C, C', ...] up to the order-th derivative (order <= 2; each (N, dimension)) of a
+    curve at parameters t."""
     t = np.asarray(t, dtype=float)
     p = curve.degree
     span = find_span(curve.knots, p, t)
-    ders = basis_derivatives(curve.knots, p, span, t, 2)            # (N, 3, p+1)
+    ders = basis_derivatives(curve.knots, p, span, t, order)          # (N, order+1, p+1)
     idx = span[:, None] - p + np.arange(p + 1)[None]                  # (N, p+1)
     if curve.weights is None:
-        poles = curve.poles[idx]                                      # (N, p+1, 3)
-        c = np.einsum("nkr,nrd->knd", ders, poles)
-        return c[0], c[1], c[2]
+        return list(np.einsum("nkr,nrd->knd", ders, curve.poles[idx]))
     w = curve.weights[idx]
     hom = np.concatenate([curve.poles[idx] * w[..., None], w[..., None]], axis=2)
     a = np.einsum("nkr,nrd->knd", ders, hom)
-    wt, w1, w2 = a[0][:, 3:], a[1][:, 3:], a[2][:, 3:]
-    c0 = a[0][:, :3] / wt
-    c1 = (a[1][:, :3] - w1 * c0) / wt
-    c2 = (a[2][:, :3] - 2.0 * w1 * c1 - w2 * c0) / wt
-    return c0, c1, c2
+    out = [a[0][:, :-1] / a[0][:, -1:]]
+    if order >= 1:
+        out.append((a[1][:, :-1] - a[1][:, -1:] * out[0]) / a[0][:, -1:])
+    if order >= 2:
+        out.append((a[2][:, :-1] - 2.0 * a[1][:, -1:] * out[1] - a[2][:, -1:] * out[0])
+                   / a[0][:, -1:])
+    return out
 
 
 def project_on_curve(curve, points, t0):
@@ -72,7 +73,7 @@ def project_on_curve(curve, points, t0):
         t = t_new
         if conv.all():
             break
-    c0 = evaluate_curve(curve, t)[0]
+    c0 = evaluate_curve(curve, t, order=0)[0]
     eps = 1e-12 * (b - a)
     return t, c0, conv, (t <= a + eps) | (t >= b - eps)
 
@@ -95,7 +96,7 @@ class FaceEdges:
     def __init__(self, curves):
         self.curves = list(curves)
         self.vertex_t = [curve_polyline(c) for c in self.curves]
-        self.trees = [cKDTree(evaluate_curve(c, t)[0])
+        self.trees = [cKDTree(evaluate_curve(c, t, order=0)[0])
                       for c, t in zip(self.curves, self.vertex_t)]
 
     def closest(self, points):
