@@ -91,8 +91,8 @@ class TrimEdges(unittest.TestCase):
                                    rtol=0, atol=1e-9)
         np.testing.assert_allclose(fast.closest[on_edge], occ.closest[outside][on_edge],
                                    rtol=0, atol=1e-7)
-        # The trim edges are decided by the fast path: before the edge kernel, 40 % of these
-        # points went to OCC.
+        # The trim edges are decided by the fast path: before the edge kernel about a third of
+        # such points went to OCC (35 % of these 250, 42 % of the outside ones of 400).
         self.assertLess(fast.fallback_fraction, 0.2)
 
     @unittest.expectedFailure
@@ -105,6 +105,7 @@ class TrimEdges(unittest.TestCase):
         inside = fast.distance < -1e-3
         occ = self.nominal.signed_distance_occ(p[inside])
         np.testing.assert_allclose(fast.distance[inside], occ.distance, rtol=0, atol=1e-7)
+
 
 if __name__ == "__main__":
     unittest.main()
