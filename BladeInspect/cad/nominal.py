@@ -20,6 +20,7 @@ import Part
 from ..core import bspline
 from ..core.bspline import SurfaceData
 from ..core.closest import DistanceResult, FaceDomain, FaceSet, Samples, point_in_domain
+from ..core.edges import CurveData, FaceEdges, evaluate_curve
 from ..core.errors import InputError
 from ..core.raycast import Tessellation
 from ..core.trim import TrimDomain
@@ -86,6 +87,24 @@ def _surface_of_face(nface):
     return surf
 
 
+def _pcurve_values(curve):
+    """A function of parameters t (N,) -> (N, 2) points of a face's curve in its surface's
+    (u, v): in numpy for B-splines and lines (what NurbsConvert leaves), else by OCC."""
+    if isinstance(curve, Part.Geom2d.BSplineCurve2d) and not curve.isPeriodic():
+        weights = np.array(curve.getWeights(), dtype=float)
+        data = CurveData(degree=curve.Degree,
+                         knots=_flat_knots(curve.getKnots(), curve.getMultiplicities()),
+                         poles=np.array([[q.x, q.y] for q in curve.getPoles()], dtype=float),
+                         weights=weights if curve.isRational() else None,
+                         t_range=np.array([curve.FirstParameter, curve.LastParameter]))
+        return lambda t: evaluate_curve(data, t, order=0)[0]
+    if isinstance(curve, Part.Geom2d.Line2d):
+        origin = np.array([curve.Location.x, curve.Location.y])
+        direction = np.array([curve.Direction.x, curve.Direction.y])
+        return lambda t: origin + np.asarray(t)[:, None] * direction
+    return lambda t: np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
+
+
 def _face_domain(nface, surf, planar):
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
     su, sv = u1 - u0, v1 - v0
@@ -99,11 +118,12 @@ def _face_domain(nface, surf, planar):
             if pc is None:
                 raise InputError("CAD face has an edge without a curve on its surface")
             curve, a, b = pc
+            values = _pcurve_values(curve)
             count = PCURVE_SAMPLES
             while True:
                 t = np.linspace(a, b, count + 1)
-                pts = np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
-                mids = np.array([[q.x, q.y] for q in (curve.value(x) for x in 0.5 * (t[1:] + t[:-1]))])
+                pts = values(t)
+                mids = values(0.5 * (t[1:] + t[:-1]))
                 chord = float(np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1).max())
                 # The margin of undecided points grows with the chord error: refine until small.
                 if chord <= CHORD_TARGET * max(su, sv) or count >= MAX_PCURVE_SAMPLES:
@@ -129,6 +149,34 @@ def _face_domain(nface, surf, planar):
     return FaceDomain(TrimDomain(segments), margin, planar_scale)
 
 
+def curve_data_of_edge(edge):
+    """CurveData of an edge of a NURBS-converted face (its 3D curve an exact B-spline), or
+    None for a degenerate edge (a point)."""
+    if edge.Degenerated:
+        return None
+    curve = edge.Curve
+    if not isinstance(curve, Part.BSplineCurve):
+        raise InputError("CAD edge of type %s is not a B-spline after conversion"
+                         % type(curve).__name__)
+    curve = curve.copy()
+    if curve.isPeriodic():
+        curve.setNotPeriodic()
+    weights = np.array(curve.getWeights(), dtype=float)
+    return CurveData(degree=curve.Degree,
+                     knots=_flat_knots(curve.getKnots(), curve.getMultiplicities()),
+                     poles=np.array([[q.x, q.y, q.z] for q in curve.getPoles()], dtype=float),
+                     weights=weights if curve.isRational() else None,
+                     t_range=np.array(edge.ParameterRange, dtype=float))
+
+
+def _face_edges(nface, domain):
+    """core.edges.FaceEdges of a trimmed face (None for a face that fills its box)."""
+    if domain.index is None:
+        return None
+    curves = [c for c in (curve_data_of_edge(e) for e in nface.Edges) if c is not None]
+    return FaceEdges(curves) if curves else None
+
+
 def _extent(surf, n=9):
     """Rough lengths of the face along u and along v (longest iso-curve of an n x n grid)."""
     u = np.linspace(*surf.u_range, n)
@@ -145,7 +193,7 @@ class Nominal:
     """The nominal CAD: faces, their exact surfaces, dense samples and the distance queries."""
 
     def __init__(self, shape, faces, nurbs_faces, surfaces, domains, reversed_, samples,
-                 bbox_corners, roles, face_sides):
+                 bbox_corners, roles, face_sides, edges=None):
         self.shape = shape
         self.faces = faces
         self.surfaces = surfaces
@@ -155,7 +203,7 @@ class Nominal:
         # cad.orient.FaceSide per face: how its outward side was decided
         self.face_sides = face_sides
         # The faces as arrays for the numeric kernels (core.closest, core.raycast).
-        self.face_set = FaceSet(surfaces, domains, reversed_, samples)
+        self.face_set = FaceSet(surfaces, domains, reversed_, samples, edges)
         self._nurbs_faces = nurbs_faces
         self._solids = list(shape.Solids)
         self._face_compound = Part.makeCompound(faces)
@@ -445,5 +493,7 @@ def nominal_from_shape(shape, roles=None, sample_spacing=None, flip_faces=()):
         face=np.concatenate([np.full(len(p[0]), i) for i, p in enumerate(parts)]),
         uv=np.concatenate([p[2] for p in parts]),
         weight=np.concatenate([p[3] for p in parts]))
+    edges = [_face_edges(nurbs[i], domains[i]) for i in range(len(faces))]
     return Nominal(shape, faces, nurbs, surfaces, domains, reversed_, samples,
-                   _bbox_corners(shape), {k: list(v) for k, v in (roles or {}).items()}, sides)
+                   _bbox_corners(shape), {k: list(v) for k, v in (roles or {}).items()}, sides,
+                   edges)

@@ -166,8 +166,10 @@ class FaceSet:
     """The CAD's faces as arrays: per face its SurfaceData, FaceDomain and whether its outward
     side is -(Su x Sv); the samples on all faces and a k-d tree over their points."""
 
-    def __init__(self, surfaces, domains, reversed_, samples):
+    def __init__(self, surfaces, domains, reversed_, samples, edges=None):
         self.surfaces = surfaces
+        # core.edges.FaceEdges per trimmed face (None: none known), for feet outside the domain.
+        self.edges = edges
         self.domains = domains
         self.reversed = np.asarray(reversed_, bool)
         self.samples = samples
@@ -326,6 +328,17 @@ class FaceSet:
                 gap = np.where(inside, 0.0, np.maximum(bdist - dom.margin, 0.0)) * dom.planar_scale
                 low = np.where(conv, np.hypot(d, gap), 0.0)
             lower[sel] = low
+            # Hook (trim edges): a foot clearly outside the trimmed domain means the face's
+            # closest point is on its boundary edges, which give it exactly.
+            rim = conv & ~inside & (bdist > dom.margin) & ~degenerate
+            if self.edges is not None and self.edges[f] is not None and rim.any():
+                j = sel[rim]
+                de, ce, uve, ne, exact = self.on_boundary(f, p[rim])
+                j, de = j[exact], de[exact]
+                dist[j], closest[j], uv[j], normal[j] = de, ce[exact], uve[exact], ne[exact]
+                trusted[j] = on_edge[j] = True
+                lower[j] = de
+                boundary[j] = 0.0
         # Per point: the best trusted candidate; doubtful candidates must not be able to beat it.
         best_d = np.full(n, np.inf)
         np.minimum.at(best_d, pi[trusted], dist[trusted])
@@ -383,6 +396,15 @@ class FaceSet:
         out.nearest[decided] = sample_dist[good, 0]
         out.boundary[decided] = boundary[b]
         return rows[np.flatnonzero(need)]
+
+    def on_boundary(self, f, p):
+        """(distance, closest point, its (u, v), outward unit normal there, exact) of points
+        p to face f's boundary edges (core.edges); exact is False where that is undecided."""
+        d, c, exact = self.edges[f].closest(p)
+        start = self.starts_on_face(f, c)
+        u, v, _, Su, Sv, conv = bspline.project(self.surfaces[f], c, start[:, 0], start[:, 1])
+        nrm, degenerate = self.unit_normal(f, Su, Sv)
+        return d, c, np.column_stack([u, v]), nrm, exact & conv & ~degenerate
 
     @staticmethod
     def clamped(surf, u, v, r, Su, Sv, d):
