@@ -113,5 +113,16 @@ class FitSensitivityRows(unittest.TestCase):
         self.assertEqual(set(doc["airfoil_verdict_by_fit"]), {"least-squares", "turned"})
 
 
+class FailedDrawsAreNotScatter(unittest.TestCase):
+    def test_a_failed_draw_is_left_out_and_normal_scatter_kept_whole(self):
+        from BladeInspect.inspection.airfoil import _draws_sd
+        rng = np.random.default_rng(15)
+        for _ in range(20):
+            draws = rng.normal(1.0, 0.003, 12)
+            self.assertEqual(_draws_sd(draws), float(np.std(draws, ddof=1)))
+            with_failure = np.append(draws, 14.0)   # a thickness station off the nose
+            self.assertEqual(_draws_sd(with_failure), float(np.std(draws, ddof=1)))
+
+
 if __name__ == "__main__":
     unittest.main()
