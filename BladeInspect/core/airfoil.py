@@ -107,15 +107,25 @@ class Profile:
         self._tree = cKDTree(self.dense)
 
     def eval(self, u, der=0):
+        # Only the asked derivative: most calls want points alone (the same arithmetic as
+        # eval3's, so the values are eval3's to the bit).
+        t, c = self._pieces(u)
+        if der == 0:
+            return ((c[:, 0] * t + c[:, 1]) * t + c[:, 2]) * t + c[:, 3]
+        if der == 1:
+            return (3.0 * c[:, 0] * t + 2.0 * c[:, 1]) * t + c[:, 2]
         return self.eval3(u)[der]
 
-    def eval3(self, u):
-        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+    def _pieces(self, u):
+        """Each parameter's offset into its spline piece and that piece's coefficients."""
         u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
         i = np.searchsorted(self._breaks, u, side="right") - 1
         i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
-        t = (u - self._breaks[i])[:, None]
-        c = self._coef[i]
+        return (u - self._breaks[i])[:, None], self._coef[i]
+
+    def eval3(self, u):
+        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+        t, c = self._pieces(u)
         c0, c1, c2, c3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
         p = ((c0 * t + c1) * t + c2) * t + c3
         d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
