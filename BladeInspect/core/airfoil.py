@@ -638,8 +638,35 @@ class CircleFit2D:
     zone_deg: float
 
 
+def _solve_spd3(a, b):
+    """x with a x = b for a symmetric 3 x 3 ``a`` by Cholesky in plain floats (a numpy linalg
+    call costs more than the arithmetic), None when ``a`` is not positive definite."""
+    (a00, a01, a02), (_, a11, a12), (_, _, a22) = a.tolist()
+    if a00 <= 0.0:
+        return None
+    l00 = a00 ** 0.5
+    l10, l20 = a01 / l00, a02 / l00
+    d1 = a11 - l10 * l10
+    if d1 <= 0.0:
+        return None
+    l11 = d1 ** 0.5
+    l21 = (a12 - l20 * l10) / l11
+    d2 = a22 - l20 * l20 - l21 * l21
+    if d2 <= 0.0:
+        return None
+    l22 = d2 ** 0.5
+    b0, b1, b2 = b.tolist()
+    y0 = b0 / l00
+    y1 = (b1 - l10 * y0) / l11
+    y2 = (b2 - l20 * y0 - l21 * y1) / l22
+    x2 = y2 / l22
+    x1 = (y1 - l21 * x2) / l11
+    x0 = (y0 - l10 * x1 - l20 * x2) / l00
+    return np.array([x0, x1, x2])
+
+
 def fit_circle_2d(xy):
-    """Geometric least-squares circle (Gauss-Newton from Kasa's algebraic circle)."""
+    """Geometric least-squares circle (Newton from Kasa's algebraic circle)."""
     xy = np.asarray(xy, dtype=float)
     if len(xy) < 3:
         raise InputError("edge circle fit: fewer than 3 points in the edge zone")
@@ -647,11 +674,28 @@ def fit_circle_2d(xy):
     sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
     c = sol[:2]
     r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
+    n = float(len(xy))
     for _ in range(50):
+        # Newton on the sum of squared residuals rho_i - r (the Gauss-Newton normal matrix
+        # plus the residuals' curvature, (I - w w^T) / rho on the centre): the same minimum
+        # as Gauss-Newton's, reached quadratically, a 3 x 3 solve per step. Gauss-Newton's
+        # matrix alone where the full one is not positive definite (far from the minimum).
         v = xy - c
-        rho = np.linalg.norm(v, axis=1)
-        J = np.column_stack([-v / rho[:, None], -np.ones(len(xy))])
-        dx, *_ = np.linalg.lstsq(J, -(rho - r), rcond=None)
+        rho = np.sqrt(np.einsum("ij,ij->i", v, v))
+        w = v / rho[:, None]
+        res = rho - r
+        sw = w.sum(axis=0)
+        jtj = np.empty((3, 3))
+        jtj[:2, :2] = w.T @ w
+        jtj[:2, 2] = jtj[2, :2] = sw
+        jtj[2, 2] = n
+        grad = -np.append(w.T @ res, res.sum())
+        q = res / rho
+        hess = jtj.copy()
+        hess[:2, :2] += q.sum() * np.eye(2) - (w * q[:, None]).T @ w
+        dx = _solve_spd3(hess, -grad)
+        if dx is None:
+            dx = np.linalg.lstsq(jtj, -grad, rcond=None)[0]
         c, r = c + dx[:2], r + dx[2]
         if np.linalg.norm(dx) < 1e-14 * max(1.0, r):
             break
