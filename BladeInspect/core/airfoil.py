@@ -48,6 +48,7 @@ _CORNER_RUN = 5
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_GRID, _ZONE_GRID_ROUNDS = 256, 4
+_ZONE_WINDOW = 512            # dense samples either side of the edge point scanned first
 # A resampled zone (too few input points) moves with its fitted centre and converges linearly:
 # it is settled when its bounds move by less than this (a nanometre; the radius moves far less).
 _ZONE_SETTLED_MM = 1e-6
@@ -314,18 +315,29 @@ def _medial_axis(profile, a, b):
         raise InputError("airfoil profile: fewer than 4 inscribed circles between its sides; "
                          "not an airfoil-like closed profile")
     run = np.arange(starts[longest], stops[longest])
-    found = [(c[run], r[run], ua[run])]
-    for inner, outer in ((run[0], run[0] - 1), (run[-1], run[-1] + 1)):
-        u_in = feet[inner]
+    # The two ends' rounds are independent: each round closes in on both at once (one
+    # vectorised call for the feet of both ends).
+    brackets = {}
+    for end, (inner, outer) in enumerate(((run[0], run[0] - 1), (run[-1], run[-1] + 1))):
         u_out = feet[outer] if 0 <= outer < len(feet) else (a.lo if outer < 0 else a.hi)
-        for _ in range(_END_ROUNDS):
-            sub = np.linspace(u_in, u_out, _END_FEET)
-            cs, rs, uas, oks = _circles_from_feet(profile, a, b, sub)
-            found.append((cs[oks], rs[oks], uas[oks]))
-            n_run = len(oks) if oks.all() else int(np.argmin(oks))
-            if n_run == 0 or n_run == len(oks):
-                break
-            u_in, u_out = sub[n_run - 1], sub[n_run]
+        brackets[end] = (feet[inner], u_out)
+    by_end = {0: [], 1: []}
+    for _ in range(_END_ROUNDS):
+        if not brackets:
+            break
+        ends = sorted(brackets)
+        subs = [np.linspace(*brackets[end], _END_FEET) for end in ends]
+        cs, rs, uas, oks = _circles_from_feet(profile, a, b, np.concatenate(subs))
+        for j, (end, sub) in enumerate(zip(ends, subs)):
+            part = slice(j * _END_FEET, (j + 1) * _END_FEET)
+            ok = oks[part]
+            by_end[end].append((cs[part][ok], rs[part][ok], uas[part][ok]))
+            n_run = len(ok) if ok.all() else int(np.argmin(ok))
+            if n_run == 0 or n_run == len(ok):
+                del brackets[end]
+            else:
+                brackets[end] = (sub[n_run - 1], sub[n_run])
+    found = [(c[run], r[run], ua[run])] + by_end[0] + by_end[1]
     c = np.vstack([f[0] for f in found])
     r = np.concatenate([f[1] for f in found])
     order = np.argsort(np.concatenate([f[2] for f in found]))
@@ -755,11 +767,21 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     n = len(profile.dense)
     h = profile.length / n
     i0 = int(np.round(np.mod(edge_u, profile.length) / h)) % n
-    seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
-    if seen.all():
-        raise InputError("edge zone: the whole profile is within the edge zone")
-    ahead = int(np.argmin(seen))                 # first sample outside, going forwards
-    behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
+    # The samples round edge_u first (a zone spans a few edge radii); the whole loop only
+    # when the zone reaches past them.
+    near = np.arange(i0 - _ZONE_WINDOW, i0 + _ZONE_WINDOW + 1) % n
+    seen_near = _unit(profile.dense[near] - centre) @ outward >= cos_zone
+    ahead_near = np.flatnonzero(~seen_near[_ZONE_WINDOW:])
+    behind_near = np.flatnonzero(~seen_near[_ZONE_WINDOW::-1][1:])
+    if 2 * _ZONE_WINDOW + 1 < n and len(ahead_near) and len(behind_near):
+        ahead = int(ahead_near[0])               # first sample outside, going forwards
+        behind = int(behind_near[0])             # first sample outside, going backwards
+    else:
+        seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
+        if seen.all():
+            raise InputError("edge zone: the whole profile is within the edge zone")
+        ahead = int(np.argmin(seen))
+        behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
     base = profile.dense_u[i0]
     # Each bound lies between its last sample inside (a) and the next one out (a + step);
     # the bracket is cut into _ZONE_GRID parts per round, both bounds in one evaluation:
