@@ -686,7 +686,7 @@ def fit_circle_2d(xy):
     sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
     c = sol[:2]
     r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
-    n = float(len(xy))
+    J = np.ones((len(xy), 3))       # minus the residuals' gradient: (w_i, 1)
     for _ in range(50):
         # Newton on the sum of squared residuals rho_i - r (the Gauss-Newton normal matrix
         # plus the residuals' curvature, (I - w w^T) / rho on the centre): the same minimum
@@ -694,22 +694,22 @@ def fit_circle_2d(xy):
         # matrix alone where the full one is not positive definite (far from the minimum).
         v = xy - c
         rho = np.sqrt(np.einsum("ij,ij->i", v, v))
-        w = v / rho[:, None]
+        w = J[:, :2]
+        np.divide(v, rho[:, None], out=w)
         res = rho - r
-        sw = w.sum(axis=0)
-        jtj = np.empty((3, 3))
-        jtj[:2, :2] = w.T @ w
-        jtj[:2, 2] = jtj[2, :2] = sw
-        jtj[2, 2] = n
-        grad = -np.append(w.T @ res, res.sum())
+        jtj = J.T @ J
+        step_rhs = J.T @ res          # minus the gradient
         q = res / rho
         hess = jtj.copy()
-        hess[:2, :2] += q.sum() * np.eye(2) - (w * q[:, None]).T @ w
-        dx = _solve_spd3(hess, -grad)
+        hess[:2, :2] -= (w * q[:, None]).T @ w
+        qs = q.sum()
+        hess[0, 0] += qs
+        hess[1, 1] += qs
+        dx = _solve_spd3(hess, step_rhs)
         if dx is None:
-            dx = np.linalg.lstsq(jtj, -grad, rcond=None)[0]
+            dx = np.linalg.lstsq(jtj, step_rhs, rcond=None)[0]
         c, r = c + dx[:2], r + dx[2]
-        if np.linalg.norm(dx) < 1e-14 * max(1.0, r):
+        if float(dx @ dx) < (1e-14 * max(1.0, r)) ** 2:
             break
     res = np.linalg.norm(xy - c, axis=1) - r
     return c, float(r), float(np.sqrt(np.mean(res ** 2)))
