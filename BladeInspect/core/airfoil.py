@@ -232,13 +232,6 @@ def _side(profile, lo, hi):
     return _Side(lo, hi, u, xy, cKDTree(xy))
 
 
-def _foot(profile, side, xy, u0=None):
-    if u0 is None:
-        _, i = side.tree.query(xy)
-        u0 = side.u[i]
-    return profile.closest(xy, u0, side.lo, side.hi)
-
-
 def _refine_centres(profile, a, b, centre):
     """Centres equidistant from sides a and b (the medial axis between them), by Newton on
     d_a - d_b along its gradient (the difference of the unit vectors from the feet). The feet
@@ -246,8 +239,7 @@ def _refine_centres(profile, a, b, centre):
     c = centre.copy()
     ua, ub = None, None
     for _ in range(30):
-        ua, fa = _foot(profile, a, c, ua)
-        ub, fb = _foot(profile, b, c, ub)
+        ua, ub, fa, fb = _feet(profile, a, b, c, ua, ub)
         va, vb = c - fa, c - fb
         da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
         g = va / da[:, None] - vb / db[:, None]
@@ -257,9 +249,21 @@ def _refine_centres(profile, a, b, centre):
         c[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
         if np.all(np.abs(f) < 1e-11):
             break
-    ua, fa = _foot(profile, a, c)
-    ub, fb = _foot(profile, b, c)
+    ua, ub, fa, fb = _feet(profile, a, b, c)
     return c, ua, ub, fa, fb
+
+
+def _feet(profile, a, b, xy, ua=None, ub=None):
+    """The feet of ``xy`` on side a and on side b: from the nearest side samples (or from ua,
+    ub), by Newton kept within each side's range; both sides in one run (half the calls)."""
+    if ua is None:
+        ua = a.u[a.tree.query(xy)[1]]
+        ub = b.u[b.tree.query(xy)[1]]
+    n = len(xy)
+    lo = np.concatenate([np.full(n, a.lo), np.full(n, b.lo)])
+    hi = np.concatenate([np.full(n, a.hi), np.full(n, b.hi)])
+    u, foot = profile.closest(np.vstack([xy, xy]), np.concatenate([ua, ub]), lo, hi)
+    return u[:n], u[n:], foot[:n], foot[n:]
 
 
 def _circles_from_feet(profile, a, b, ua0):
