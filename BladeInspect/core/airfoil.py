@@ -198,7 +198,13 @@ def _signed_area(pts):
 
 def _unit(v):
     v = np.asarray(v, dtype=float)
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / _norms(v)[..., None]
+
+
+def _norms(v):
+    """Lengths of vectors along the last axis: np.linalg.norm's sum of squares, without its
+    per-call overhead (the hot loops call it tens of thousands of times)."""
+    return np.sqrt(np.einsum("...i,...i->...", v, v))
 
 
 def _angle_deg(direction, axis):
@@ -241,7 +247,7 @@ def _refine_centres(profile, a, b, centre):
     for _ in range(30):
         ua, ub, fa, fb = _feet(profile, a, b, c, ua, ub)
         va, vb = c - fa, c - fb
-        da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
+        da, db = _norms(va), _norms(vb)
         g = va / da[:, None] - vb / db[:, None]
         g2 = np.einsum("ij,ij->i", g, g)
         f = da - db
@@ -284,7 +290,7 @@ def _circles_from_feet(profile, a, b, ua0):
     r0 = np.where(np.isfinite(r0), r0, 0.0)
     centre = fa + r0[:, None] * inward
     c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
-    r = np.linalg.norm(fa - c, axis=1)
+    r = _norms(fa - c)
     va, vb = _unit(fa - c), _unit(fb - c)
     contact = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", va, vb), -1, 1)))
     tol = 1e-9 * profile.length
@@ -293,10 +299,10 @@ def _circles_from_feet(profile, a, b, ua0):
     # nearer edge; the edge circle itself (an exact circular edge) runs along it there.
     via_lo = (ua - a.lo) + (b.hi - ub) < (a.hi - ua) + (ub - b.lo)
     mid = np.where(via_lo, (ua + ub - profile.length) / 2.0, (ua + ub) / 2.0)
-    gap = np.linalg.norm(profile.eval(mid) - c, axis=1) - r
+    gap = _norms(profile.eval(mid) - c) - r
     # Inscribed: no point of the profile nearer than the contacts (a foot stuck at a local
     # stationary point next to a closer edge would make a circle that crosses the profile).
-    nearest = np.linalg.norm(profile.closest(c)[1] - c, axis=1)
+    nearest = _norms(profile.closest(c)[1] - c)
     inscribed = nearest > r - 1e-9 * np.maximum(r, 1.0)
     ok = ((r0 > 0) & interior & inscribed & (contact >= MIN_CONTACT_ANGLE_DEG)
           & (gap > _EDGE_GAP * r))
@@ -948,7 +954,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         s_try = np.linspace(lo_s, hi_s, 9)
         seeds, _ = mcl.at(mcl.le_extension + s_try)
         cs, _, _, fs, _ = _refine_centres(profile, side_a, side_b, seeds)
-        r_try = np.linalg.norm(fs - cs, axis=1)
+        r_try = _norms(fs - cs)
         a2, a1, _ = np.polyfit(s_try - s_try[4], r_try, 2)
         s_max = s_try[4] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
         s_max = float(np.clip(s_max, lo_s, hi_s))
