@@ -532,10 +532,11 @@ def _thickness_normal(profile, mcl, s):
     the camber line's normal there (nearest crossing on each side)."""
     m, t = mcl.at(s)
     n = np.column_stack([-t[:, 1], t[:, 0]])
-    out = np.empty(len(s))
+    out = np.full(len(s), np.nan)
     p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
     e = q - p
     h = profile.length / len(profile.dense)
+    starts, found = [], []
     for k in range(len(s)):
         den = _cross2(n[k], e)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -544,13 +545,16 @@ def _thickness_normal(profile, mcl, s):
         ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
         plus, minus = ok & (tau > 0), ok & (tau < 0)
         if not plus.any() or not minus.any():
-            out[k] = np.nan
             continue
         ip = np.flatnonzero(plus)[np.argmin(tau[plus])]
         im = np.flatnonzero(minus)[np.argmax(tau[minus])]
-        u0 = profile.dense_u[[ip, im]] + lam[[ip, im]] * h
-        _, xy = _line_hit(profile, np.tile(m[k], (2, 1)), np.tile(n[k], (2, 1)), u0)
-        out[k] = float(np.linalg.norm(xy[0] - xy[1]))
+        starts.append(profile.dense_u[[ip, im]] + lam[[ip, im]] * h)
+        found.append(k)
+    if found:
+        # every crossing's Newton run in one call (each runs its fixed steps alone)
+        rows = np.repeat(found, 2)
+        _, xy = _line_hit(profile, m[rows], n[rows], np.concatenate(starts))
+        out[found] = _norms(xy[0::2] - xy[1::2])
     return out
 
 
