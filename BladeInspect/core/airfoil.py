@@ -106,6 +106,7 @@ class Profile:
         self.dense_u = np.linspace(0.0, self.length, n_dense, endpoint=False)
         self.dense = self.eval(self.dense_u)
         self._tree = cKDTree(self.dense)
+        self._hull = None
 
     def eval(self, u, der=0):
         # Only the asked derivative: most calls want points alone (the same arithmetic as
@@ -165,6 +166,13 @@ class Profile:
         h = np.einsum("ij,ij->i", s1, s1) + np.einsum("ij,ij->i", d, s2)
         h = np.where(np.abs(h) > 1e-12, h, np.einsum("ij,ij->i", s1, s1))
         return u - g / h
+
+    def hull_vertices(self):
+        """Indices of the dense samples on their convex hull (the caliper and the tangent
+        chord both want it; worked out once)."""
+        if self._hull is None:
+            self._hull = ConvexHull(self.dense).vertices
+        return self._hull
 
     def knot_quadrature(self, order=5):
         """Gauss-Legendre nodes and weights over every knot span: exact for polynomials of
@@ -582,16 +590,18 @@ def _farthest_pair(profile):
     point of the curve furthest from the other: the furthest dense sample, then Newton steps
     kept within one sample spacing (a step must not run off to the nearest point, which is
     stationary too)."""
-    hull = profile.dense[ConvexHull(profile.dense).vertices]
+    hull = profile.dense[profile.hull_vertices()]
     hull = hull[::max(1, len(hull) // 400)]
-    d2 = np.sum((hull[:, None, :] - hull[None, :, :]) ** 2, axis=2)
+    # x^2 + y^2 per pair as two planes (a sum over a length-2 last axis is numpy's slow case)
+    d2 = (hull[:, None, 0] - hull[None, :, 0]) ** 2 + (hull[:, None, 1] - hull[None, :, 1]) ** 2
     i, j = np.unravel_index(np.argmax(d2), d2.shape)
     spacing = profile.length / len(profile.dense)
     uj = profile.nearest_param(hull[j])
 
     def furthest_from(u_other):
         p = profile.eval(u_other)[0]
-        u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
+        v = profile.dense - p
+        u = profile.dense_u[[int(np.argmax(np.einsum("ij,ij->i", v, v)))]]
         start = u.copy()
         for _ in range(_NEWTON_ITERATIONS):
             new = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
@@ -628,7 +638,7 @@ def _tangent_from(profile, point, u):
 def _pressure_bitangent(profile, pressure, le_u, te_u):
     """The line touching the profile at both edges across the pressure side, as (point near
     the LE, point near the TE), or None when the pressure side is not concave."""
-    hull = np.sort(ConvexHull(profile.dense).vertices)
+    hull = np.sort(profile.hull_vertices())
     hu = profile.dense_u[hull]
     gaps = np.diff(np.concatenate([hu, [hu[0] + profile.length]]))
     k = int(np.argmax(np.where(_in_range(hu + gaps / 2, pressure, profile.length), gaps, 0)))
