@@ -7,8 +7,9 @@ uncertainty re-fits, on the demo blade:
 
     scripts/fcpython bench/bench_airfoil_speed.py [POINTS.csv]
 
-Prints the CPU seconds of run_stage for draws 0 and the default draws, and of the kernel alone
-(core.airfoil.characteristics on the five nominal cuts). BLAS is held to one thread (its
+Prints the CPU seconds of run_stage for draws 0 and the default draws, of the kernel alone
+(core.airfoil.characteristics on the five nominal cuts), and of one kernel run a measured
+section (what every uncertainty re-fit repeats). BLAS is held to one thread (its
 spinning threads double a CPU figure on a shared machine).
 """
 import os
@@ -69,6 +70,13 @@ def main():
             n = [b["measured"]["n_points"] if b.get("measured") else 0 for b in stage.blocks]
             print("%s: draws %2d: %.2f s CPU for %d sections (points %s)"
                   % (name, draws, cpu, len(n), "/".join(map(str, n))))
+        # one kernel run on each measured section (what each of the 12 re-fits repeats)
+        measured = [r for r in stage.sections if r.measured is not None]
+        t = time.process_time()
+        for r in measured:
+            kernel.characteristics(r.points_2d, noise_mm=r.noise_mm, le_hint=r.nominal.le_point)
+        print("%s: kernel on the %d measured sections: %.3f s CPU each"
+              % (name, len(measured), (time.process_time() - t) / max(len(measured), 1)))
 
 
 if __name__ == "__main__":

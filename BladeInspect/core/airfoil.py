@@ -48,6 +48,7 @@ _CORNER_RUN = 5
 _ZONE_ROUNDS = 20
 _ZONE_SAMPLES = 400
 _ZONE_GRID, _ZONE_GRID_ROUNDS = 256, 4
+_ZONE_WINDOW = 512            # dense samples either side of the edge point scanned first
 # A resampled zone (too few input points) moves with its fitted centre and converges linearly:
 # it is settled when its bounds move by less than this (a nanometre; the radius moves far less).
 _ZONE_SETTLED_MM = 1e-6
@@ -105,17 +106,28 @@ class Profile:
         self.dense_u = np.linspace(0.0, self.length, n_dense, endpoint=False)
         self.dense = self.eval(self.dense_u)
         self._tree = cKDTree(self.dense)
+        self._hull = None
 
     def eval(self, u, der=0):
+        # Only the asked derivative: most calls want points alone (the same arithmetic as
+        # eval3's, so the values are eval3's to the bit).
+        t, c = self._pieces(u)
+        if der == 0:
+            return ((c[:, 0] * t + c[:, 1]) * t + c[:, 2]) * t + c[:, 3]
+        if der == 1:
+            return (3.0 * c[:, 0] * t + 2.0 * c[:, 1]) * t + c[:, 2]
         return self.eval3(u)[der]
 
-    def eval3(self, u):
-        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+    def _pieces(self, u):
+        """Each parameter's offset into its spline piece and that piece's coefficients."""
         u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
         i = np.searchsorted(self._breaks, u, side="right") - 1
         i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
-        t = (u - self._breaks[i])[:, None]
-        c = self._coef[i]
+        return (u - self._breaks[i])[:, None], self._coef[i]
+
+    def eval3(self, u):
+        """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
+        t, c = self._pieces(u)
         c0, c1, c2, c3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
         p = ((c0 * t + c1) * t + c2) * t + c3
         d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
@@ -155,6 +167,13 @@ class Profile:
         h = np.where(np.abs(h) > 1e-12, h, np.einsum("ij,ij->i", s1, s1))
         return u - g / h
 
+    def hull_vertices(self):
+        """Indices of the dense samples on their convex hull (the caliper and the tangent
+        chord both want it; worked out once)."""
+        if self._hull is None:
+            self._hull = ConvexHull(self.dense).vertices
+        return self._hull
+
     def knot_quadrature(self, order=5):
         """Gauss-Legendre nodes and weights over every knot span: exact for polynomials of
         degree 2*order-1 in the spline's parameter."""
@@ -187,7 +206,13 @@ def _signed_area(pts):
 
 def _unit(v):
     v = np.asarray(v, dtype=float)
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / _norms(v)[..., None]
+
+
+def _norms(v):
+    """Lengths of vectors along the last axis: np.linalg.norm's sum of squares, without its
+    per-call overhead (the hot loops call it tens of thousands of times)."""
+    return np.sqrt(np.einsum("...i,...i->...", v, v))
 
 
 def _angle_deg(direction, axis):
@@ -221,13 +246,6 @@ def _side(profile, lo, hi):
     return _Side(lo, hi, u, xy, cKDTree(xy))
 
 
-def _foot(profile, side, xy, u0=None):
-    if u0 is None:
-        _, i = side.tree.query(xy)
-        u0 = side.u[i]
-    return profile.closest(xy, u0, side.lo, side.hi)
-
-
 def _refine_centres(profile, a, b, centre):
     """Centres equidistant from sides a and b (the medial axis between them), by Newton on
     d_a - d_b along its gradient (the difference of the unit vectors from the feet). The feet
@@ -235,10 +253,9 @@ def _refine_centres(profile, a, b, centre):
     c = centre.copy()
     ua, ub = None, None
     for _ in range(30):
-        ua, fa = _foot(profile, a, c, ua)
-        ub, fb = _foot(profile, b, c, ub)
+        ua, ub, fa, fb = _feet(profile, a, b, c, ua, ub)
         va, vb = c - fa, c - fb
-        da, db = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
+        da, db = _norms(va), _norms(vb)
         g = va / da[:, None] - vb / db[:, None]
         g2 = np.einsum("ij,ij->i", g, g)
         f = da - db
@@ -246,9 +263,21 @@ def _refine_centres(profile, a, b, centre):
         c[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
         if np.all(np.abs(f) < 1e-11):
             break
-    ua, fa = _foot(profile, a, c)
-    ub, fb = _foot(profile, b, c)
+    ua, ub, fa, fb = _feet(profile, a, b, c)
     return c, ua, ub, fa, fb
+
+
+def _feet(profile, a, b, xy, ua=None, ub=None):
+    """The feet of ``xy`` on side a and on side b: from the nearest side samples (or from ua,
+    ub), by Newton kept within each side's range; both sides in one run (half the calls)."""
+    if ua is None:
+        ua = a.u[a.tree.query(xy)[1]]
+        ub = b.u[b.tree.query(xy)[1]]
+    n = len(xy)
+    lo = np.concatenate([np.full(n, a.lo), np.full(n, b.lo)])
+    hi = np.concatenate([np.full(n, a.hi), np.full(n, b.hi)])
+    u, foot = profile.closest(np.vstack([xy, xy]), np.concatenate([ua, ub]), lo, hi)
+    return u[:n], u[n:], foot[:n], foot[n:]
 
 
 def _circles_from_feet(profile, a, b, ua0):
@@ -269,7 +298,7 @@ def _circles_from_feet(profile, a, b, ua0):
     r0 = np.where(np.isfinite(r0), r0, 0.0)
     centre = fa + r0[:, None] * inward
     c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
-    r = np.linalg.norm(fa - c, axis=1)
+    r = _norms(fa - c)
     va, vb = _unit(fa - c), _unit(fb - c)
     contact = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", va, vb), -1, 1)))
     tol = 1e-9 * profile.length
@@ -278,10 +307,10 @@ def _circles_from_feet(profile, a, b, ua0):
     # nearer edge; the edge circle itself (an exact circular edge) runs along it there.
     via_lo = (ua - a.lo) + (b.hi - ub) < (a.hi - ua) + (ub - b.lo)
     mid = np.where(via_lo, (ua + ub - profile.length) / 2.0, (ua + ub) / 2.0)
-    gap = np.linalg.norm(profile.eval(mid) - c, axis=1) - r
+    gap = _norms(profile.eval(mid) - c) - r
     # Inscribed: no point of the profile nearer than the contacts (a foot stuck at a local
     # stationary point next to a closer edge would make a circle that crosses the profile).
-    nearest = np.linalg.norm(profile.closest(c)[1] - c, axis=1)
+    nearest = _norms(profile.closest(c)[1] - c)
     inscribed = nearest > r - 1e-9 * np.maximum(r, 1.0)
     ok = ((r0 > 0) & interior & inscribed & (contact >= MIN_CONTACT_ANGLE_DEG)
           & (gap > _EDGE_GAP * r))
@@ -304,18 +333,29 @@ def _medial_axis(profile, a, b):
         raise InputError("airfoil profile: fewer than 4 inscribed circles between its sides; "
                          "not an airfoil-like closed profile")
     run = np.arange(starts[longest], stops[longest])
-    found = [(c[run], r[run], ua[run])]
-    for inner, outer in ((run[0], run[0] - 1), (run[-1], run[-1] + 1)):
-        u_in = feet[inner]
+    # The two ends' rounds are independent: each round closes in on both at once (one
+    # vectorised call for the feet of both ends).
+    brackets = {}
+    for end, (inner, outer) in enumerate(((run[0], run[0] - 1), (run[-1], run[-1] + 1))):
         u_out = feet[outer] if 0 <= outer < len(feet) else (a.lo if outer < 0 else a.hi)
-        for _ in range(_END_ROUNDS):
-            sub = np.linspace(u_in, u_out, _END_FEET)
-            cs, rs, uas, oks = _circles_from_feet(profile, a, b, sub)
-            found.append((cs[oks], rs[oks], uas[oks]))
-            n_run = len(oks) if oks.all() else int(np.argmin(oks))
-            if n_run == 0 or n_run == len(oks):
-                break
-            u_in, u_out = sub[n_run - 1], sub[n_run]
+        brackets[end] = (feet[inner], u_out)
+    by_end = {0: [], 1: []}
+    for _ in range(_END_ROUNDS):
+        if not brackets:
+            break
+        ends = sorted(brackets)
+        subs = [np.linspace(*brackets[end], _END_FEET) for end in ends]
+        cs, rs, uas, oks = _circles_from_feet(profile, a, b, np.concatenate(subs))
+        for j, (end, sub) in enumerate(zip(ends, subs)):
+            part = slice(j * _END_FEET, (j + 1) * _END_FEET)
+            ok = oks[part]
+            by_end[end].append((cs[part][ok], rs[part][ok], uas[part][ok]))
+            n_run = len(ok) if ok.all() else int(np.argmin(ok))
+            if n_run == 0 or n_run == len(ok):
+                del brackets[end]
+            else:
+                brackets[end] = (sub[n_run - 1], sub[n_run])
+    found = [(c[run], r[run], ua[run])] + by_end[0] + by_end[1]
     c = np.vstack([f[0] for f in found])
     r = np.concatenate([f[1] for f in found])
     order = np.argsort(np.concatenate([f[2] for f in found]))
@@ -500,10 +540,11 @@ def _thickness_normal(profile, mcl, s):
     the camber line's normal there (nearest crossing on each side)."""
     m, t = mcl.at(s)
     n = np.column_stack([-t[:, 1], t[:, 0]])
-    out = np.empty(len(s))
+    out = np.full(len(s), np.nan)
     p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
     e = q - p
     h = profile.length / len(profile.dense)
+    starts, found = [], []
     for k in range(len(s)):
         den = _cross2(n[k], e)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -512,13 +553,16 @@ def _thickness_normal(profile, mcl, s):
         ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
         plus, minus = ok & (tau > 0), ok & (tau < 0)
         if not plus.any() or not minus.any():
-            out[k] = np.nan
             continue
         ip = np.flatnonzero(plus)[np.argmin(tau[plus])]
         im = np.flatnonzero(minus)[np.argmax(tau[minus])]
-        u0 = profile.dense_u[[ip, im]] + lam[[ip, im]] * h
-        _, xy = _line_hit(profile, np.tile(m[k], (2, 1)), np.tile(n[k], (2, 1)), u0)
-        out[k] = float(np.linalg.norm(xy[0] - xy[1]))
+        starts.append(profile.dense_u[[ip, im]] + lam[[ip, im]] * h)
+        found.append(k)
+    if found:
+        # every crossing's Newton run in one call (each runs its fixed steps alone)
+        rows = np.repeat(found, 2)
+        _, xy = _line_hit(profile, m[rows], n[rows], np.concatenate(starts))
+        out[found] = _norms(xy[0::2] - xy[1::2])
     return out
 
 
@@ -546,16 +590,18 @@ def _farthest_pair(profile):
     point of the curve furthest from the other: the furthest dense sample, then Newton steps
     kept within one sample spacing (a step must not run off to the nearest point, which is
     stationary too)."""
-    hull = profile.dense[ConvexHull(profile.dense).vertices]
+    hull = profile.dense[profile.hull_vertices()]
     hull = hull[::max(1, len(hull) // 400)]
-    d2 = np.sum((hull[:, None, :] - hull[None, :, :]) ** 2, axis=2)
+    # x^2 + y^2 per pair as two planes (a sum over a length-2 last axis is numpy's slow case)
+    d2 = (hull[:, None, 0] - hull[None, :, 0]) ** 2 + (hull[:, None, 1] - hull[None, :, 1]) ** 2
     i, j = np.unravel_index(np.argmax(d2), d2.shape)
     spacing = profile.length / len(profile.dense)
     uj = profile.nearest_param(hull[j])
 
     def furthest_from(u_other):
         p = profile.eval(u_other)[0]
-        u = profile.dense_u[[int(np.argmax(np.sum((profile.dense - p) ** 2, axis=1)))]]
+        v = profile.dense - p
+        u = profile.dense_u[[int(np.argmax(np.einsum("ij,ij->i", v, v)))]]
         start = u.copy()
         for _ in range(_NEWTON_ITERATIONS):
             new = np.clip(profile._newton_stationary(u, p), start - spacing, start + spacing)
@@ -592,7 +638,7 @@ def _tangent_from(profile, point, u):
 def _pressure_bitangent(profile, pressure, le_u, te_u):
     """The line touching the profile at both edges across the pressure side, as (point near
     the LE, point near the TE), or None when the pressure side is not concave."""
-    hull = np.sort(ConvexHull(profile.dense).vertices)
+    hull = np.sort(profile.hull_vertices())
     hu = profile.dense_u[hull]
     gaps = np.diff(np.concatenate([hu, [hu[0] + profile.length]]))
     k = int(np.argmax(np.where(_in_range(hu + gaps / 2, pressure, profile.length), gaps, 0)))
@@ -628,8 +674,35 @@ class CircleFit2D:
     zone_deg: float
 
 
+def _solve_spd3(a, b):
+    """x with a x = b for a symmetric 3 x 3 ``a`` by Cholesky in plain floats (a numpy linalg
+    call costs more than the arithmetic), None when ``a`` is not positive definite."""
+    (a00, a01, a02), (_, a11, a12), (_, _, a22) = a.tolist()
+    if a00 <= 0.0:
+        return None
+    l00 = a00 ** 0.5
+    l10, l20 = a01 / l00, a02 / l00
+    d1 = a11 - l10 * l10
+    if d1 <= 0.0:
+        return None
+    l11 = d1 ** 0.5
+    l21 = (a12 - l20 * l10) / l11
+    d2 = a22 - l20 * l20 - l21 * l21
+    if d2 <= 0.0:
+        return None
+    l22 = d2 ** 0.5
+    b0, b1, b2 = b.tolist()
+    y0 = b0 / l00
+    y1 = (b1 - l10 * y0) / l11
+    y2 = (b2 - l20 * y0 - l21 * y1) / l22
+    x2 = y2 / l22
+    x1 = (y1 - l21 * x2) / l11
+    x0 = (y0 - l10 * x1 - l20 * x2) / l00
+    return np.array([x0, x1, x2])
+
+
 def fit_circle_2d(xy):
-    """Geometric least-squares circle (Gauss-Newton from Kasa's algebraic circle)."""
+    """Geometric least-squares circle (Newton from Kasa's algebraic circle)."""
     xy = np.asarray(xy, dtype=float)
     if len(xy) < 3:
         raise InputError("edge circle fit: fewer than 3 points in the edge zone")
@@ -637,13 +710,30 @@ def fit_circle_2d(xy):
     sol, *_ = np.linalg.lstsq(A, np.einsum("ij,ij->i", xy, xy), rcond=None)
     c = sol[:2]
     r = float(np.sqrt(max(sol[2] + c @ c, 0.0)))
+    J = np.ones((len(xy), 3))       # minus the residuals' gradient: (w_i, 1)
     for _ in range(50):
+        # Newton on the sum of squared residuals rho_i - r (the Gauss-Newton normal matrix
+        # plus the residuals' curvature, (I - w w^T) / rho on the centre): the same minimum
+        # as Gauss-Newton's, reached quadratically, a 3 x 3 solve per step. Gauss-Newton's
+        # matrix alone where the full one is not positive definite (far from the minimum).
         v = xy - c
-        rho = np.linalg.norm(v, axis=1)
-        J = np.column_stack([-v / rho[:, None], -np.ones(len(xy))])
-        dx, *_ = np.linalg.lstsq(J, -(rho - r), rcond=None)
+        rho = np.sqrt(np.einsum("ij,ij->i", v, v))
+        w = J[:, :2]
+        np.divide(v, rho[:, None], out=w)
+        res = rho - r
+        jtj = J.T @ J
+        step_rhs = J.T @ res          # minus the gradient
+        q = res / rho
+        hess = jtj.copy()
+        hess[:2, :2] -= (w * q[:, None]).T @ w
+        qs = q.sum()
+        hess[0, 0] += qs
+        hess[1, 1] += qs
+        dx = _solve_spd3(hess, step_rhs)
+        if dx is None:
+            dx = np.linalg.lstsq(jtj, step_rhs, rcond=None)[0]
         c, r = c + dx[:2], r + dx[2]
-        if np.linalg.norm(dx) < 1e-14 * max(1.0, r):
+        if float(dx @ dx) < (1e-14 * max(1.0, r)) ** 2:
             break
     res = np.linalg.norm(xy - c, axis=1) - r
     return c, float(r), float(np.sqrt(np.mean(res ** 2)))
@@ -701,11 +791,21 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     n = len(profile.dense)
     h = profile.length / n
     i0 = int(np.round(np.mod(edge_u, profile.length) / h)) % n
-    seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
-    if seen.all():
-        raise InputError("edge zone: the whole profile is within the edge zone")
-    ahead = int(np.argmin(seen))                 # first sample outside, going forwards
-    behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
+    # The samples round edge_u first (a zone spans a few edge radii); the whole loop only
+    # when the zone reaches past them.
+    near = np.arange(i0 - _ZONE_WINDOW, i0 + _ZONE_WINDOW + 1) % n
+    seen_near = _unit(profile.dense[near] - centre) @ outward >= cos_zone
+    ahead_near = np.flatnonzero(~seen_near[_ZONE_WINDOW:])
+    behind_near = np.flatnonzero(~seen_near[_ZONE_WINDOW::-1][1:])
+    if 2 * _ZONE_WINDOW + 1 < n and len(ahead_near) and len(behind_near):
+        ahead = int(ahead_near[0])               # first sample outside, going forwards
+        behind = int(behind_near[0])             # first sample outside, going backwards
+    else:
+        seen = np.roll(_unit(profile.dense - centre) @ outward >= cos_zone, -i0)
+        if seen.all():
+            raise InputError("edge zone: the whole profile is within the edge zone")
+        ahead = int(np.argmin(seen))
+        behind = int(np.argmin(seen[::-1][:-1] if seen[0] else seen[::-1]))
     base = profile.dense_u[i0]
     # Each bound lies between its last sample inside (a) and the next one out (a + step);
     # the bracket is cut into _ZONE_GRID parts per round, both bounds in one evaluation:
@@ -868,7 +968,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         s_try = np.linspace(lo_s, hi_s, 9)
         seeds, _ = mcl.at(mcl.le_extension + s_try)
         cs, _, _, fs, _ = _refine_centres(profile, side_a, side_b, seeds)
-        r_try = np.linalg.norm(fs - cs, axis=1)
+        r_try = _norms(fs - cs)
         a2, a1, _ = np.polyfit(s_try - s_try[4], r_try, 2)
         s_max = s_try[4] + (-a1 / (2 * a2) if a2 < 0 else 0.0)
         s_max = float(np.clip(s_max, lo_s, hi_s))
