@@ -121,9 +121,17 @@ class TestDatumFitFromTheCommandLine(unittest.TestCase):
         tmp = tempfile.mkdtemp(prefix="bi-datum-cli-")
         try:
             sim, reg = os.path.join(tmp, "sim"), os.path.join(tmp, "reg")
+            scans, lot = os.path.join(tmp, "scans"), os.path.join(tmp, "lot")
+            points = os.path.join(sim, "points.csv")
             for args in (["simulate", "--cad", "demo:root-block", "--out", sim, "--seed", "3"],
-                         ["register", "--cad", "demo:root-block", "--points",
-                          os.path.join(sim, "points.csv"), "--out", reg, "--fit", "datum"]):
+                         ["register", "--cad", "demo:root-block", "--points", points,
+                          "--out", reg, "--fit", "datum"],
+                         # the batch and the report's FreeCAD document take the name too
+                         ["batch", "--cad", "demo:root-block", "--scans", scans, "--out", lot,
+                          "--workers", "1", "--no-airfoil", "--fit", "datum"]):
+                if args[0] == "batch":
+                    os.makedirs(scans)
+                    shutil.copy(points, os.path.join(scans, "blade1.csv"))
                 done = subprocess.run([os.path.join(REPO, "bladeinspect")] + args,
                                       capture_output=True, text=True, timeout=300)
                 self.assertEqual(done.returncode, 0, done.stderr[-2000:])
@@ -143,6 +151,14 @@ class TestDatumFitFromTheCommandLine(unittest.TestCase):
             moved = tf.apply_transform(np.asarray(fit["measured_to_cad"]) @
                                        tf.invert_transform(truth), corners)
             self.assertLess(np.abs(moved - corners).max(), 0.002)
+            import FreeCAD
+            doc = FreeCAD.openDocument(os.path.join(lot, "blade1", "inspection.FCStd"))
+            try:
+                blade = doc.getObject("DemoBlade")
+                self.assertTrue(blade.RootBlock)
+                self.assertEqual(len(blade.Shape.Faces), 10)   # 4 of the blade, 6 of the block
+            finally:
+                FreeCAD.closeDocument(doc.Name)
         finally:
             shutil.rmtree(tmp)
 

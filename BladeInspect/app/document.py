@@ -24,6 +24,7 @@ from ..core import transforms as tf
 from ..core.contracts import PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from ..core.pointio import PointSet
+from ..cad.load import builtin_cad
 from . import objects
 
 
@@ -38,14 +39,16 @@ def _measured_pointset(result):
 def write_inspection_document(path, nominal, result, sections, tolerance=PROFILE_TOLERANCE_MM,
                               verdict=None, cad_path=None, name="Inspection"):
     """Save the inspection document at ``path`` (.FCStd) and close it. ``cad_path`` is the CAD
-    file the nominal came from (None: the built-in demo blade). Returns the path."""
+    file the nominal came from (None or a cad.load.BUILTIN_CADS name: the built-in demo blade).
+    Returns the path."""
     if not str(path).lower().endswith(".fcstd"):
         raise InputError("%s: an inspection document must be an .FCStd file" % path)
     # hidden: when the GUI is up (a report run from the workbench) no 3D view opens for it
     doc = FreeCAD.newDocument(name, hidden=True)
     try:
-        if cad_path is None:
-            cad = objects.make_demo_blade(doc)
+        builtin = builtin_cad(cad_path)
+        if builtin is not None:
+            cad = objects.make_demo_blade(doc, **builtin)
         else:
             cad = objects.make_cad_model(doc, os.path.abspath(cad_path))
         measurement = objects.make_measurement(doc, _measured_pointset(result),

@@ -195,6 +195,8 @@ class DemoBlade(_Proxy):
                 setattr(obj, field.name, value)
         _add(obj, "App::PropertyMap", "FaceRoles", "Blade",
              "Face indices of each role (suction, pressure, leading_edge, ...)", read_only=True)
+        _add(obj, "App::PropertyBool", "RootBlock", "Blade",
+             "On a root block with three datum faces (--cad demo:root-block)")
 
     def params(self, obj):
         names = [f.name for f in dataclasses.fields(demo_blade.BladeParams)]
@@ -202,7 +204,7 @@ class DemoBlade(_Proxy):
                                          if n in obj.PropertiesList})
 
     def execute(self, obj):
-        model = demo_blade.make_demo_blade(self.params(obj))
+        model = demo_blade.make_demo_blade(self.params(obj), root_block=obj.RootBlock)
         obj.Shape = model.shape
         obj.FaceRoles = _roles_to_map(model.roles)
 
@@ -255,10 +257,11 @@ def nominal_of(obj):
     return _NOMINAL_CACHE[key]
 
 
-def make_demo_blade(doc, params=None, name="DemoBlade"):
+def make_demo_blade(doc, params=None, name="DemoBlade", root_block=False):
     with building(doc, "Demo blade"):
         obj = doc.addObject("Part::FeaturePython", name)
         DemoBlade(obj)
+        obj.RootBlock = bool(root_block)
         if params is not None:
             for field in dataclasses.fields(params):
                 if field.name in obj.PropertiesList:

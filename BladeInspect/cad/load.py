@@ -10,15 +10,12 @@ import numpy as np
 import FreeCAD
 import Part
 
+from ..core.contracts import BUILTIN_CADS
 from ..core.errors import InputError
 
 SHAPE_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
 DOCUMENT_EXTENSIONS = (".fcstd",)
 POINTS_MODULE_EXTENSIONS = (".ply", ".pcd")
-# Built-in parts a command's --cad may name instead of a file: the demo blade, and the demo
-# blade on a root block whose three datum faces carry the roles datum_primary/secondary/
-# tertiary (for --fit datum, which a STEP file's unnamed faces can only reach by index).
-BUILTIN_CADS = {"demo": {}, "demo:root-block": {"root_block": True}}
 
 
 def _check_file(path, kinds):
@@ -129,6 +126,16 @@ def read_points_any(path):
 
 
 
+def builtin_cad(cad_path):
+    """make_demo_blade's keyword arguments when ``cad_path`` is None or names a built-in part
+    (BUILTIN_CADS; a file of that name wins), else None."""
+    if cad_path is None:
+        return dict(BUILTIN_CADS["demo"])
+    if cad_path in BUILTIN_CADS and not os.path.exists(cad_path):
+        return dict(BUILTIN_CADS[cad_path])
+    return None
+
+
 def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     """The nominal geometry every command measures against: a CAD file, a blade section table
     (.dat, the NASA Rotor 67 format, lofted into B-spline faces), or the built-in demo blade
@@ -136,9 +143,10 @@ def load_nominal(cad_path=None, sample_spacing=None, flip_faces=()):
     ``flip_faces``: indices of faces whose outward side the user
     reverses (``--flip-face``, see cad.orient)."""
     from .nominal import nominal_from_shape
-    if cad_path is None or (cad_path in BUILTIN_CADS and not os.path.exists(cad_path)):
+    builtin = builtin_cad(cad_path)
+    if builtin is not None:
         from .demo_blade import make_demo_blade
-        model = make_demo_blade(**BUILTIN_CADS[cad_path or "demo"])
+        model = make_demo_blade(**builtin)
         return nominal_from_shape(model.shape, roles=model.roles, sample_spacing=sample_spacing,
                                   flip_faces=flip_faces)
     if cad_path.lower().endswith(".dat"):

@@ -13,6 +13,11 @@ PROFILE_TOLERANCE_MM = 0.04
 # Where the profile table's (Table 2) section planes cut the CAD without a section column,
 # in % of the span.
 SECTION_HEIGHTS_PCT = (10.0, 30.0, 50.0, 70.0, 90.0)
+# Built-in parts a command's --cad may name instead of a file (a file of that name wins), with
+# cad.demo_blade.make_demo_blade's arguments: the demo blade, and the demo blade on a root
+# block whose three datum faces carry the roles datum_primary/secondary/tertiary (for
+# --fit datum, which a STEP file's unnamed faces can only reach by index).
+BUILTIN_CADS = {"demo": {}, "demo:root-block": {"root_block": True}}
 
 
 def parse_section_heights(text, name="--section-heights", allow_empty=False):

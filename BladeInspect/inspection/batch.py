@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 
-from ..core.contracts import PROFILE_TOLERANCE_MM
+from ..core.contracts import BUILTIN_CADS, PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from . import airfoil as airfoil_mod
 from .pipeline import load_nominal
@@ -182,7 +182,7 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     tolerance = float(tolerance)
     if not tolerance > 0:
         raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
-    if cad_path is not None and not os.path.exists(cad_path):
+    if cad_path is not None and not os.path.exists(cad_path) and cad_path not in BUILTIN_CADS:
         raise InputError("%s: no such CAD file" % cad_path)
     files = point_files(scans_dir)
     os.makedirs(out_dir, exist_ok=True)
