@@ -95,16 +95,20 @@ class TrimEdges(unittest.TestCase):
         # such points went to OCC (35 % of these 250, 42 % of the outside ones of 400).
         self.assertLess(fast.fallback_fraction, 0.2)
 
-    @unittest.expectedFailure
-    def test_inside_points_near_the_hub_edge_are_occs(self):
+    def test_inside_points_near_the_hub_edge_are_never_understated(self):
         """Known, and older than the edge kernel: a point just inside the material near where
         a side meets the hub, whose 8 nearest samples all lie on the hub, never makes the side
-        a candidate, so the fast path answers the hub's distance (0.057 mm for 0.0023 mm)."""
+        a candidate, so the fast path may answer the hub's distance (0.057 mm where OCC finds
+        0.0023 mm on FreeCAD 0.20's sampling of this part; FreeCAD 1.0's samples happen to
+        avoid it). What holds on every platform, and what a verdict relies on: the answer is
+        a true distance to some face, so it never understates |deviation| nor flips its side."""
         p = points_near_edges(np.random.default_rng(2), self.edges, 400, 0.2)
         fast = self.nominal.signed_distance(p)
         inside = fast.distance < -1e-3
+        self.assertGreater(np.count_nonzero(inside), 20)
         occ = self.nominal.signed_distance_occ(p[inside])
-        np.testing.assert_allclose(fast.distance[inside], occ.distance, rtol=0, atol=1e-7)
+        self.assertTrue(np.all(np.abs(fast.distance[inside]) >= np.abs(occ.distance) - 1e-7))
+        np.testing.assert_array_equal(np.sign(fast.distance[inside]), np.sign(occ.distance))
 
 
 if __name__ == "__main__":
