@@ -24,20 +24,18 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
   estimator's own, larger scatter, which is not included (core.fits, "Covariance").
 """
 
-import json
-import os
 from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
 
 from ..core.errors import InputError
+from ..core.weights import beam_in_table
+from ..rig.kinematics import read_rig_file
 from ..rig.sensor import SensorModel
+from ..rig.simulated import BEAM_MACHINE
 
 COVERAGE_FACTOR = 2.0
-# The sensor looks down machine -Z: a reading d puts the point at (X, Y, Z - d)
-# (rig.kinematics.machine_point).
-BEAM_MACHINE = np.array([0.0, 0.0, -1.0])
 
 
 @dataclass
@@ -75,13 +73,7 @@ def model_from_rig_file(path, sensor=None):
     sensor = sensor or SensorModel()
     if path is None:
         return MeasurementModel(sensor=sensor)
-    if not os.path.isfile(path):
-        raise InputError("%s: rig file not found" % path)
-    try:
-        with open(path) as fh:
-            data = json.load(fh)
-    except (OSError, ValueError) as exc:
-        raise InputError("%s: not a readable JSON rig file (%s)" % (path, exc))
+    data = read_rig_file(path)
     value = data.get("calibration_uncertainty_mm") if isinstance(data, dict) else None
     if value is not None:
         value = float(value)
@@ -129,13 +121,8 @@ def beam_directions(result):
     angles = np.asarray(angles, dtype=float)
     if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
         return None
-    kinematics = RigKinematics()
     to_cad = np.asarray(result.measured_to_cad, dtype=float)[:3, :3]
-    beams = np.empty((len(angles), 3))
-    for a in np.unique(angles):
-        # table_point turns machine vectors back by the angle: R(a)^T v
-        beams[angles == a] = to_cad @ (kinematics.rotation(a).T @ BEAM_MACHINE)
-    return beams
+    return beam_in_table(angles, RigKinematics().axis_direction, BEAM_MACHINE) @ to_cad.T
 
 
 def systematic_coefficients(result):

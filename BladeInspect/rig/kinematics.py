@@ -113,11 +113,16 @@ class RigKinematics:
 
     @classmethod
     def from_json(cls, path):
-        if not os.path.isfile(path):
-            raise InputError("%s: rig file not found" % path)
-        try:
-            with open(path) as f:
-                data = json.load(f)
-        except (OSError, ValueError) as exc:
-            raise InputError("%s: not a readable JSON rig file (%s)" % (path, exc))
-        return cls.from_dict(data, source=path)
+        return cls.from_dict(read_rig_file(path), source=path)
+
+
+def read_rig_file(path):
+    """The parsed JSON of a RIG.json (calibrate's output); InputError when it is missing or
+    not JSON."""
+    if not os.path.isfile(path):
+        raise InputError("%s: rig file not found" % path)
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError) as exc:
+        raise InputError("%s: not a readable JSON rig file (%s)" % (path, exc))
