@@ -43,6 +43,11 @@ FINE_SUBSAMPLE = 30000
 # reach, which a tenth of the points does at a tenth of the cost; FINE_SUBSAMPLE's level then
 # converges from there with Gauss-Newton steps, and the full cloud finishes as before.
 FINE_FIRST_SUBSAMPLE = 3000
+# Gauss-Newton steps on the FINE_SUBSAMPLE points: the full cloud's optimum is a few of its
+# standard deviations from theirs, so one step (which leaves the subsample a few 1e-3 of the
+# way from its own optimum) starts the full cloud as well as converging them would; only the
+# pose is kept, so the step's residuals are left linear, without another evaluation.
+SUBSAMPLE_STEPS = 1
 # The full cloud starts a few of its own standard deviations from its optimum (the
 # subsample's), and Gauss-Newton contracts the remaining error by a few 1e-3 a step on these
 # surfaces (the rate is residual x curvature): the first step leaves about 1e-2 of a standard
@@ -402,7 +407,9 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         progress(0.1, "fine registration on %d of %d points" % (len(first), n))
         T = fit_level(first, icp_mod.ICPOptions(time_limit_s=remaining()))
         progress(0.3, "fine registration on %d of %d points" % (len(sub), n))
-        T = fit_level(sub, icp_mod.ICPOptions(horn_iters=0, time_limit_s=remaining()))
+        T = fit_level(sub, icp_mod.ICPOptions(horn_iters=0, max_iter=SUBSAMPLE_STEPS,
+                                              linear_update_mm=np.inf, linear_update_rad=np.inf,
+                                              time_limit_s=remaining()))
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
                                      uncertainty_fraction=FULL_CLOUD_UNCERTAINTY_FRACTION,
                                      linear_update_mm=LINEAR_UPDATE_MM,
