@@ -398,7 +398,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
         else:
             dt, dw = _gauss_newton_step(moved, normals, distances, w, center)
             R = rotation_from_vector(dw)
-            last_step = (moved, normals, distances, center, dt, dw, closest)
+            last_step = (moved, normals, distances, center, dt, dw)
             size = (np.linalg.norm(dt), np.linalg.norm(dw))
             T = make_transform(R, center + dt - R @ center) @ T
             motion = _extreme_motion(moved, center, dt, dw)
@@ -418,7 +418,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
             and np.linalg.norm(last_step[5]) < options.linear_update_rad:
         # The residuals at the returned pose to first order in the last small step, which
         # saves a closest-point evaluation of the whole cloud.
-        moved_before, normals, distances, center, dt, dw, _ = last_step
+        moved_before, normals, distances, center, dt, dw = last_step
         distances = distances + _jacobian(moved_before, normals, center) @ np.r_[dt, dw]
         moved = points @ T[:3, :3].T + T[:3, 3]
         # The foot point that goes with that distance: the point less it along the normal

@@ -41,7 +41,7 @@ FINE_SUBSAMPLE = 30000
 # The fine fit's first, coarsest level (a random part of the FINE_SUBSAMPLE points): its Horn
 # iterations from the coarse stage's pose only have to bring the pose within Gauss-Newton's
 # reach, which a tenth of the points does at a tenth of the cost; FINE_SUBSAMPLE's level then
-# converges from there with Gauss-Newton steps, and the full cloud finishes as before.
+# takes it on with Gauss-Newton (SUBSAMPLE_STEPS), and the full cloud finishes.
 FINE_FIRST_SUBSAMPLE = 3000
 # Gauss-Newton steps on the FINE_SUBSAMPLE points: the full cloud's optimum is a few of its
 # standard deviations from theirs, so one step (which leaves the subsample a few 1e-3 of the
