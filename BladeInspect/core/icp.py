@@ -80,6 +80,10 @@ class ICPResult:
     center: np.ndarray          # (3,) weighted centroid of the points in the CAD frame
     split: "PoseSplit" = None   # the covariance of the measured directions, and the others
     stopped: str = ""           # why the iterations ended early: "time limit" or ""
+    # The closest points and normals behind `distances` (to first order in the last step, as
+    # the distances, when that was applied linearly; see ICPOptions.linear_update_mm).
+    closest: np.ndarray = None  # (N,3)
+    normals: np.ndarray = None  # (N,3)
 
 
 def horn(target, source, weights=None):
@@ -417,9 +421,13 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
         moved_before, normals, distances, center, dt, dw = last_step
         distances = distances + _jacobian(moved_before, normals, center) @ np.r_[dt, dw]
         moved = points @ T[:3, :3].T + T[:3, 3]
+        # The foot point that goes with that distance: the point less it along the normal
+        # (the foot moved along the tangent plane), where the true one is within curvature x
+        # distance x step.
+        closest = moved - distances[:, None] * normals
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
-        _, normals, distances = closest_fn(moved)
+        closest, normals, distances = closest_fn(moved)
     if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
         a = normalised_weights(weight_model, T, normals, len(points))
     rho, _ = robust_weights(distances, a, options, neighbourhoods)
@@ -436,4 +444,4 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
         rms=float(np.sqrt(np.mean(distances[inlier] ** 2))) if inlier.any() else float("nan"),
         sigma0=float(np.sqrt(np.sum(w[keep] * distances[keep] ** 2) / dof)),
         iterations=iterations, converged=converged, covariance=cov, center=center,
-        split=split, stopped=stopped)
+        split=split, stopped=stopped, closest=closest, normals=normals)

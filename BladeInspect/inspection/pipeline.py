@@ -5,6 +5,7 @@ about a terminal or a window. Long stages report through ``progress(fraction, me
 progress callback that raises ``core.errors.Cancelled`` stops the work.
 """
 
+import dataclasses
 import json
 import os
 import shutil
@@ -40,15 +41,29 @@ FINE_SUBSAMPLE = 30000
 # The fine fit's first, coarsest level (a random part of the FINE_SUBSAMPLE points): its Horn
 # iterations from the coarse stage's pose only have to bring the pose within Gauss-Newton's
 # reach, which a tenth of the points does at a tenth of the cost; FINE_SUBSAMPLE's level then
-# converges from there with Gauss-Newton steps, and the full cloud finishes as before.
+# takes it on with Gauss-Newton (SUBSAMPLE_STEPS), and the full cloud finishes.
 FINE_FIRST_SUBSAMPLE = 3000
-FULL_CLOUD_STEPS = 3
-# The full cloud starts within a few tenths of a micrometre of its optimum (the subsample's),
-# and Gauss-Newton contracts the remaining error by about 1e-3 a step on these surfaces (the
-# rate is residual x curvature): one step below these leaves ~1e-6 mm, far under any pose
-# bound, so the pose is final without another closest-point evaluation of every point.
-FULL_CLOUD_TOL_MM = 5e-4
-FULL_CLOUD_TOL_RAD = 1e-5
+# Gauss-Newton steps on the FINE_SUBSAMPLE points: the full cloud's optimum is a few of its
+# standard deviations from theirs, so one step (which leaves the subsample a few 1e-3 of the
+# way from its own optimum) starts the full cloud as well as converging them would; only the
+# pose is kept, so the step's residuals are left linear, without another evaluation.
+SUBSAMPLE_STEPS = 1
+# The full cloud starts a few of its own standard deviations from its optimum (the
+# subsample's), and Gauss-Newton contracts the remaining error by a few 1e-3 a step on these
+# surfaces (the rate is residual x curvature): the first step leaves about 1e-2 of a standard
+# deviation, the second about 1e-5. The fit stops once the motion still to come, extrapolated
+# from how the steps shrink (core.icp, ICPOptions.uncertainty_fraction), is below this
+# fraction of the pose's own 1 sigma - nothing that could matter against it - within
+# FULL_CLOUD_STEPS closest-point evaluations of every point.
+FULL_CLOUD_UNCERTAINTY_FRACTION = 1e-3
+FULL_CLOUD_STEPS = 4
+# A last step below both is applied to the residuals linearly (core.icp): their error is of
+# order curvature x step^2, below 1e-9 mm for radii of curvature down to 0.05 mm at 1e-5 mm
+# (1e-7 rad turns a point 100 mm from the centre by 1e-5 mm). The deviations are then the
+# fit's own residuals, without another closest-point evaluation of every point; a larger last
+# step costs that evaluation at the final pose.
+LINEAR_UPDATE_MM = 1e-5
+LINEAR_UPDATE_RAD = 1e-7
 # The coarse stage's capture phase (see coarse_register): full weight within this many standard
 # errors of the PCA centroid (3: the start is rarely farther off), for this many iterations.
 CAPTURE_STANDARD_ERRORS = 3.0
@@ -337,11 +352,24 @@ class TrackedDistance:
     def __init__(self, nominal, start=None):
         self.nominal = nominal
         self.start = start
+        self.result = None   # the last call's DistanceResult
 
     def __call__(self, points):
         res = self.nominal.signed_distance(points, self.start)
         self.start = FootStart.of(points, res)
+        self.result = res
         return res.closest, res.normal, res.distance
+
+
+def final_distances(fit, tracked):
+    """The DistanceResult at the fit's pose of the fine ICP's last level, which ran on every
+    point through ``tracked`` (a TrackedDistance): its residuals, foot points and normals are
+    that closest-point evaluation's at the final pose, or follow from it to first order in a
+    last step below LINEAR_UPDATE_MM / LINEAR_UPDATE_RAD (core.icp); the faces are the
+    evaluation's."""
+    last = tracked.result
+    return dataclasses.replace(last, closest=fit.closest, normal=fit.normals,
+                               distance=fit.distances)
 
 
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
@@ -379,14 +407,18 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         progress(0.1, "fine registration on %d of %d points" % (len(first), n))
         T = fit_level(first, icp_mod.ICPOptions(time_limit_s=remaining()))
         progress(0.3, "fine registration on %d of %d points" % (len(sub), n))
-        T = fit_level(sub, icp_mod.ICPOptions(horn_iters=0, time_limit_s=remaining()))
+        T = fit_level(sub, icp_mod.ICPOptions(horn_iters=0, max_iter=SUBSAMPLE_STEPS,
+                                              linear_update_mm=np.inf, linear_update_rad=np.inf,
+                                              time_limit_s=remaining()))
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
-                                     trans_tol=FULL_CLOUD_TOL_MM, rot_tol=FULL_CLOUD_TOL_RAD,
-                                     linear_update_mm=FULL_CLOUD_TOL_MM,
-                                     linear_update_rad=FULL_CLOUD_TOL_RAD,
+                                     uncertainty_fraction=FULL_CLOUD_UNCERTAINTY_FRACTION,
+                                     linear_update_mm=LINEAR_UPDATE_MM,
+                                     linear_update_rad=LINEAR_UPDATE_RAD,
                                      time_limit_s=remaining())
     else:
-        options = icp_mod.ICPOptions(time_limit_s=remaining())
+        options = icp_mod.ICPOptions(linear_update_mm=LINEAR_UPDATE_MM,
+                                     linear_update_rad=LINEAR_UPDATE_RAD,
+                                     time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
     fit = icp_mod.icp(measured_xyz, snr, full_distance, T, options, weight_model=weight_model)
     _check_time(fit, time_limit_s)
@@ -483,8 +515,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     progress(0.92, "signed deviations of %d points" % len(xyz))
     points_cad = tf.apply_transform(fit.transform, xyz)
-    # The fit's last foot points are micrometres from these: Newton starts there.
-    dist = nominal.signed_distance(points_cad, full_distance.start)
+    dist = final_distances(fit, full_distance)   # hook: the fit's own residuals (issue 14)
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
