@@ -85,11 +85,13 @@ def _registration(doc_name, name):
 
 
 def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
-               decision_rule="iso14253", datum_faces=None):
-    """The FitChoice of the GUI's fit selector (the same checks as the command line's)."""
+               decision_rule="iso14253", datum_faces=None, weights=None):
+    """The FitChoice of the GUI's fit selector (the same checks as the command line's);
+    ``weights``: the fine ICP's, as --weights (None: inspection.weighting's default)."""
     return fitting.FitChoice(objective=fit, free=free or None,
                              weights_by_zone=weights_by_zone or None,
-                             decision_rule=decision_rule, datum_faces=datum_faces or None)
+                             decision_rule=decision_rule, datum_faces=datum_faces or None,
+                             weights=weights or None)
 
 
 def judge_fits(result, nominal, choice, tolerance):
@@ -121,7 +123,7 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
     p(0.0, "sampling the nominal")
     model = objects.nominal_of(nominal_obj)
     result = pipeline.register(model, objects.pointset_of(measurement_obj), seed=seed,
-                               progress=lambda f, m: p(0.85 * f, m))
+                               progress=lambda f, m: p(0.85 * f, m), weights=choice.weights)
     result.cad_source = nominal_obj.Label
     p(0.9, "fit: %s, and its sensitivity" % choice.objective)
     judge_fits(result, model, choice, tolerance)

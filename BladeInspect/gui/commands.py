@@ -453,8 +453,13 @@ class Report(_Command):
     def Activated(self):
         out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
-            summary = self.report(find_input((objects.Registration.Type,)), out_dir)
+            registration = find_input((objects.Registration.Type,))
+            summary = self.report(registration, out_dir)
             html = os.path.join(out_dir, "report.html")
+            if summary is not None:
+                FreeCAD.Console.PrintMessage(
+                    translate("BladeInspect", "BladeInspect: report in %s; ICP weights: %s")
+                    % (out_dir, registration.WeightsUsed or "-") + "\n")
             if summary is not None and os.path.exists(html):
                 open_in_browser(html)
 

@@ -177,8 +177,9 @@ class ScanPanel(FormPanel):
 
 
 class FitSelector(QtGui.QGroupBox):
-    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule, as the
-    command line's (inspection.fitting checks them when the command runs)."""
+    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule and the
+    fine ICP's --weights, as the command line's (inspection.fitting checks them when the
+    command runs)."""
 
     def __init__(self):
         super().__init__(translate("BladeInspect", "Fit"))
@@ -202,18 +203,28 @@ class FitSelector(QtGui.QGroupBox):
         self.rule.setToolTip(translate(
             "BladeInspect", "iso14253: pass / not proven / fail (ISO 14253-1); simple: simple "
             "acceptance"))
+        self.icp_weights = QtGui.QComboBox()
+        self.icp_weights.addItems(list(registration_fit.WEIGHT_CHOICES))
+        self.icp_weights.setToolTip(translate(
+            "BladeInspect", "The fine ICP's weights: snr, the paper's SNR-linear weights; "
+            "sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' "
+            "angle_deg); default: sensor when the points carry snr and angle_deg, else snr"))
         for label, widget in ((QT_TRANSLATE_NOOP("BladeInspect", "Objective"), self.objective),
                               (QT_TRANSLATE_NOOP("BladeInspect", "Free DOF"), self.free),
                               (QT_TRANSLATE_NOOP("BladeInspect", "Zone weights"), self.weights),
-                              (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule)):
+                              (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule),
+                              (QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
+                               self.icp_weights)):
             layout.addRow(translate("BladeInspect", label), widget)
 
     def values(self):
         """Keywords of app.actions.fit_choice (literals, for the console line)."""
+        weights = self.icp_weights.currentText()
         return {"fit": self.objective.currentText(),
                 "free": self.free.text().strip() or None,
                 "weights_by_zone": self.weights.text().strip() or None,
-                "decision_rule": self.rule.currentText()}
+                "decision_rule": self.rule.currentText(),
+                "weights": None if weights == registration_fit.DEFAULT_WEIGHTS else weights}
 
 
 class RegisterPanel(FormPanel):
@@ -270,6 +281,9 @@ def registration_html(obj):
         rows.append((tr("Fit"), _escape("%s, free %s, decision rule %s" % (
             record["objective"], ",".join(record["free"]) if isinstance(record["free"], list)
             else record["free"], record["decision_rule"]))))
+    weights = getattr(obj, "WeightsUsed", "")
+    if weights:   # issue 16 item 3: which weights the fine ICP used, and why
+        rows.append((tr("ICP weights"), _escape(weights)))
     html = "<table cellspacing='4'>" + "".join(
         "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
     notes = list(obj.Warnings) + rival_lines(json.loads(obj.CoarseJson or "{}"))

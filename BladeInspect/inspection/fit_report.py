@@ -46,11 +46,22 @@ def model_lines(verdict):
                                                "fit") if k in model]
 
 
+def weights_text(record):
+    """One line naming the fine ICP's weights (result.json's ``weights``) and why they were
+    chosen; "" for none."""
+    if not record:
+        return ""
+    return "%s, noise along the normal %s; %s" % (
+        record["model"], record.get("normal_noise", "?"), record.get("chosen_by", "?"))
+
+
 def fit_lines(result):
+    weights = weights_text(getattr(result, "weights", None))   # issue 16 item 3
+    lines = ["ICP weights: " + weights] if weights else []
     fit = result.fit
     if not fit:
-        return []
-    lines = ["objective %s, free %s, region weights %s; start: %s"
+        return lines
+    lines += ["objective %s, free %s, region weights %s; start: %s"
              % (fit["objective"], fit["free"] if isinstance(fit["free"], str)
                 else ",".join(fit["free"]), fit.get("weights_by_zone") or "none", fit["start"])]
     if fit.get("margin_mm") is not None:

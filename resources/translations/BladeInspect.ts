@@ -77,6 +77,11 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect: report in %s; ICP weights: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
         <source>BladeInspect: rig connected (%s)</source>
         <translation type="unfinished"></translation>
     </message>
@@ -200,6 +205,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Free degrees of freedom, any of tx,ty,tz,rx,ry,rz and t_stacking,r_stacking,t_engine,r_engine; empty: all six</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>ICP weights</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -438,6 +448,11 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The fine ICP's weights: snr, the paper's SNR-linear weights; sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' angle_deg); default: sensor when the points carry snr and angle_deg, else snr</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
