@@ -5,6 +5,7 @@ import html
 
 from ..core import decision as decision_mod
 from . import fitting
+from .report_table import pdf_table
 
 VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
                 decision_mod.FAIL: "FAIL"}
@@ -108,18 +109,12 @@ def pdf_page(plt, result, verdict, dpi):
         fig.text(0.06, y, line, fontsize=7, wrap=True)
         y -= 0.02
     header, rows = decision_rows(verdict)
-    ax = fig.add_axes([0.06, 0.5, 0.88, max(0.05, y - 0.52)])
-    ax.axis("off")
+    rect = [0.06, 0.5, 0.88, max(0.05, y - 0.52)]
     if rows:
-        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(7)
+        pdf_table(fig, rect, header, rows, 7)
+    else:
+        fig.add_axes(rect).axis("off")
     if result.fit_sensitivity:
         header, rows = fitting.report_rows(result.fit_sensitivity)
-        ax = fig.add_axes([0.06, 0.05, 0.88, 0.4])
-        ax.axis("off")
-        ax.set_title("Fit sensitivity", fontsize=11, loc="left")
-        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(6.5)
+        pdf_table(fig, [0.06, 0.05, 0.88, 0.4], header, rows, 6.5, title="Fit sensitivity")
     return fig
