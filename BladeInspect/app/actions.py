@@ -21,6 +21,7 @@ from ..core.errors import InputError
 from ..core.pointio import read_points
 from ..inspection import fitting
 from ..inspection import pipeline
+from ..inspection.judging import fit_and_judge
 from ..inspection.sections import section_table
 from . import objects, settings
 
@@ -97,14 +98,8 @@ def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
 def judge_fits(result, nominal, choice, tolerance):
     """Move ``result`` to the chosen fit's pose and record result.fit and result.fit_sensitivity,
     as the `report` command does before it writes (inspection.report.write_result_report)."""
-    from ..inspection import verdict as verdict_mod
-    runs = fitting.apply(result, nominal, choice, tolerance, all_objectives=True)
-    table = section_table(result, nominal)
-    judge_options = {"measurement_model": None}
-    verdict_mod.judge(result, table, tolerance=tolerance, decision_rule=choice.decision_rule,
-                      **judge_options)
-    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, choice,
-                                                 judge_options)
+    fit_and_judge(result, nominal, choice, tolerance,
+                  lambda fitted: section_table(fitted, nominal))
     return result
 
 

@@ -36,15 +36,15 @@ def add_properties(obj, add):
             setattr(obj, prop, list(choices))
     for prop, _, tip in TEXT_INPUTS:
         add(obj, "App::PropertyString", prop, GROUP, tip)
-    add(obj, "App::PropertyString", "WeightsUsed", GROUP,
-        "The weights the fine ICP used and why (result.json's weights)", read_only=True)
-    add(obj, "App::PropertyString", "WeightsJson", GROUP,
-        "The weights' record, as result.json's weights", hidden=True)
-    add(obj, "App::PropertyString", "FitJson", GROUP,
-        "The fit's record, as result.json's fit", hidden=True)
-    add(obj, "App::PropertyString", "FitSensitivityJson", GROUP,
-        "Each judged value and the verdict under each fit objective (fit_sensitivity)",
-        hidden=True)
+    # What the registration produced: shown but not editable, or kept for the report only.
+    for prop, tip, mode in (
+            ("WeightsUsed", "The weights the fine ICP used and why (result.json's weights)",
+             "read_only"),
+            ("WeightsJson", "The weights' record, as result.json's weights", "hidden"),
+            ("FitJson", "The fit's record, as result.json's fit", "hidden"),
+            ("FitSensitivityJson", "Each judged value and the verdict under each fit "
+             "objective (fit_sensitivity)", "hidden")):
+        add(obj, "App::PropertyString", prop, GROUP, tip, **{mode: True})
 
 
 def choice_of(obj):

@@ -26,6 +26,7 @@ from . import airfoil_report
 from . import pipeline
 from . import sections as sections_mod
 from . import fit_report
+from . import judging
 from . import verdict as verdict_mod
 from .checks import check_out_dir
 from .report_table import pdf_table
@@ -595,15 +596,11 @@ def write_result_report(result, nominal, out_dir, cmm_data=None,
     tolerance = contracts.profile_tolerance(tolerance)
     t0 = time.perf_counter()
     progress(0.82, "section table")
-    from . import fitting   # hook: issue 16, the fit, its sensitivity and the decision
-    fit_choice = fit_choice or fitting.FitChoice()
-    runs = fitting.apply(result, nominal, fit_choice, tolerance, all_objectives=True)
-    table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
-    judge_options = {"measurement_model": measurement_model}
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance,
-                                decision_rule=fit_choice.decision_rule, **judge_options)
-    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, fit_choice,
-                                                 judge_options)
+    table, verdict = judging.fit_and_judge(   # hook: issue 16, the fit and the decision
+        result, nominal, fit_choice, tolerance,
+        lambda fitted: sections_mod.section_table(fitted, nominal, heights_pct=heights_pct,
+                                                  cmm=cmm_data),
+        measurement_model=measurement_model)
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0
