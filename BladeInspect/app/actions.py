@@ -185,12 +185,17 @@ def inspection_rig(nominal_obj, seed, rig_file=None):
         rig.close()
 
 
-def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None, **fit):
+def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None, airfoil=True,
+            **fit):
     """run_inspect on the nominal named ``nominal`` (the `inspect` command's pipeline), the
-    fit ``fit`` chooses; the points, registration, deviation map and section profiles added.
-    Returns run_inspect's summary with the new objects under "objects"."""
+    fit ``fit`` chooses, with the airfoil characteristics unless ``airfoil`` is False (as the
+    command's default and its --no-airfoil); the points, registration, deviation map, section
+    profiles and airfoil objects added. Returns run_inspect's summary with the new objects
+    under "objects"."""
+    from ..inspection import airfoil as airfoil_mod
     from ..inspection.closed_loop import run_inspect
-    from . import loop
+    from . import airfoil_objects, loop
+    airfoil_options = airfoil_mod.options_from_args() if airfoil else None
     doc = _document(doc_name)
     nominal_obj = _object(doc, nominal, "nominal")
     choice = fit_choice(**fit)
@@ -202,7 +207,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
             getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
             section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
             progress=p, rig=rig, nominal=objects.nominal_of(nominal_obj), document=False,
-            on_plan=_INTERACTIVE["on_plan"], fit_choice=choice)
+            on_plan=_INTERACTIVE["on_plan"], fit_choice=choice, airfoil=airfoil_options)
         result = summary["result"]
         p(0.95, "adding the inspection to the document")
         points_csv = os.path.join(out_dir, "points.csv")
@@ -219,8 +224,12 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
         loop.mark_inspection(registration, heights, n_blind, out_dir)
         deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
         profiles = objects.make_section_profiles(doc, summary["sections"], registration)
+        stage = getattr(summary["sections"], "airfoil", None)
+        analysis = None if stage is None else airfoil_objects.make_airfoil_objects(
+            doc, stage, registration, airfoil_options)
     summary["objects"] = {"measurement": measurement, "registration": registration,
-                          "deviation_map": deviation_map, "profiles": profiles}
+                          "deviation_map": deviation_map, "profiles": profiles,
+                          "airfoil": analysis}
     return summary
 
 

@@ -79,10 +79,21 @@ def _hide_measured_frame(measurement):
 
 
 def _show_table(title, table, note, sensitivity=None):
+    """Table 2 in a panel; when the airfoil stage ran on the table, a button to its
+    characteristics (the Airfoil command's panel)."""
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
-    taskpanels.show_panel(taskpanels.TablePanel(
-        title, header, rows, "; ".join(n for n in notes if n), sensitivity))
+    panel = taskpanels.TablePanel(title, header, rows, "; ".join(n for n in notes if n),
+                                  sensitivity)
+    stage = getattr(table, "airfoil", None)
+    if stage is not None:
+        analysis = stage.extras()
+        panel.airfoil_button = QtGui.QPushButton(
+            translate("BladeInspect", "Airfoil characteristics..."))
+        panel.airfoil_button.clicked.connect(
+            lambda: taskpanels.show_panel(taskpanels.AirfoilPanel(analysis)))
+        panel.form.layout().addWidget(panel.airfoil_button)
+    return taskpanels.show_panel(panel)
 
 
 # ---------------------------------------------------------------- task panels
@@ -112,6 +123,12 @@ class InspectPanel(taskpanels.FormPanel):
             QtGui.QLineEdit(LAST_RIG_FILE[0] or ""),
             QT_TRANSLATE_NOOP("BladeInspect",
                               "RIG.json from Calibrate; empty: the nominal kinematics"))
+        self.airfoil = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Airfoil characteristics"), QtGui.QCheckBox(),
+            QT_TRANSLATE_NOOP("BladeInspect", "Chord, stagger, thickness, edge radii, angles, "
+                              "shift and twist per section, judged in the verdict (the "
+                              "inspect command's default; off: --no-airfoil)"))
+        self.airfoil.setChecked(True)
         self.fit = taskpanels.FitSelector()
         self.layout.addRow(self.fit)
         self.layout.addRow(QtGui.QLabel(translate("BladeInspect", "Rig: %s") % (
@@ -119,7 +136,8 @@ class InspectPanel(taskpanels.FormPanel):
 
     def options(self):
         return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
-                     "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None},
+                     "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None,
+                     "airfoil": self.airfoil.isChecked()},
                     **self.fit.values())
 
     def accept(self):
@@ -253,18 +271,26 @@ class Inspect(commands._Command):
                 # The paths ran; drawn over the deviation map they would hide its colours.
                 drawn["plan"].ViewObject.Visibility = False
             summary["objects"]["plan"] = drawn["plan"]
+            analysis = summary["objects"].get("airfoil")
+            for obj in analysis.Group if analysis is not None else ():
+                if obj.ViewObject is not None:
+                    # Red camber lines over the deviation map would read as deviations; the
+                    # Model tree shows them on demand.
+                    obj.ViewObject.Visibility = False
             doc.recompute()
             commands.fit_view()
         return summary
 
     @staticmethod
     def show(summary):
-        note = (translate("BladeInspect", "%s. Pose uncertainty %.2f um after the planned scan "
-                          "(%.2f um after the blind scan). Files in %s")
+        note = (translate("BladeInspect", "%s. Pose uncertainty %.2f \u00b5m after the planned "
+                          "scan (%.2f \u00b5m after the blind scan); ICP weights: %s. Files in %s")
                 % (summary["verdict"]["summary"], 1e3 * summary["pose_uncertainty_mm"],
-                   1e3 * summary["uncertainty_after_blind_mm"], summary["out_dir"]))
-        _show_table(translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
-                    summary["sections"], note, summary["result"].fit_sensitivity)
+                   1e3 * summary["uncertainty_after_blind_mm"],
+                   summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
+        return _show_table(
+            translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
+            summary["sections"], note, summary["result"].fit_sensitivity)
 
 
 class Calibrate(commands._Command):

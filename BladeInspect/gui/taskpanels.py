@@ -293,6 +293,13 @@ def registration_html(obj):
     return html
 
 
+# Rows of the fit-sensitivity table shown without scrolling (the demo's sections, part and
+# airfoil rows run to about twenty).
+SENSITIVITY_ROWS_SHOWN = 12
+# Rows of a section table shown without scrolling (Table 2 of the usual five to nine sections).
+TABLE_ROWS_SHOWN = 9
+
+
 def table_widget(header, rows):
     table = QtGui.QTableWidget(len(rows), len(header))
     table.setHorizontalHeaderLabels([translate("BladeInspect", h) for h in header])
@@ -303,13 +310,26 @@ def table_widget(header, rows):
     return table
 
 
+def fit_rows_height(table, max_rows):
+    """Make ``table`` tall enough for its header and up to ``max_rows`` rows (a scroll bar
+    beyond), so a short table shows whole in a task panel instead of scrolling in a strip."""
+    rows = min(table.rowCount(), max_rows)
+    # Room for a horizontal scroll bar too: whether the panel is wide enough is known only
+    # once it is shown.
+    table.setMinimumHeight(table.horizontalHeader().sizeHint().height()
+                           + sum(table.rowHeight(r) for r in range(rows))
+                           + 2 * table.frameWidth()
+                           + table.horizontalScrollBar().sizeHint().height())
+
+
 def sensitivity_widget(sensitivity):
-    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change."""
+    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change; an
+    objective's unit and verdict below its name, so that the columns fit a task panel."""
     box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
     layout = QtGui.QVBoxLayout(box)
     header, rows = fitting.report_rows(sensitivity)
-    table = table_widget(header, rows)
-    table.setMinimumHeight(200)
+    table = table_widget([h.replace(" (", "\n(", 1) for h in header], rows)
+    fit_rows_height(table, SENSITIVITY_ROWS_SHOWN)
     layout.addWidget(table)
     largest = sensitivity.get("largest_change")
     if largest:
@@ -366,7 +386,7 @@ class TablePanel(_ResultPanel):
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
         self.table = table_widget(header, rows)
-        self.table.setMinimumHeight(260)
+        fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
         if note:
             label = QtGui.QLabel(note)

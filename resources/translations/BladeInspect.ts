@@ -5,7 +5,7 @@
     <name>BladeInspect</name>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <source>%s. Pose uncertainty %.2f um after the planned scan (%.2f um after the blind scan). Files in %s</source>
+        <source>%s. Pose uncertainty %.2f µm after the planned scan (%.2f µm after the blind scan); ICP weights: %s. Files in %s</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -45,8 +45,14 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Airfoil characteristics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Airfoil characteristics...</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -138,6 +144,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Chord, stagger, thickness, edge radii, angles, shift and twist per section, judged in the verdict (the inspect command's default; off: --no-airfoil)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
