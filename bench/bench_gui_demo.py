@@ -18,6 +18,9 @@ import tempfile
 import time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, REPO)
+
+from tests.helpers import run_freecad_gui  # noqa: E402
 
 
 def main():
@@ -30,18 +33,10 @@ def main():
         subprocess.run([os.path.join(REPO, "bladeinspect"), "demo", "--out",
                         os.path.join(tmp, "cli")], check=True, capture_output=True)
         cli_s = time.time() - t0
-        home = os.path.join(tmp, "home")
-        env = dict(os.environ, HOME=home, QTWEBENGINE_DISABLE_SANDBOX="1", BI_BENCH_OUT=tmp,
-                   FREECAD_USER_MOD=os.path.join(home, ".local", "share", "FreeCAD", "Mod"))
         if args.shots:
-            env.update(BI_DEMO_SHOTS="1", BI_REPO=REPO, BI_GUI_OUT=tmp)
-        for key in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
-            env.pop(key, None)
-        subprocess.run([os.path.join(REPO, "scripts", "install-workbench.sh")], env=env,
-                       check=True, capture_output=True)
-        subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
-                        os.path.join(REPO, "bench", "gui_demo_macro.py")], env=env, cwd=tmp,
-                       capture_output=True, timeout=600)
+            os.environ["BI_DEMO_SHOTS"] = "1"
+        # The GUI as the GUI tests start it: a private HOME with the workbench installed.
+        run_freecad_gui(os.path.join(REPO, "bench", "gui_demo_macro.py"), tmp, 600)
         with open(os.path.join(tmp, "gui_demo.json")) as fh:
             gui = json.load(fh)
         if "error" in gui:

@@ -1,8 +1,8 @@
 """Run by bench/bench_gui_demo.py inside the real FreeCAD GUI: the demo from the toolbar's
 functions (demo blade, then Inspect with the default sections) timed, written to
-$BI_BENCH_OUT/gui_demo.json. With $BI_DEMO_SHOTS set, after the timing it also opens what a
+$BI_GUI_OUT/gui_demo.json. With $BI_DEMO_SHOTS set, after the timing it also opens what a
 user looks at next (the Inspect panel, the inspection's tables, the registration, the
-deviation map, the report) and saves a screenshot of each into $BI_BENCH_OUT. Not a test
+deviation map, the report) and saves a screenshot of each into $BI_GUI_OUT. Not a test
 module."""
 import json
 import os
@@ -13,14 +13,14 @@ import traceback
 import FreeCAD
 import FreeCADGui as Gui
 
-OUT = os.environ["BI_BENCH_OUT"]
+OUT = os.environ["BI_GUI_OUT"]
 HEIGHTS = [10.0, 30.0, 50.0, 70.0, 90.0]
 result = {}
 
 
 def screenshots(summary, blade):
     """The demo's panels and views as a user sees them, for people to look at."""
-    sys.path.insert(0, os.environ["BI_REPO"])   # tests.gui_harness: $BI_GUI_OUT is OUT
+    sys.path.insert(0, os.environ["BI_REPO"])
     from tests.gui_harness import settle, start_workbench, view_shot, window_shot
     from BladeInspect.gui import commands, loop_commands
     start_workbench(640)

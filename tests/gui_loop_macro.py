@@ -249,11 +249,12 @@ def run():
         view_shot("loop_inspection_map")
         button = getattr(panel, "airfoil_button", None)
         if button is not None:
-            button.click()
+            button.click()   # replaces the panel: the button is gone after this
             settle(0.3)
         airfoil_panel = active_panel(taskpanels.AirfoilPanel)
         check("Table 2's button opens the airfoil characteristics",
-              airfoil_panel is not None and airfoil_panel.table.rowCount() > 0, button)
+              airfoil_panel is not None and airfoil_panel.table.rowCount() > 0,
+              "button" if button is not None else "no button")
         window_shot("loop_inspection_airfoil")
         Gui.Control.closeDialog()
 
