@@ -59,6 +59,33 @@ class FormPanel:
         return True
 
 
+# The demo blade's parameters (cad.demo_blade.BladeParams) as the panel names them, with
+# their units; a parameter not listed shows under its field name.
+DEMO_BLADE_LABELS = {
+    "span": (QT_TRANSLATE_NOOP("BladeInspect", "Span"), "mm"),
+    "chord_root": (QT_TRANSLATE_NOOP("BladeInspect", "Chord at the hub"), "mm"),
+    "chord_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Chord at the tip"), "mm"),
+    "thickness_root": (QT_TRANSLATE_NOOP("BladeInspect", "Thickness / chord at the hub"), ""),
+    "thickness_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Thickness / chord at the tip"), ""),
+    "thickness_position": (QT_TRANSLATE_NOOP("BladeInspect",
+                                             "Thickest point / chord"), ""),
+    "camber_root": (QT_TRANSLATE_NOOP("BladeInspect", "Camber / chord at the hub"), ""),
+    "camber_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Camber / chord at the tip"), ""),
+    "camber_position": (QT_TRANSLATE_NOOP("BladeInspect", "Most cambered point / chord"), ""),
+    "stagger_root_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Stagger at the hub"), "\u00b0"),
+    "twist_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Twist, hub to tip"), "\u00b0"),
+    "twist_exponent": (QT_TRANSLATE_NOOP("BladeInspect", "Twist exponent"), ""),
+    "sweep": (QT_TRANSLATE_NOOP("BladeInspect", "Sweep of the tip (+X)"), "mm"),
+    "lean": (QT_TRANSLATE_NOOP("BladeInspect", "Lean of the tip (+Y)"), "mm"),
+    "le_radius_root": (QT_TRANSLATE_NOOP("BladeInspect", "LE radius at the hub"), "mm"),
+    "le_radius_tip": (QT_TRANSLATE_NOOP("BladeInspect", "LE radius at the tip"), "mm"),
+    "te_radius_root": (QT_TRANSLATE_NOOP("BladeInspect", "TE radius at the hub"), "mm"),
+    "te_radius_tip": (QT_TRANSLATE_NOOP("BladeInspect", "TE radius at the tip"), "mm"),
+    "n_sections": (QT_TRANSLATE_NOOP("BladeInspect", "Sections lofted"), ""),
+    "n_profile": (QT_TRANSLATE_NOOP("BladeInspect", "Points per side and section"), ""),
+}
+
+
 class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Demo blade")
@@ -73,9 +100,11 @@ class DemoBladePanel(FormPanel):
             value = getattr(defaults, field.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 continue
-            box = spin_box(value, -1e4, 1e4)
+            label, unit = DEMO_BLADE_LABELS.get(field.name,
+                                                (field.name.replace("_", " "), ""))
+            box = spin_box(value, -1e4, 1e4, suffix=unit)
             self.boxes[field.name] = box
-            self.add_row(field.name.replace("_", " "), box)
+            self.add_row(label, box)
 
     def params(self):
         return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())

@@ -132,6 +132,16 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Camber / chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Camber / chord at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>Cancel</source>
         <translation type="unfinished"></translation>
@@ -144,6 +154,16 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord at the tip</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -240,12 +260,27 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>LE radius at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>LE radius at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Largest change: %s, %.4f mm; the verdict %s with the fit.</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Lean and bow: largest bow at section %s.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Lean of the tip (+Y)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -266,6 +301,11 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Measurement error</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Most cambered point / chord</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -296,6 +336,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Point spacing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Points per side and section</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -406,6 +451,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sections lofted</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Seed</source>
@@ -437,8 +487,18 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Span</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Sphere diameter</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Stagger at the hub</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -457,6 +517,21 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sweep of the tip (+X)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>TE radius at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>TE radius at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
         <translation type="unfinished"></translation>
@@ -467,6 +542,21 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickest point / chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickness / chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickness / chord at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tilt from +Y: %.4f deg about Z, %.4f deg about X. Sphere measured %.4f mm (nominal %.4f); circle residual RMS %.4f mm.</source>
         <translation type="unfinished"></translation>
@@ -474,6 +564,16 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Twist exponent</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Twist, hub to tip</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
