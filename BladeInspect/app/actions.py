@@ -126,6 +126,56 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
                                      fit_choice=choice)
 
 
+def reconstruct(doc_name, measurement):
+    """Cubic B-spline section curves of the Measurement named ``measurement`` lofted into
+    surfaces (cad.loft.reconstruct), added as its Reconstruction."""
+    from ..cad.loft import reconstruct as loft_reconstruct
+    doc = _document(doc_name)
+    measurement_obj = _object(doc, measurement, "measurement")
+    p = _progress()
+    p(0.1, "fitting section curves")
+    recon = loft_reconstruct(objects.pointset_of(measurement_obj))
+    if recon is None:
+        raise InputError("%s: no section and angle_deg columns, so no section curves to fit "
+                         "(a scan's points have them)" % measurement_obj.Label)
+    p(0.9, "storing %d curves, %d surfaces" % (len(recon.curves), len(recon.surfaces)))
+    return objects.make_reconstruction(doc, measurement_obj, recon)
+
+
+def simulate(doc_name, seed=0, nominal=None, **options):
+    """The simulation test bed (inspection.simulate.run_simulation, the `simulate` command's)
+    on the nominal named ``nominal``, else on a new demo blade; adds the simulated measurement,
+    its registration (with the pose error against the simulator's truth) and deviation map.
+    Returns (report, registration, deviation map)."""
+    from ..inspection.simulate import run_simulation
+    doc = _document(doc_name)
+    p = _progress()
+    with objects.building(doc, "Simulation test bed"):
+        if nominal is None:
+            p(0.0, "building the demo blade")
+            nominal_obj = objects.make_demo_blade(doc)
+            doc.recompute()
+        else:
+            nominal_obj = _object(doc, nominal, "nominal")
+        result, report, pointset = run_simulation(
+            objects.nominal_of(nominal_obj), seed=seed, progress=p, **options)
+        result.cad_source = nominal_obj.Label
+        measurement = objects.make_measurement(doc, pointset, name="SimulatedScan")
+        registration = objects.make_registration(doc, result, measurement, nominal_obj,
+                                                 seed, name="SimulatedRegistration")
+        for prop, tip, value in (
+                ("PoseErrorMm", "Pose error against the simulator's truth (largest "
+                 "bounding-box corner displacement), mm", report["pose_error_mm"]),
+                ("PoseErrorOverBound", "Pose error / its Cramer-Rao bound",
+                 report["pose_error_over_bound"])):
+            registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
+            setattr(registration, prop, value)
+            # The simulator's truth, not an input.
+            registration.setEditorMode(prop, ["ReadOnly"])
+        deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
+    return report, registration, deviation_map
+
+
 def _registered_sections(reg, p):
     """(Nominal, RegistrationResult, section table) of a Registration, as stored."""
     nominal = objects.nominal_of(reg.Nominal)

@@ -2,8 +2,9 @@
 to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
 function as the command line (run_inspect, run_calibration, section_table, run_simulation)
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
-or a cancel leaves the document as it was. Inspect runs as a console line
-(app.actions.inspect through commands.run_action), which a recorded macro replays."""
+or a cancel leaves the document as it was. Inspect and the simulation test bed run as console
+lines (app.actions.inspect and app.actions.simulate through commands.run_action), which a
+recorded macro replays."""
 import contextlib
 import os
 import shutil
@@ -18,7 +19,6 @@ from ..app import actions, loop, objects, settings
 from ..core import contracts
 from ..core.errors import InputError
 from ..inspection.report import section_rows
-from ..inspection.simulate import run_simulation
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from . import commands, progress, taskpanels
 from .i18n import QT_TRANSLATE_NOOP, translate
@@ -391,41 +391,19 @@ class Simulate(commands._Command):
         return self.simulate(**options)
 
     def simulate(self, seed=0, **options):
-        """run_simulation on the document's nominal, else a new demo blade; adds the simulated
-        measurement, its registration and deviation map. Returns (report, registration)."""
+        """app.actions.simulate on the document's nominal, else a new demo blade; adds the
+        simulated measurement, its registration and deviation map. Returns (report,
+        registration)."""
         doc = commands.active_document()
         title = translate("BladeInspect", "Simulation test bed")
-
-        def job(p):
-            with objects.building(doc, "Simulation test bed"):
-                nominal_obj = commands.find_nominal()
-                if nominal_obj is None:
-                    p(0.0, translate("BladeInspect", "building the demo blade"))
-                    nominal_obj = objects.make_demo_blade(doc)
-                    doc.recompute()
-                result, report, pointset = run_simulation(
-                    objects.nominal_of(nominal_obj), seed=seed, progress=p, **options)
-                result.cad_source = nominal_obj.Label
-                measurement = objects.make_measurement(doc, pointset, name="SimulatedScan")
-                registration = objects.make_registration(doc, result, measurement, nominal_obj,
-                                                         seed, name="SimulatedRegistration")
-                for prop, tip, value in (
-                        ("PoseErrorMm", "Pose error against the simulator's truth (largest "
-                         "bounding-box corner displacement), mm", report["pose_error_mm"]),
-                        ("PoseErrorOverBound", "Pose error / its Cramer-Rao bound",
-                         report["pose_error_over_bound"])):
-                    registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
-                    setattr(registration, prop, value)
-                    # The simulator's truth, not an input.
-                    registration.setEditorMode(prop, ["ReadOnly"])
-                deviation_map = objects.make_deviation_map(doc, registration,
-                                                           settings.colour_limit())
-            _hide_measured_frame(measurement)
-            return report, registration, deviation_map
-        outcome = progress.run(title, job)
+        nominal_obj = commands.find_nominal()
+        outcome = commands.run_action(title, "simulate", doc.Name, int(seed),
+                                      nominal=nominal_obj.Name if nominal_obj else None,
+                                      **options)
         if outcome is None:
             return None
         report, registration, _ = outcome
+        _hide_measured_frame(registration.Measurement)
         doc.recompute()
         commands.fit_view()
         show_result(title, simulation_text(report))

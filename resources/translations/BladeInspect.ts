@@ -602,11 +602,6 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <source>building the demo blade</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>changes</source>
         <translation type="unfinished"></translation>
@@ -624,11 +619,6 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>does not change</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/commands.py"/>
-        <source>fitting section curves</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -689,11 +679,6 @@
     <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>starting</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/commands.py"/>
-        <source>storing %d curves, %d surfaces</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
