@@ -530,7 +530,7 @@ class Registration(_Proxy):
             return
         nominal = nominal_of(obj.Nominal)
         result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed,
-                                   weights=registration_fit.choice_of(obj).weights)  # issue 16
+                                   **registration_fit.register_options(obj))  # issue 16
         registration_fit.refit(obj, result, nominal)   # hook: issue 16
         store_registration(obj, result)
         obj.InputSignature = signature

@@ -66,6 +66,13 @@ def set_choice(obj, choice):
     obj.Weights = choice.weights or DEFAULT_WEIGHTS
 
 
+def register_options(obj):
+    """pipeline.register's keywords for the object's choice: the weights when chosen, none
+    for the default (the call of a Registration made before weights could be chosen)."""
+    weights = choice_of(obj).weights
+    return {} if weights is None else {"weights": weights}
+
+
 def signature_part(obj):
     """() for the default choice (the signature older documents stored), else the choice;
     the weights only when chosen, so a document stored before they were keeps its signature."""
