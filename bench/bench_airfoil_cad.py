@@ -23,22 +23,16 @@ import Part  # noqa: E402
 
 from BladeInspect.cad.airfoil_sections import airfoil_section  # noqa: E402
 from BladeInspect.core import airfoil  # noqa: E402
-from BladeInspect.inspection.pipeline import load_nominal  # noqa: E402
-from BladeInspect.inspection.sections import span_axis_of  # noqa: E402
-from tests.helpers import ROTOR67_SECTIONS, have_rotor67  # noqa: E402
+from bench.airfoil_planes import cad_planes, each_blade  # noqa: E402
 
 HEIGHTS_PCT = (10, 30, 50, 70, 90)
 
 
 def blade(name, path):
-    nominal = load_nominal(path)
-    span, (lo, hi) = span_axis_of(nominal)
-    bb = nominal.shape.BoundBox
-    centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
+    nominal, span, planes = cad_planes(path, HEIGHTS_PCT)
     print("%s: span axis %s, engine axis +X" % (name, np.round(span, 4).tolist()))
     cut_cpu = kernel_cpu = 0.0
-    for pct in HEIGHTS_PCT:
-        origin = centre + ((lo + pct / 100.0 * (hi - lo)) - centre @ span) * span
+    for pct, origin in planes:
         t0 = time.process_time()
         xy, frame = airfoil_section(nominal.shape, origin, span)
         cut_cpu += time.process_time() - t0
@@ -68,9 +62,7 @@ def blade(name, path):
 
 
 def main():
-    blade("demo blade", None)
-    if have_rotor67():
-        blade("NASA Rotor 67", ROTOR67_SECTIONS)
+    each_blade(blade)
 
 
 if __name__ == "__main__":

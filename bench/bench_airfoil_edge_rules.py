@@ -20,9 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import FreeCAD  # noqa: E402,F401
 from BladeInspect.cad.airfoil_sections import airfoil_section  # noqa: E402
 from BladeInspect.core import airfoil  # noqa: E402
-from BladeInspect.inspection.pipeline import load_nominal  # noqa: E402
-from BladeInspect.inspection.sections import span_axis_of  # noqa: E402
-from tests.helpers import ROTOR67_SECTIONS, have_rotor67  # noqa: E402
+from bench.airfoil_planes import cad_planes, each_blade  # noqa: E402
 
 HEIGHTS_PCT = (10, 50, 90)
 SPACINGS = (0.01, 0.02)
@@ -31,13 +29,9 @@ UPSTREAM = (-1.0, 0.0)
 
 
 def blade(name, path):
-    nominal = load_nominal(path)
-    span, (lo, hi) = span_axis_of(nominal)
-    bb = nominal.shape.BoundBox
-    centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
+    nominal, span, planes = cad_planes(path, HEIGHTS_PCT)
     print(name)
-    for pct in HEIGHTS_PCT:
-        origin = centre + ((lo + pct / 100.0 * (hi - lo)) - centre @ span) * span
+    for pct, origin in planes:
         cuts = {h: airfoil_section(nominal.shape, origin, span, spacing=h)[0] for h in SPACINGS}
         xy = cuts[0.02]
         default = airfoil.characteristics(xy)
@@ -62,9 +56,7 @@ def blade(name, path):
 
 
 def main():
-    blade("demo blade", None)
-    if have_rotor67():
-        blade("NASA Rotor 67", ROTOR67_SECTIONS)
+    each_blade(blade)
 
 
 if __name__ == "__main__":

@@ -228,11 +228,34 @@ def run():
         check("Table 2 shown with one row per section",
               panel is not None and panel.table.rowCount() == len(HEIGHTS),
               panel and panel.table.rowCount())
+        # The airfoil characteristics are the inspect command's default: result.json holds a
+        # block per section, the document an Airfoil group with the same blocks, and Table 2's
+        # panel opens them.
+        from BladeInspect.app import airfoil_objects
+        with open(os.path.join(reg.InspectionFolder, "result.json")) as fh:
+            written = json.load(fh)
+        group = airfoil_objects.find_analysis(doc)
+        check("inspect adds the airfoil characteristics, as the command does",
+              len(written.get("airfoil", [])) == len(HEIGHTS) and group is not None
+              and airfoil_objects.analysis_of(group)["airfoil"] == written["airfoil"],
+              [b.get("label") for b in written.get("airfoil", [])])
+        check("the note names the ICP weights result.json records",
+              panel is not None and "ICP weights: %s," % written["weights"]["model"]
+              in panel.form.findChildren(QtGui.QLabel)[0].text(), written.get("weights"))
         for o in doc.Objects:
             if o.ViewObject is not None:
                 o.ViewObject.Visibility = o == dmap[0]
         window_shot("loop_inspection_table")
         view_shot("loop_inspection_map")
+        button = getattr(panel, "airfoil_button", None)
+        if button is not None:
+            button.click()   # replaces the panel: the button is gone after this
+            settle(0.3)
+        airfoil_panel = active_panel(taskpanels.AirfoilPanel)
+        check("Table 2's button opens the airfoil characteristics",
+              airfoil_panel is not None and airfoil_panel.table.rowCount() > 0,
+              "button" if button is not None else "no button")
+        window_shot("loop_inspection_airfoil")
         Gui.Control.closeDialog()
 
     @step("inspect cancelled once its paths are drawn leaves the document as it was")

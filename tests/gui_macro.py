@@ -135,6 +135,11 @@ def run():
         register_panel = active_panel(taskpanels.RegisterPanel)
         check("register opens its panel with the fit selector", register_panel is not None
               and register_panel.fit.objective.currentText() == "least-squares")
+        check("the fit selector offers the ICP weights, the default first",
+              register_panel is not None and
+              [register_panel.fit.icp_weights.itemText(k) for k in
+               range(register_panel.fit.icp_weights.count())] == ["default", "snr", "sensor"]
+              and register_panel.fit.values()["weights"] is None)
         window_shot("task_panel_register")
         register_panel.accept()
         regs = objects.find_objects(doc, "BladeInspect::Registration")
@@ -200,6 +205,15 @@ def run():
                 T = np.array(json.load(fh)["measured_to_cad"])
             check("report's pose is the document's", tf.corner_displacement(
                 T, objects.matrix_array(reg.MeasuredToCad), nominal.bbox_corners) < 1e-4)
+            from BladeInspect.app import registration_fit
+            with open(os.path.join(out, "result.json")) as fh:
+                weights = json.load(fh).get("weights")
+            with open(os.path.join(out, "report.html"), encoding="utf-8") as fh:
+                html = fh.read()
+            # Points without angle_deg have no beam: the paper's SNR weights, by default.
+            check("report names the ICP weights the registration used",
+                  weights == registration_fit.weights_record(reg) and weights["model"] == "snr"
+                  and "ICP weights: snr" in html, weights)
             doc_path = os.path.join(out, "inspection.FCStd")
             check("report's document written", os.path.exists(doc_path))
             saved = FreeCAD.openDocument(doc_path, hidden=True)
@@ -258,6 +272,9 @@ def run():
               "pose error %.4f mm, stated 1 sigma %.4f mm" % (error, reg.PoseUncertaintyMm))
         check("registration uncertainty stated", 0 < reg.PoseUncertaintyMm < 0.05,
               reg.PoseUncertaintyMm)
+        # The rig's readings carry angle_deg: their beam is known, so the sensor weights.
+        check("scan registered with the sensor model's weights",
+              reg.WeightsUsed.startswith("sensor,"), reg.WeightsUsed)
         commands.Register.show(reg)
         window_shot("task_panel_registration_scan")
         Gui.Control.closeDialog()

@@ -21,6 +21,7 @@ from ..core.errors import InputError
 from ..core.pointio import read_points
 from ..inspection import fitting
 from ..inspection import pipeline
+from ..inspection.judging import fit_and_judge
 from ..inspection.sections import section_table
 from . import objects, settings
 
@@ -85,24 +86,20 @@ def _registration(doc_name, name):
 
 
 def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
-               decision_rule="iso14253", datum_faces=None):
-    """The FitChoice of the GUI's fit selector (the same checks as the command line's)."""
+               decision_rule="iso14253", datum_faces=None, weights=None):
+    """The FitChoice of the GUI's fit selector (the same checks as the command line's);
+    ``weights``: the fine ICP's, as --weights (None: inspection.weighting's default)."""
     return fitting.FitChoice(objective=fit, free=free or None,
                              weights_by_zone=weights_by_zone or None,
-                             decision_rule=decision_rule, datum_faces=datum_faces or None)
+                             decision_rule=decision_rule, datum_faces=datum_faces or None,
+                             weights=weights or None)
 
 
 def judge_fits(result, nominal, choice, tolerance):
     """Move ``result`` to the chosen fit's pose and record result.fit and result.fit_sensitivity,
     as the `report` command does before it writes (inspection.report.write_result_report)."""
-    from ..inspection import verdict as verdict_mod
-    runs = fitting.apply(result, nominal, choice, tolerance, all_objectives=True)
-    table = section_table(result, nominal)
-    judge_options = {"measurement_model": None}
-    verdict_mod.judge(result, table, tolerance=tolerance, decision_rule=choice.decision_rule,
-                      **judge_options)
-    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, choice,
-                                                 judge_options)
+    fit_and_judge(result, nominal, choice, tolerance,
+                  lambda fitted: section_table(fitted, nominal))
     return result
 
 
@@ -121,12 +118,62 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
     p(0.0, "sampling the nominal")
     model = objects.nominal_of(nominal_obj)
     result = pipeline.register(model, objects.pointset_of(measurement_obj), seed=seed,
-                               progress=lambda f, m: p(0.85 * f, m))
+                               progress=lambda f, m: p(0.85 * f, m), weights=choice.weights)
     result.cad_source = nominal_obj.Label
     p(0.9, "fit: %s, and its sensitivity" % choice.objective)
     judge_fits(result, model, choice, tolerance)
     return objects.make_registration(doc, result, measurement_obj, nominal_obj, seed,
                                      fit_choice=choice)
+
+
+def reconstruct(doc_name, measurement):
+    """Cubic B-spline section curves of the Measurement named ``measurement`` lofted into
+    surfaces (cad.loft.reconstruct), added as its Reconstruction."""
+    from ..cad.loft import reconstruct as loft_reconstruct
+    doc = _document(doc_name)
+    measurement_obj = _object(doc, measurement, "measurement")
+    p = _progress()
+    p(0.1, "fitting section curves")
+    recon = loft_reconstruct(objects.pointset_of(measurement_obj))
+    if recon is None:
+        raise InputError("%s: no section and angle_deg columns, so no section curves to fit "
+                         "(a scan's points have them)" % measurement_obj.Label)
+    p(0.9, "storing %d curves, %d surfaces" % (len(recon.curves), len(recon.surfaces)))
+    return objects.make_reconstruction(doc, measurement_obj, recon)
+
+
+def simulate(doc_name, seed=0, nominal=None, **options):
+    """The simulation test bed (inspection.simulate.run_simulation, the `simulate` command's)
+    on the nominal named ``nominal``, else on a new demo blade; adds the simulated measurement,
+    its registration (with the pose error against the simulator's truth) and deviation map.
+    Returns (report, registration, deviation map)."""
+    from ..inspection.simulate import run_simulation
+    doc = _document(doc_name)
+    p = _progress()
+    with objects.building(doc, "Simulation test bed"):
+        if nominal is None:
+            p(0.0, "building the demo blade")
+            nominal_obj = objects.make_demo_blade(doc)
+            doc.recompute()
+        else:
+            nominal_obj = _object(doc, nominal, "nominal")
+        result, report, pointset = run_simulation(
+            objects.nominal_of(nominal_obj), seed=seed, progress=p, **options)
+        result.cad_source = nominal_obj.Label
+        measurement = objects.make_measurement(doc, pointset, name="SimulatedScan")
+        registration = objects.make_registration(doc, result, measurement, nominal_obj,
+                                                 seed, name="SimulatedRegistration")
+        for prop, tip, value in (
+                ("PoseErrorMm", "Pose error against the simulator's truth (largest "
+                 "bounding-box corner displacement), mm", report["pose_error_mm"]),
+                ("PoseErrorOverBound", "Pose error / its Cramer-Rao bound",
+                 report["pose_error_over_bound"])):
+            registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
+            setattr(registration, prop, value)
+            # The simulator's truth, not an input.
+            registration.setEditorMode(prop, ["ReadOnly"])
+        deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
+    return report, registration, deviation_map
 
 
 def _registered_sections(reg, p):
@@ -188,12 +235,17 @@ def inspection_rig(nominal_obj, seed, rig_file=None):
         rig.close()
 
 
-def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None, **fit):
+def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None, airfoil=True,
+            **fit):
     """run_inspect on the nominal named ``nominal`` (the `inspect` command's pipeline), the
-    fit ``fit`` chooses; the points, registration, deviation map and section profiles added.
-    Returns run_inspect's summary with the new objects under "objects"."""
+    fit ``fit`` chooses, with the airfoil characteristics unless ``airfoil`` is False (as the
+    command's default and its --no-airfoil); the points, registration, deviation map, section
+    profiles and airfoil objects added. Returns run_inspect's summary with the new objects
+    under "objects"."""
+    from ..inspection import airfoil as airfoil_mod
     from ..inspection.closed_loop import run_inspect
-    from . import loop
+    from . import airfoil_objects, loop
+    airfoil_options = airfoil_mod.options_from_args() if airfoil else None
     doc = _document(doc_name)
     nominal_obj = _object(doc, nominal, "nominal")
     choice = fit_choice(**fit)
@@ -205,7 +257,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
             getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
             section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
             progress=p, rig=rig, nominal=objects.nominal_of(nominal_obj), document=False,
-            on_plan=_INTERACTIVE["on_plan"], fit_choice=choice)
+            on_plan=_INTERACTIVE["on_plan"], fit_choice=choice, airfoil=airfoil_options)
         result = summary["result"]
         p(0.95, "adding the inspection to the document")
         points_csv = os.path.join(out_dir, "points.csv")
@@ -222,8 +274,12 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
         loop.mark_inspection(registration, heights, n_blind, out_dir)
         deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
         profiles = objects.make_section_profiles(doc, summary["sections"], registration)
+        stage = getattr(summary["sections"], "airfoil", None)
+        analysis = None if stage is None else airfoil_objects.make_airfoil_objects(
+            doc, stage, registration, airfoil_options)
     summary["objects"] = {"measurement": measurement, "registration": registration,
-                          "deviation_map": deviation_map, "profiles": profiles}
+                          "deviation_map": deviation_map, "profiles": profiles,
+                          "airfoil": analysis}
     return summary
 
 

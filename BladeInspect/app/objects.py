@@ -529,7 +529,8 @@ class Registration(_Proxy):
         if not signature or signature == obj.InputSignature:
             return
         nominal = nominal_of(obj.Nominal)
-        result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed)
+        result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed,
+                                   **registration_fit.register_options(obj))  # issue 16
         registration_fit.refit(obj, result, nominal)   # hook: issue 16
         store_registration(obj, result)
         obj.InputSignature = signature
@@ -654,7 +655,7 @@ def registration_result(obj, nominal):
     snr = None
     if obj.Measurement is not None and len(obj.Measurement.SNR) == len(points):
         snr = np.asarray(obj.Measurement.SNR, dtype=float)
-    return RegistrationResult(
+    result = RegistrationResult(
         measured_to_cad=matrix_array(obj.MeasuredToCad), points_cad=points,
         deviation=deviation, inlier=inlier, closest=dist.closest, normal=dist.normal,
         face=dist.face, snr=snr, columns=columns, n_rows_skipped=0, rms_mm=obj.RmsMm,
@@ -665,6 +666,8 @@ def registration_result(obj, nominal):
         coarse=json.loads(obj.CoarseJson or "{}"), warnings=list(obj.Warnings),
         source=obj.Measurement.SourceFile if obj.Measurement is not None else "",
         cad_source=obj.Nominal.Label if obj.Nominal is not None else "")
+    registration_fit.restore(obj, result)   # hook: issue 16, the weights used
+    return result
 
 
 def make_section_profiles(doc, table, registration=None, name="SectionProfiles"):

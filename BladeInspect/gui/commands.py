@@ -13,7 +13,6 @@ from PySide import QtCore, QtGui
 
 from ..app import actions, objects, registration_fit, settings
 from ..app.document import write_inspection_document
-from ..cad.loft import reconstruct
 from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
 from ..measurement.scan import open_rig
@@ -318,15 +317,10 @@ class Reconstruct(_Command):
         self.reconstruct(find_input((objects.Measurement.Type,)))
 
     def reconstruct(self, measurement):
+        """app.actions.reconstruct of the measurement."""
         doc = measurement.Document
-
-        def job(p):
-            p(0.1, translate("BladeInspect", "fitting section curves"))
-            recon = reconstruct(objects.pointset_of(measurement))
-            p(0.9, translate("BladeInspect", "storing %d curves, %d surfaces")
-              % (len(recon.curves), len(recon.surfaces)))
-            return objects.make_reconstruction(doc, measurement, recon)
-        obj = progress.run(translate("BladeInspect", "Reconstruct"), job)
+        obj = run_action(translate("BladeInspect", "Reconstruct"), "reconstruct", doc.Name,
+                         measurement.Name)
         if obj is not None:
             _recompute_gui(doc)
         return obj
@@ -453,8 +447,13 @@ class Report(_Command):
     def Activated(self):
         out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
-            summary = self.report(find_input((objects.Registration.Type,)), out_dir)
+            registration = find_input((objects.Registration.Type,))
+            summary = self.report(registration, out_dir)
             html = os.path.join(out_dir, "report.html")
+            if summary is not None:
+                FreeCAD.Console.PrintMessage(
+                    translate("BladeInspect", "BladeInspect: report in %s; ICP weights: %s")
+                    % (out_dir, registration.WeightsUsed or "-") + "\n")
             if summary is not None and os.path.exists(html):
                 open_in_browser(html)
 

@@ -10,6 +10,11 @@ from .i18n import translate
 BAR_X = (-0.975, -0.945)
 BAR_Y = (-0.75, 0.75)
 LABEL_WIDTH = 0.25
+# The labels are drawn in pixels while the backing is in view coordinates: at each render the
+# backing is widened to the text's width in this view, taken as this many font sizes a
+# character (FreeCAD's SoText2 font, measured generously) plus a margin in pixels.
+CHAR_EM = 0.7
+MARGIN_PX = 6
 
 
 def _skip_bounding_group():
@@ -28,6 +33,7 @@ def legend_node(values, colours, title=None, font_size=14):
         title = translate("BladeInspect", "Deviation [mm]")
     group = _skip_bounding_group()
     hud = coin.SoAnnotation()
+    hud.renderCaching = coin.SoSeparator.OFF   # the backing follows the viewport (fit)
     group.addChild(hud)
     camera = coin.SoOrthographicCamera()
     camera.viewportMapping = coin.SoCamera.LEAVE_ALONE
@@ -57,7 +63,18 @@ def legend_node(values, colours, title=None, font_size=14):
     n = len(values)
     x0, x1 = BAR_X
     ys = [BAR_Y[0] + (BAR_Y[1] - BAR_Y[0]) * i / (n - 1) for i in range(n)]
-    hud.addChild(_backing((x0 - 0.015, BAR_Y[0] - 0.06), (x1 + LABEL_WIDTH, BAR_Y[1] + 0.12)))
+    digits = 3 if max(abs(v) for v in values) < 1.0 else 2
+    labels = ["%+.*f" % (digits, v) if abs(v) > 1e-12 else "%.*f" % (digits, 0.0)
+              for v in values]
+    backing, corners = _backing((x0 - 0.015, BAR_Y[0] - 0.06),
+                                (x1 + LABEL_WIDTH, BAR_Y[1] + 0.12))
+    # Each text's start (view x) and length in characters: the backing must reach past both.
+    texts = [(x1 + 0.01, max(len(label) for label in labels)), (x0, len(title))]
+    group.fit_backing = _backing_fitter(corners, texts, font_size, x1 + LABEL_WIDTH)
+    fit = coin.SoCallback()
+    fit.setCallback(group.fit_backing)
+    hud.addChild(fit)
+    hud.addChild(backing)
     material = coin.SoMaterial()
     material.diffuseColor.setValues(0, 2 * n, [tuple(c) for c in colours for _ in (0, 1)])
     hud.addChild(material)
@@ -84,17 +101,41 @@ def legend_node(values, colours, title=None, font_size=14):
     font = coin.SoFont()
     font.size = font_size
     hud.addChild(font)
-    digits = 3 if max(abs(v) for v in values) < 1.0 else 2
-    for value, y in zip(values, ys):
-        label = "%+.*f" % (digits, value) if abs(value) > 1e-12 else "%.*f" % (digits, 0.0)
+    for label, y in zip(labels, ys):
         hud.addChild(_text((x1 + 0.01, y - 0.015, 0.0), label))
     hud.addChild(_text((x0, BAR_Y[1] + 0.06, 0.0), title))
     return group
 
 
+def _backing_fitter(corners, texts, font_size, least_right):
+    """A SoCallback function that moves the right edge of the backing ``corners`` (its
+    SoCoordinate3) past every text (start in view x, length in characters) in the viewport
+    being rendered, and never left of ``least_right``."""
+    def fit(_, action):
+        if not action.isOfType(coin.SoGLRenderAction.getClassTypeId()):
+            return
+        region = coin.SoViewportRegionElement.get(action.getState())
+        width_px = region.getViewportSizePixels().getValue()[0]
+        if width_px <= 0:
+            return
+        per_px = 2.0 / width_px     # the view spans 2 in x
+        right = max([least_right] + [x + (n * CHAR_EM * font_size + MARGIN_PX) * per_px
+                                     for x, n in texts])
+        points = [tuple(p.getValue()) for p in corners.point.getValues()]
+        if abs(points[1][0] - right) > 1e-9:
+            # Not a scene change for the viewer to redraw: this render draws it already.
+            corners.point.enableNotify(False)
+            for k in (1, 2):
+                corners.point.set1Value(k, (right, points[k][1], points[k][2]))
+            corners.point.enableNotify(True)
+    return fit
+
+
 def _backing(lower_left, upper_right):
-    """A pale panel behind the legend so its labels read on any background."""
+    """A pale panel behind the legend so its labels read on any background: (its separator,
+    its SoCoordinate3, corners lower-left, lower-right, upper-right, upper-left)."""
     sep = coin.SoSeparator()
+    sep.renderCaching = coin.SoSeparator.OFF   # its corners follow the viewport (fit)
     binding = coin.SoMaterialBinding()
     binding.value = coin.SoMaterialBinding.OVERALL   # not the host's per-point colours
     sep.addChild(binding)
@@ -109,7 +150,7 @@ def _backing(lower_left, upper_right):
     face = coin.SoFaceSet()
     face.numVertices.setValue(4)
     sep.addChild(face)
-    return sep
+    return sep, coords
 
 
 def _text(position, text):

@@ -2,8 +2,9 @@
 to an inspection's Table 2, and run the simulation test bed. Each calls the same pipeline
 function as the command line (run_inspect, run_calibration, section_table, run_simulation)
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
-or a cancel leaves the document as it was. Inspect runs as a console line
-(app.actions.inspect through commands.run_action), which a recorded macro replays."""
+or a cancel leaves the document as it was. Inspect and the simulation test bed run as console
+lines (app.actions.inspect and app.actions.simulate through commands.run_action), which a
+recorded macro replays."""
 import contextlib
 import os
 import shutil
@@ -18,7 +19,6 @@ from ..app import actions, loop, objects, settings
 from ..core import contracts
 from ..core.errors import InputError
 from ..inspection.report import section_rows
-from ..inspection.simulate import run_simulation
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from . import commands, progress, taskpanels
 from .i18n import QT_TRANSLATE_NOOP, translate
@@ -79,10 +79,21 @@ def _hide_measured_frame(measurement):
 
 
 def _show_table(title, table, note, sensitivity=None):
+    """Table 2 in a panel; when the airfoil stage ran on the table, a button to its
+    characteristics (the Airfoil command's panel)."""
     header, rows = section_rows(table)
     notes = [note] + list(table.warnings)
-    taskpanels.show_panel(taskpanels.TablePanel(
-        title, header, rows, "; ".join(n for n in notes if n), sensitivity))
+    panel = taskpanels.TablePanel(title, header, rows, "; ".join(n for n in notes if n),
+                                  sensitivity)
+    stage = getattr(table, "airfoil", None)
+    if stage is not None:
+        analysis = stage.extras()
+        panel.airfoil_button = QtGui.QPushButton(
+            translate("BladeInspect", "Airfoil characteristics..."))
+        panel.airfoil_button.clicked.connect(
+            lambda: taskpanels.show_panel(taskpanels.AirfoilPanel(analysis)))
+        panel.form.layout().addWidget(panel.airfoil_button)
+    return taskpanels.show_panel(panel)
 
 
 # ---------------------------------------------------------------- task panels
@@ -112,6 +123,12 @@ class InspectPanel(taskpanels.FormPanel):
             QtGui.QLineEdit(LAST_RIG_FILE[0] or ""),
             QT_TRANSLATE_NOOP("BladeInspect",
                               "RIG.json from Calibrate; empty: the nominal kinematics"))
+        self.airfoil = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Airfoil characteristics"), QtGui.QCheckBox(),
+            QT_TRANSLATE_NOOP("BladeInspect", "Chord, stagger, thickness, edge radii, angles, "
+                              "shift and twist per section, judged in the verdict (the "
+                              "inspect command's default; off: --no-airfoil)"))
+        self.airfoil.setChecked(True)
         self.fit = taskpanels.FitSelector()
         self.layout.addRow(self.fit)
         self.layout.addRow(QtGui.QLabel(translate("BladeInspect", "Rig: %s") % (
@@ -119,7 +136,8 @@ class InspectPanel(taskpanels.FormPanel):
 
     def options(self):
         return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
-                     "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None},
+                     "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None,
+                     "airfoil": self.airfoil.isChecked()},
                     **self.fit.values())
 
     def accept(self):
@@ -253,18 +271,26 @@ class Inspect(commands._Command):
                 # The paths ran; drawn over the deviation map they would hide its colours.
                 drawn["plan"].ViewObject.Visibility = False
             summary["objects"]["plan"] = drawn["plan"]
+            analysis = summary["objects"].get("airfoil")
+            for obj in analysis.Group if analysis is not None else ():
+                if obj.ViewObject is not None:
+                    # Red camber lines over the deviation map would read as deviations; the
+                    # Model tree shows them on demand.
+                    obj.ViewObject.Visibility = False
             doc.recompute()
             commands.fit_view()
         return summary
 
     @staticmethod
     def show(summary):
-        note = (translate("BladeInspect", "%s. Pose uncertainty %.2f um after the planned scan "
-                          "(%.2f um after the blind scan). Files in %s")
+        note = (translate("BladeInspect", "%s. Pose uncertainty %.2f \u00b5m after the planned "
+                          "scan (%.2f \u00b5m after the blind scan); ICP weights: %s. Files in %s")
                 % (summary["verdict"]["summary"], 1e3 * summary["pose_uncertainty_mm"],
-                   1e3 * summary["uncertainty_after_blind_mm"], summary["out_dir"]))
-        _show_table(translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
-                    summary["sections"], note, summary["result"].fit_sensitivity)
+                   1e3 * summary["uncertainty_after_blind_mm"],
+                   summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
+        return _show_table(
+            translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
+            summary["sections"], note, summary["result"].fit_sensitivity)
 
 
 class Calibrate(commands._Command):
@@ -365,41 +391,19 @@ class Simulate(commands._Command):
         return self.simulate(**options)
 
     def simulate(self, seed=0, **options):
-        """run_simulation on the document's nominal, else a new demo blade; adds the simulated
-        measurement, its registration and deviation map. Returns (report, registration)."""
+        """app.actions.simulate on the document's nominal, else a new demo blade; adds the
+        simulated measurement, its registration and deviation map. Returns (report,
+        registration)."""
         doc = commands.active_document()
         title = translate("BladeInspect", "Simulation test bed")
-
-        def job(p):
-            with objects.building(doc, "Simulation test bed"):
-                nominal_obj = commands.find_nominal()
-                if nominal_obj is None:
-                    p(0.0, translate("BladeInspect", "building the demo blade"))
-                    nominal_obj = objects.make_demo_blade(doc)
-                    doc.recompute()
-                result, report, pointset = run_simulation(
-                    objects.nominal_of(nominal_obj), seed=seed, progress=p, **options)
-                result.cad_source = nominal_obj.Label
-                measurement = objects.make_measurement(doc, pointset, name="SimulatedScan")
-                registration = objects.make_registration(doc, result, measurement, nominal_obj,
-                                                         seed, name="SimulatedRegistration")
-                for prop, tip, value in (
-                        ("PoseErrorMm", "Pose error against the simulator's truth (largest "
-                         "bounding-box corner displacement), mm", report["pose_error_mm"]),
-                        ("PoseErrorOverBound", "Pose error / its Cramer-Rao bound",
-                         report["pose_error_over_bound"])):
-                    registration.addProperty("App::PropertyFloat", prop, "Simulation", tip)
-                    setattr(registration, prop, value)
-                    # The simulator's truth, not an input.
-                    registration.setEditorMode(prop, ["ReadOnly"])
-                deviation_map = objects.make_deviation_map(doc, registration,
-                                                           settings.colour_limit())
-            _hide_measured_frame(measurement)
-            return report, registration, deviation_map
-        outcome = progress.run(title, job)
+        nominal_obj = commands.find_nominal()
+        outcome = commands.run_action(title, "simulate", doc.Name, int(seed),
+                                      nominal=nominal_obj.Name if nominal_obj else None,
+                                      **options)
         if outcome is None:
             return None
         report, registration, _ = outcome
+        _hide_measured_frame(registration.Measurement)
         doc.recompute()
         commands.fit_view()
         show_result(title, simulation_text(report))

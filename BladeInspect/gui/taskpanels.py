@@ -59,6 +59,33 @@ class FormPanel:
         return True
 
 
+# The demo blade's parameters (cad.demo_blade.BladeParams) as the panel names them, with
+# their units; a parameter not listed shows under its field name.
+DEMO_BLADE_LABELS = {
+    "span": (QT_TRANSLATE_NOOP("BladeInspect", "Span"), "mm"),
+    "chord_root": (QT_TRANSLATE_NOOP("BladeInspect", "Chord at the hub"), "mm"),
+    "chord_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Chord at the tip"), "mm"),
+    "thickness_root": (QT_TRANSLATE_NOOP("BladeInspect", "Thickness / chord at the hub"), ""),
+    "thickness_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Thickness / chord at the tip"), ""),
+    "thickness_position": (QT_TRANSLATE_NOOP("BladeInspect",
+                                             "Thickest point / chord"), ""),
+    "camber_root": (QT_TRANSLATE_NOOP("BladeInspect", "Camber / chord at the hub"), ""),
+    "camber_tip": (QT_TRANSLATE_NOOP("BladeInspect", "Camber / chord at the tip"), ""),
+    "camber_position": (QT_TRANSLATE_NOOP("BladeInspect", "Most cambered point / chord"), ""),
+    "stagger_root_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Stagger at the hub"), "\u00b0"),
+    "twist_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Twist, hub to tip"), "\u00b0"),
+    "twist_exponent": (QT_TRANSLATE_NOOP("BladeInspect", "Twist exponent"), ""),
+    "sweep": (QT_TRANSLATE_NOOP("BladeInspect", "Sweep of the tip (+X)"), "mm"),
+    "lean": (QT_TRANSLATE_NOOP("BladeInspect", "Lean of the tip (+Y)"), "mm"),
+    "le_radius_root": (QT_TRANSLATE_NOOP("BladeInspect", "LE radius at the hub"), "mm"),
+    "le_radius_tip": (QT_TRANSLATE_NOOP("BladeInspect", "LE radius at the tip"), "mm"),
+    "te_radius_root": (QT_TRANSLATE_NOOP("BladeInspect", "TE radius at the hub"), "mm"),
+    "te_radius_tip": (QT_TRANSLATE_NOOP("BladeInspect", "TE radius at the tip"), "mm"),
+    "n_sections": (QT_TRANSLATE_NOOP("BladeInspect", "Sections lofted"), ""),
+    "n_profile": (QT_TRANSLATE_NOOP("BladeInspect", "Points per side and section"), ""),
+}
+
+
 class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Demo blade")
@@ -73,9 +100,11 @@ class DemoBladePanel(FormPanel):
             value = getattr(defaults, field.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 continue
-            box = spin_box(value, -1e4, 1e4)
+            label, unit = DEMO_BLADE_LABELS.get(field.name,
+                                                (field.name.replace("_", " "), ""))
+            box = spin_box(value, -1e4, 1e4, suffix=unit)
             self.boxes[field.name] = box
-            self.add_row(field.name.replace("_", " "), box)
+            self.add_row(label, box)
 
     def params(self):
         return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())
@@ -177,8 +206,9 @@ class ScanPanel(FormPanel):
 
 
 class FitSelector(QtGui.QGroupBox):
-    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule, as the
-    command line's (inspection.fitting checks them when the command runs)."""
+    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule and the
+    fine ICP's --weights, as the command line's (inspection.fitting checks them when the
+    command runs)."""
 
     def __init__(self):
         super().__init__(translate("BladeInspect", "Fit"))
@@ -202,18 +232,28 @@ class FitSelector(QtGui.QGroupBox):
         self.rule.setToolTip(translate(
             "BladeInspect", "iso14253: pass / not proven / fail (ISO 14253-1); simple: simple "
             "acceptance"))
+        self.icp_weights = QtGui.QComboBox()
+        self.icp_weights.addItems(list(registration_fit.WEIGHT_CHOICES))
+        self.icp_weights.setToolTip(translate(
+            "BladeInspect", "The fine ICP's weights: snr, the paper's SNR-linear weights; "
+            "sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' "
+            "angle_deg); default: sensor when the points carry snr and angle_deg, else snr"))
         for label, widget in ((QT_TRANSLATE_NOOP("BladeInspect", "Objective"), self.objective),
                               (QT_TRANSLATE_NOOP("BladeInspect", "Free DOF"), self.free),
                               (QT_TRANSLATE_NOOP("BladeInspect", "Zone weights"), self.weights),
-                              (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule)):
+                              (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule),
+                              (QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
+                               self.icp_weights)):
             layout.addRow(translate("BladeInspect", label), widget)
 
     def values(self):
         """Keywords of app.actions.fit_choice (literals, for the console line)."""
+        weights = self.icp_weights.currentText()
         return {"fit": self.objective.currentText(),
                 "free": self.free.text().strip() or None,
                 "weights_by_zone": self.weights.text().strip() or None,
-                "decision_rule": self.rule.currentText()}
+                "decision_rule": self.rule.currentText(),
+                "weights": None if weights == registration_fit.DEFAULT_WEIGHTS else weights}
 
 
 class RegisterPanel(FormPanel):
@@ -270,6 +310,9 @@ def registration_html(obj):
         rows.append((tr("Fit"), _escape("%s, free %s, decision rule %s" % (
             record["objective"], ",".join(record["free"]) if isinstance(record["free"], list)
             else record["free"], record["decision_rule"]))))
+    weights = getattr(obj, "WeightsUsed", "")
+    if weights:   # issue 16 item 3: which weights the fine ICP used, and why
+        rows.append((tr("ICP weights"), _escape(weights)))
     html = "<table cellspacing='4'>" + "".join(
         "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
     notes = list(obj.Warnings) + rival_lines(json.loads(obj.CoarseJson or "{}"))
@@ -277,6 +320,13 @@ def registration_html(obj):
         html += "<p><b>%s</b><br>" % tr("Warnings") + "<br>".join(
             _escape(w) for w in notes) + "</p>"
     return html
+
+
+# Rows of the fit-sensitivity table shown without scrolling (the demo's sections, part and
+# airfoil rows run to about twenty).
+SENSITIVITY_ROWS_SHOWN = 12
+# Rows of a section table shown without scrolling (Table 2 of the usual five to nine sections).
+TABLE_ROWS_SHOWN = 9
 
 
 def table_widget(header, rows):
@@ -289,13 +339,26 @@ def table_widget(header, rows):
     return table
 
 
+def fit_rows_height(table, max_rows):
+    """Make ``table`` tall enough for its header and up to ``max_rows`` rows (a scroll bar
+    beyond), so a short table shows whole in a task panel instead of scrolling in a strip."""
+    rows = min(table.rowCount(), max_rows)
+    # Room for a horizontal scroll bar too: whether the panel is wide enough is known only
+    # once it is shown.
+    table.setMinimumHeight(table.horizontalHeader().sizeHint().height()
+                           + sum(table.rowHeight(r) for r in range(rows))
+                           + 2 * table.frameWidth()
+                           + table.horizontalScrollBar().sizeHint().height())
+
+
 def sensitivity_widget(sensitivity):
-    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change."""
+    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change; an
+    objective's unit and verdict below its name, so that the columns fit a task panel."""
     box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
     layout = QtGui.QVBoxLayout(box)
     header, rows = fitting.report_rows(sensitivity)
-    table = table_widget(header, rows)
-    table.setMinimumHeight(200)
+    table = table_widget([h.replace(" (", "\n(", 1) for h in header], rows)
+    fit_rows_height(table, SENSITIVITY_ROWS_SHOWN)
     layout.addWidget(table)
     largest = sensitivity.get("largest_change")
     if largest:
@@ -352,7 +415,7 @@ class TablePanel(_ResultPanel):
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
         self.table = table_widget(header, rows)
-        self.table.setMinimumHeight(260)
+        fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
         if note:
             label = QtGui.QLabel(note)

@@ -8,6 +8,7 @@ import html
 import numpy as np
 
 from . import airfoil as stage_mod
+from .report_table import pdf_table
 
 # Inscribed circles drawn per profile besides the largest one.
 N_CIRCLES = 5
@@ -150,15 +151,11 @@ def add_pages(pdf, parts, table):
         if section.nominal is None:
             continue
         fig = plt.figure(figsize=(8.27, 11.69))
-        ax = fig.add_axes([0.04, 0.04, 0.92, 0.9])
-        ax.axis("off")
-        ax.set_title("Airfoil characteristics, section %s (%.1f %% span): %s"
-                     % (block["label"], block["height_pct"], block.get("verdict", "-")),
-                     fontsize=10, loc="left")
-        t = ax.table(cellText=rows or [["-"] * len(TABLE_HEADER)], colLabels=TABLE_HEADER,
-                     loc="upper center", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(6.5)
+        pdf_table(fig, [0.04, 0.04, 0.92, 0.9], TABLE_HEADER,
+                  rows or [["-"] * len(TABLE_HEADER)], 6.5,
+                  title="Airfoil characteristics, section %s (%.1f %% span): %s"
+                  % (block["label"], block["height_pct"], block.get("verdict", "-")),
+                  title_size=10, loc="upper center")
         pdf.savefig(fig)
         plt.close(fig)
         fig = figure_profile(section)

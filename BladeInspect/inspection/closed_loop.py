@@ -46,8 +46,8 @@ from ..rig.kinematics import RigKinematics
 from . import airfoil as airfoil_mod
 from . import pipeline
 from . import sections as sections_mod
-from . import verdict as verdict_mod
 from . import weighting
+from .judging import fit_and_judge
 from .checkpoint import LIVE_FOLDER, Checkpoint, inspection_identity, save_plan, start_or_resume
 from .checks import unmeasured_warning
 from .report import write_report
@@ -625,20 +625,16 @@ def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm
     """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
     indexed back into the whole result, and the verdict on every point; the result moved to
     the pose of ``fit_choice`` first (inspection.fitting), its fit sensitivity recorded."""
-    from . import fitting   # hook: issue 16
-    fit_choice = fit_choice or fitting.FitChoice()
-    runs = fitting.apply(result, nominal, fit_choice, tolerance, all_objectives=True)
-    rows = np.arange(n_blind, n_blind + n_rows)
-    table = sections_mod.section_table(result.planned_rows(rows), nominal, heights_pct=heights,
-                                       span_axis=span_axis, cmm=cmm_data)
-    for sec in table.sections:
-        sec.point_index = sec.point_index + n_blind
-    judge_options = {"measurement_model": measurement_model}
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance,
-                                decision_rule=fit_choice.decision_rule, **judge_options)
-    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, fit_choice,
-                                                 judge_options)
-    return table, verdict
+    def planned_table(fitted):
+        rows = np.arange(n_blind, n_blind + n_rows)
+        table = sections_mod.section_table(fitted.planned_rows(rows), nominal,
+                                           heights_pct=heights, span_axis=span_axis,
+                                           cmm=cmm_data)
+        for sec in table.sections:
+            sec.point_index = sec.point_index + n_blind
+        return table
+    return fit_and_judge(result, nominal, fit_choice, tolerance, planned_table,
+                         measurement_model=measurement_model)
 
 
 def _blind_column(pointset, name, n):

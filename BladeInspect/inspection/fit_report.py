@@ -5,6 +5,7 @@ import html
 
 from ..core import decision as decision_mod
 from . import fitting
+from .report_table import pdf_table
 
 VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
                 decision_mod.FAIL: "FAIL"}
@@ -46,11 +47,22 @@ def model_lines(verdict):
                                                "fit") if k in model]
 
 
+def weights_text(record):
+    """One line naming the fine ICP's weights (result.json's ``weights``) and why they were
+    chosen; "" for none."""
+    if not record:
+        return ""
+    return "%s, noise along the normal %s; %s" % (
+        record["model"], record.get("normal_noise", "?"), record.get("chosen_by", "?"))
+
+
 def fit_lines(result):
+    weights = weights_text(getattr(result, "weights", None))   # issue 16 item 3
+    lines = ["ICP weights: " + weights] if weights else []
     fit = result.fit
     if not fit:
-        return []
-    lines = ["objective %s, free %s, region weights %s; start: %s"
+        return lines
+    lines += ["objective %s, free %s, region weights %s; start: %s"
              % (fit["objective"], fit["free"] if isinstance(fit["free"], str)
                 else ",".join(fit["free"]), fit.get("weights_by_zone") or "none", fit["start"])]
     if fit.get("margin_mm") is not None:
@@ -97,18 +109,12 @@ def pdf_page(plt, result, verdict, dpi):
         fig.text(0.06, y, line, fontsize=7, wrap=True)
         y -= 0.02
     header, rows = decision_rows(verdict)
-    ax = fig.add_axes([0.06, 0.5, 0.88, max(0.05, y - 0.52)])
-    ax.axis("off")
+    rect = [0.06, 0.5, 0.88, max(0.05, y - 0.52)]
     if rows:
-        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(7)
+        pdf_table(fig, rect, header, rows, 7)
+    else:
+        fig.add_axes(rect).axis("off")
     if result.fit_sensitivity:
         header, rows = fitting.report_rows(result.fit_sensitivity)
-        ax = fig.add_axes([0.06, 0.05, 0.88, 0.4])
-        ax.axis("off")
-        ax.set_title("Fit sensitivity", fontsize=11, loc="left")
-        t = ax.table(cellText=rows, colLabels=header, loc="upper left", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(6.5)
+        pdf_table(fig, [0.06, 0.05, 0.88, 0.4], header, rows, 6.5, title="Fit sensitivity")
     return fig

@@ -26,8 +26,10 @@ from . import airfoil_report
 from . import pipeline
 from . import sections as sections_mod
 from . import fit_report
+from . import judging
 from . import verdict as verdict_mod
 from .checks import check_out_dir
+from .report_table import pdf_table
 from .result import rival_lines
 
 # Enough points for a faithful picture; more only costs time and PDF size.
@@ -468,13 +470,9 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         for line in verdict_lines[:24]:
             fig.text(0.06, y, line, fontsize=8, wrap=True)
             y -= 0.018
-        ax = fig.add_axes([0.06, 0.05, 0.88, max(0.1, y - 0.1)])
-        ax.axis("off")
-        ax.set_title("Pose and its uncertainty", fontsize=11, loc="left")
-        t = ax.table(cellText=p_rows, colLabels=["Quantity", "Value"], loc="upper left",
-                     cellLoc="left", colWidths=[0.45, 0.55])
-        t.auto_set_font_size(False)
-        t.set_fontsize(7.5)
+        pdf_table(fig, [0.06, 0.05, 0.88, max(0.1, y - 0.1)], ["Quantity", "Value"], p_rows,
+                  7.5, title="Pose and its uncertainty", cell_loc="left",
+                  col_widths=[0.45, 0.55])
         pdf.savefig(fig, dpi=PDF_DPI)
         plt.close(fig)
         n_pages += 1
@@ -504,20 +502,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         n_pages += 1
 
         fig = plt.figure(figsize=(11.69, 8.27))
-        ax = fig.add_axes([0.03, 0.52, 0.94, 0.42])
-        ax.axis("off")
-        ax.set_title("Table 2: section profile errors (points within +-%.2f mm of each plane "
-                     "or of the section column)" % table.band, fontsize=11, loc="left")
-        t = ax.table(cellText=s_rows or [["-"] * len(s_header)], colLabels=s_header,
-                     loc="upper center", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(7.5)
-        ax = fig.add_axes([0.03, 0.05, 0.94, 0.42])
-        ax.axis("off")
-        ax.set_title("Table 3: deviation bands", fontsize=11, loc="left")
-        t = ax.table(cellText=h_rows, colLabels=h_header, loc="upper center", cellLoc="right")
-        t.auto_set_font_size(False)
-        t.set_fontsize(8)
+        pdf_table(fig, [0.03, 0.52, 0.94, 0.42], s_header, s_rows or [["-"] * len(s_header)],
+                  7.5, title="Table 2: section profile errors (points within +-%.2f mm of each "
+                  "plane or of the section column)" % table.band, loc="upper center")
+        pdf_table(fig, [0.03, 0.05, 0.94, 0.42], h_header, h_rows, 8,
+                  title="Table 3: deviation bands", loc="upper center")
         notes = ["LE/TE: points within %.0f %% of the chord of each end of the nominal profile."
                  % (100 * table.edge_fraction)]
         if table.cmm_source:
@@ -607,15 +596,11 @@ def write_result_report(result, nominal, out_dir, cmm_data=None,
     tolerance = contracts.profile_tolerance(tolerance)
     t0 = time.perf_counter()
     progress(0.82, "section table")
-    from . import fitting   # hook: issue 16, the fit, its sensitivity and the decision
-    fit_choice = fit_choice or fitting.FitChoice()
-    runs = fitting.apply(result, nominal, fit_choice, tolerance, all_objectives=True)
-    table = sections_mod.section_table(result, nominal, heights_pct=heights_pct, cmm=cmm_data)
-    judge_options = {"measurement_model": measurement_model}
-    verdict = verdict_mod.judge(result, table, tolerance=tolerance,
-                                decision_rule=fit_choice.decision_rule, **judge_options)
-    result.fit_sensitivity = fitting.sensitivity(runs, result, table, tolerance, fit_choice,
-                                                 judge_options)
+    table, verdict = judging.fit_and_judge(   # hook: issue 16, the fit and the decision
+        result, nominal, fit_choice, tolerance,
+        lambda fitted: sections_mod.section_table(fitted, nominal, heights_pct=heights_pct,
+                                                  cmm=cmm_data),
+        measurement_model=measurement_model)
     if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
         airfoil_mod.attach(result, nominal, table, verdict, airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0

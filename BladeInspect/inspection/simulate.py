@@ -9,10 +9,11 @@ import time
 import numpy as np
 
 from ..core import bspline
+from ..core import span as span_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 from ..core.pointio import PointSet, write_points_csv
-from ..measurement.planning import span_frame
+from ..measurement.planning import face_count_and_planes, span_frame
 from .pipeline import AtomicOutput, register, write_register_outputs
 
 # Good readings and gross outliers get these SNRs: outliers come from poor signal.
@@ -33,8 +34,8 @@ def measurement_faces(nominal, sides):
         return sorted(i for name in names for i in roles.get(name, ()))
     if sides != "both":
         raise InputError("--sides %s: this CAD has no suction/pressure faces marked" % sides)
-    faces = [i for i, f in enumerate(nominal.faces) if "Plane" not in type(f.Surface).__name__]
-    return faces or list(range(len(nominal.faces)))
+    # No side named: the airfoil rule without roles, every face that is not a plane.
+    return span_mod.airfoil_faces(None, *face_count_and_planes(nominal))
 
 
 def sample_faces(nominal, faces, n, rng):

@@ -136,7 +136,7 @@ class Plan:
 
 # ---------------------------------------------------------------- geometry helpers
 
-def _faces(nominal):
+def face_count_and_planes(nominal):
     """(number of faces, indices of the planar ones); samples alone (no faces) count as one
     non-planar face each index."""
     faces = getattr(nominal, "faces", None)
@@ -148,13 +148,13 @@ def _faces(nominal):
 def blade_faces(nominal):
     """Faces that make the airfoil (core.span.airfoil_faces): the roles when known, else every
     non-planar face."""
-    return span_mod.airfoil_faces(nominal.roles, *_faces(nominal))
+    return span_mod.airfoil_faces(nominal.roles, *face_count_and_planes(nominal))
 
 
 def span_frame(nominal, span_axis=None):
     """core.span.Span of the nominal: the one span rule of the planner and the analysis."""
     s = nominal.samples
-    n_faces, planar = _faces(nominal)
+    n_faces, planar = face_count_and_planes(nominal)
     return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis)
 
 

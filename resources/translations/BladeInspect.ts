@@ -5,7 +5,7 @@
     <name>BladeInspect</name>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <source>%s. Pose uncertainty %.2f um after the planned scan (%.2f um after the blind scan). Files in %s</source>
+        <source>%s. Pose uncertainty %.2f µm after the planned scan (%.2f µm after the blind scan); ICP weights: %s. Files in %s</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -45,8 +45,14 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Airfoil characteristics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Airfoil characteristics...</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -73,6 +79,11 @@
     <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>BladeInspect: %s cancelled</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect: report in %s; ICP weights: %s</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -121,6 +132,16 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Camber / chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Camber / chord at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>Cancel</source>
         <translation type="unfinished"></translation>
@@ -133,6 +154,21 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Chord at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Chord, stagger, thickness, edge radii, angles, shift and twist per section, judged in the verdict (the inspect command's default; off: --no-airfoil)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -203,6 +239,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>ICP weights</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>Import points</source>
         <translation type="unfinished"></translation>
@@ -219,12 +260,27 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>LE radius at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>LE radius at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Largest change: %s, %.4f mm; the verdict %s with the fit.</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Lean and bow: largest bow at section %s.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Lean of the tip (+Y)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -245,6 +301,11 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Measurement error</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Most cambered point / chord</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -275,6 +336,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Point spacing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Points per side and section</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -385,6 +451,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sections lofted</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Seed</source>
@@ -416,8 +487,18 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Span</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Sphere diameter</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Stagger at the hub</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -436,8 +517,43 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sweep of the tip (+X)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>TE radius at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>TE radius at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The fine ICP's weights: snr, the paper's SNR-linear weights; sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' angle_deg); default: sensor when the points carry snr and angle_deg, else snr</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickest point / chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickness / chord at the hub</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Thickness / chord at the tip</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -448,6 +564,16 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Twist exponent</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Twist, hub to tip</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -476,11 +602,6 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <source>building the demo blade</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>changes</source>
         <translation type="unfinished"></translation>
@@ -498,11 +619,6 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>does not change</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/commands.py"/>
-        <source>fitting section curves</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -563,11 +679,6 @@
     <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>starting</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/commands.py"/>
-        <source>storing %d curves, %d surfaces</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
