@@ -4,7 +4,9 @@ the faces and a k-d tree over them. No FreeCAD: cad.nominal turns OCC faces into
 asks OpenCASCADE only for the points the fast path here leaves undecided.
 
 Fast path: the k-d tree gives, for each point, the nearby faces and a start (u, v) on each;
-Newton on every candidate face (vectorised per face), the smallest distance wins. A candidate is
+Newton on every candidate face (vectorised per face), the smallest distance wins. A face none of
+whose samples is among the k nearest is tried too where it can be nearer (SampleCover: the
+samples' cover radius per face and clearance to the other faces per sample). A candidate is
 only trusted when Newton converged to a point inside the face's trimmed domain, away from its
 boundary; a point whose winner lies on a face edge (clamped at the parameter box) without one
 partner face across it, or that a doubtful candidate might beat, is left undecided.
@@ -12,7 +14,7 @@ partner face across it, or that a doubtful candidate might beat, is left undecid
 Warm starts: ICP and the deviations that follow it evaluate the same points again and again,
 each time moved rigidly by less than the last (micrometres at the end). A FootStart carries a
 previous call's answer for the same points. A point that call decided inside a face (not at an
-edge), with every other candidate face farther by its ``lead`` (a lower bound), needs no new
+edge), with every other face farther by its ``lead`` (a lower bound), needs no new
 candidates while it has moved by delta < lead / 2: every distance is 1-Lipschitz in the point,
 so no candidate can overtake the winner. Newton then runs on that face alone from the previous
 (u, v) (one or two iterations), and the point is decided by the same tests as a cold one
