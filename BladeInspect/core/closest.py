@@ -242,6 +242,9 @@ class SampleCover:
                 if a == b or np.linalg.norm(boxes_apart) > reach:
                     continue
                 mine = members[a]
+                # Only the samples within reach of b's box can be within reach of b's samples.
+                mine = mine[box_distance(samples.xyz[mine], self.lo[b:b + 1],
+                                         self.hi[b:b + 1])[:, 0] <= reach]
                 d, _ = self.trees[b].query(samples.xyz[mine], distance_upper_bound=reach)
                 self.clearance[mine] = np.minimum(self.clearance[mine],
                                                   np.minimum(d, reach) - self.radius[b])
