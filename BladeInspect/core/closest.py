@@ -212,6 +212,7 @@ class SampleCover:
         n_faces = len(surfaces)
         self.trees, self.uv = [None] * n_faces, [None] * n_faces
         self.sample_xyz = samples.xyz
+        self.surfaces, self.boxes = surfaces, [None] * n_faces
         self.lo, self.hi = np.zeros((n_faces, 3)), np.zeros((n_faces, 3))
         self.radius = np.zeros(n_faces)
         order = np.argsort(samples.face, kind="stable")
@@ -248,6 +249,12 @@ class SampleCover:
                 d, _ = self.trees[b].query(samples.xyz[mine], distance_upper_bound=reach)
                 self.clearance[mine] = np.minimum(self.clearance[mine],
                                                   np.minimum(d, reach) - self.radius[b])
+
+    def patch_boxes(self, f):
+        """patch_boxes of face f, kept from the first call."""
+        if self.boxes[f] is None:
+            self.boxes[f] = patch_boxes(self.surfaces[f])
+        return self.boxes[f]
 
     def beyond(self, points, pi, pf, pair_sample, dist, closest, trusted):
         """(point, face, Newton start (u, v)) of the candidates the k nearest samples missed,
@@ -286,8 +293,15 @@ class SampleCover:
                 if not len(r):
                     continue
                 d, j = self.trees[f].query(p[r])
-                close = d <= reach[r] + self.radius[f]
-                bound[r[~close]] = np.minimum(bound[r[~close]], d[~close] - self.radius[f])
+                low = d - self.radius[f]
+                close = low <= reach[r]
+                if close.any():
+                    # The face lies in its patches' boxes: where they are farther, so is it.
+                    lo, hi = self.patch_boxes(f)
+                    low[close] = np.maximum(low[close],
+                                            box_distance(p[r[close]], lo, hi).min(axis=1))
+                    close = low <= reach[r]
+                bound[r[~close]] = np.minimum(bound[r[~close]], low[~close])
                 more[0].append(ask[r[close]])
                 more[1].append(np.full(np.count_nonzero(close), f))
                 more[2].append(self.uv[f][j[close]])
