@@ -161,7 +161,6 @@ def box_distance(points, lo, hi):
     return np.linalg.norm(gap, axis=2)
 
 
-
 def grid_step(values):
     """The step of a regular grid of which ``values`` are nodes (NaN for fewer than two)."""
     steps = np.diff(np.unique(values))
