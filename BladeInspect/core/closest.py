@@ -4,7 +4,9 @@ the faces and a k-d tree over them. No FreeCAD: cad.nominal turns OCC faces into
 asks OpenCASCADE only for the points the fast path here leaves undecided.
 
 Fast path: the k-d tree gives, for each point, the nearby faces and a start (u, v) on each;
-Newton on every candidate face (vectorised per face), the smallest distance wins. A candidate is
+Newton on every candidate face (vectorised per face), the smallest distance wins. A face none of
+whose samples is among the k nearest is tried too where it can be nearer (SampleCover: the
+samples' cover radius per face and clearance to the other faces per sample). A candidate is
 only trusted when Newton converged to a point inside the face's trimmed domain, away from its
 boundary; a point whose winner lies on a face edge (clamped at the parameter box) without one
 partner face across it, or that a doubtful candidate might beat, is left undecided.
@@ -12,7 +14,7 @@ partner face across it, or that a doubtful candidate might beat, is left undecid
 Warm starts: ICP and the deviations that follow it evaluate the same points again and again,
 each time moved rigidly by less than the last (micrometres at the end). A FootStart carries a
 previous call's answer for the same points. A point that call decided inside a face (not at an
-edge), with every other candidate face farther by its ``lead`` (a lower bound), needs no new
+edge), with every other face farther by its ``lead`` (a lower bound), needs no new
 candidates while it has moved by delta < lead / 2: every distance is 1-Lipschitz in the point,
 so no candidate can overtake the winner. Newton then runs on that face alone from the previous
 (u, v) (one or two iterations), and the point is decided by the same tests as a cold one
@@ -45,6 +47,12 @@ POINT_CHUNK = 32768
 THREADS = 2
 # Nearest samples searched for a Newton start on one given face.
 START_CANDIDATES = 8
+# Factor on the largest sample distance found at a face's check points (cell corners, boundary
+# points a quarter cell apart) for its cover radius: the points between checks are at most an
+# eighth of a cell diagonal farther, and a cover radius is at least half of one.
+COVER_SAFETY = 1.25
+# How far a sample's clearance to the other faces is sought, in largest cover radii.
+CLEARANCE_REACH = 4.0
 
 
 @dataclass
@@ -153,6 +161,153 @@ def box_distance(points, lo, hi):
     return np.linalg.norm(gap, axis=2)
 
 
+def grid_step(values):
+    """The step of a regular grid of which ``values`` are nodes (NaN for fewer than two)."""
+    steps = np.diff(np.unique(values))
+    return steps.min() if len(steps) else np.nan
+
+
+def cover_radius(surf, domain, uv, tree, hull_size):
+    """The cover radius of a face's samples: the largest distance from a point of the face to
+    its nearest sample (mm), capped at ``hull_size`` (a diameter of the face). The samples
+    are the centres of the cells of a regular (u, v) grid on the parameter box that lie in
+    the trimmed domain (``uv``, ``tree`` a k-d tree over their points); the face's farthest
+    points from them are the cells' corners (the vertices of the samples' Voronoi diagram)
+    and, where the grid is cut, the trimmed boundary: both are checked (COVER_SAFETY)."""
+    (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    du, dv = grid_step(uv[:, 0]), grid_step(uv[:, 1])
+    if not (du > 0 and dv > 0):
+        return hull_size
+    iu, iv = (uv[:, 0] - u0) / du - 0.5, (uv[:, 1] - v0) / dv - 0.5
+    if (np.abs(iu - np.rint(iu)).max() > 1e-6 or np.abs(iv - np.rint(iv)).max() > 1e-6
+            or iu.min() < -0.5 or iv.min() < -0.5):
+        return hull_size         # not the grid of nominal's sampling
+    iu, iv = np.rint(iu).astype(np.int64), np.rint(iv).astype(np.int64)
+    width = iv.max() + 2
+    corner = np.unique(((iu[:, None] + [0, 0, 1, 1]) * width + iv[:, None] + [0, 1, 0, 1]).ravel())
+    check = [np.column_stack([u0 + corner // width * du, v0 + corner % width * dv])]
+    if domain.index is not None:
+        a, b = domain.index.segments[:, 0], domain.index.segments[:, 1]
+        along = np.cumsum(np.linalg.norm(b - a, axis=1)) / (0.25 * min(du, dv))
+        check.append(a[np.diff(np.floor(along), prepend=-1.0) > 0])
+    check = np.clip(np.concatenate(check), [u0, v0], [u1, v1])
+    (S,) = bspline.evaluate(surf, check[:, 0], check[:, 1], order=0)
+    return min(COVER_SAFETY * float(tree.query(S)[0].max()), hull_size)
+
+
+class SampleCover:
+    """Which faces a point's candidates (the faces of its k nearest samples) may miss.
+
+    Every point of a face B lies within B's cover radius R_B (cover_radius) of one of B's
+    samples, so a point s is at least |s - t| - R_B from B, t the B-sample nearest to s. For
+    each sample s of a face A the clearance is the least of that bound over the other faces
+    (``clearance``, known up to CLEARANCE_REACH). A point p whose best candidate is face A at
+    distance d, closest point c, Newton started from A's sample s, is at least
+    clearance(s) - |c - s| - d from every other face: where that exceeds d, no face missed
+    can be nearer. Elsewhere (near another face) every face with a sample within d + R_B of
+    p is tried, from that sample; the others are farther than d."""
+
+    def __init__(self, surfaces, domains, samples):
+        n_faces = len(surfaces)
+        self.trees, self.uv = [None] * n_faces, [None] * n_faces
+        self.sample_xyz = samples.xyz
+        self.surfaces, self.boxes = surfaces, [None] * n_faces
+        self.lo, self.hi = np.zeros((n_faces, 3)), np.zeros((n_faces, 3))
+        self.radius = np.zeros(n_faces)
+        order = np.argsort(samples.face, kind="stable")
+        cuts = np.searchsorted(samples.face[order], np.arange(n_faces + 1))
+        members = [order[cuts[f]:cuts[f + 1]] for f in range(n_faces)]
+        for f, surf in enumerate(surfaces):
+            if not len(members[f]):
+                continue
+            xyz = samples.xyz[members[f]]
+            self.trees[f], self.uv[f] = cKDTree(xyz), samples.uv[members[f]]
+            self.lo[f], self.hi[f] = xyz.min(axis=0), xyz.max(axis=0)
+            poles = surf.poles.reshape(-1, 3)
+            # The convex hull property (positive weights): the face lies in its poles' box.
+            hull = (np.linalg.norm(poles.max(axis=0) - poles.min(axis=0))
+                    if surf.weights is None or np.all(surf.weights > 0) else np.inf)
+            self.radius[f] = cover_radius(surf, domains[f], self.uv[f], self.trees[f], hull)
+        self.sampled = np.flatnonzero(cuts[1:] > cuts[:-1])
+        # A face without samples is never a candidate: only its patch boxes bound it.
+        self.unsampled = [(f, patch_boxes(surfaces[f])) for f in
+                          np.flatnonzero(cuts[1:] == cuts[:-1])]
+        self.radius_max = float(self.radius.max()) if n_faces else 0.0
+        reach = CLEARANCE_REACH * self.radius_max
+        self.clearance = np.full(len(samples.xyz), reach - self.radius_max)
+        for b in self.sampled:
+            for a in self.sampled:
+                boxes_apart = np.maximum(np.maximum(self.lo[a] - self.hi[b],
+                                                    self.lo[b] - self.hi[a]), 0.0)
+                if a == b or np.linalg.norm(boxes_apart) > reach:
+                    continue
+                mine = members[a]
+                # Only the samples within reach of b's box can be within reach of b's samples.
+                mine = mine[box_distance(samples.xyz[mine], self.lo[b:b + 1],
+                                         self.hi[b:b + 1])[:, 0] <= reach]
+                d, _ = self.trees[b].query(samples.xyz[mine], distance_upper_bound=reach)
+                self.clearance[mine] = np.minimum(self.clearance[mine],
+                                                  np.minimum(d, reach) - self.radius[b])
+
+    def patch_boxes(self, f):
+        """patch_boxes of face f, kept from the first call."""
+        if self.boxes[f] is None:
+            self.boxes[f] = patch_boxes(self.surfaces[f])
+        return self.boxes[f]
+
+    def beyond(self, points, pi, pf, pair_sample, dist, closest, trusted):
+        """(point, face, Newton start (u, v)) of the candidates the k nearest samples missed,
+        and per point a lower bound of its distance to every face tried neither among those
+        nor among the pairs (pi, pf) (candidates from samples ``pair_sample``, at
+        ``dist`` with closest points ``closest``, ``trusted`` where decided)."""
+        n = len(points)
+        best = np.full(n, np.inf)
+        np.minimum.at(best, pi[trusted], dist[trusted])
+        win = np.flatnonzero(trusted & (dist == best[pi]))
+        s = np.full(n, -1)
+        s[pi[win]] = pair_sample[win]
+        gap = np.full(n, np.inf)
+        gap[pi[win]] = np.linalg.norm(closest[win] - self.sample_xyz[pair_sample[win]], axis=1)
+        untried = np.where(s >= 0, self.clearance[s] - gap - best, -np.inf)
+        for f, (lo, hi) in self.unsampled:
+            untried = np.minimum(untried, box_distance(points, lo, hi).min(axis=1))
+        ask = np.flatnonzero((s >= 0) & ~(untried > best))
+        more = [np.zeros(0, int)], [np.zeros(0, int)], [np.zeros((0, 2))]
+        if len(ask):
+            row = np.full(n, -1)
+            row[ask] = np.arange(len(ask))
+            mine = row[pi] >= 0
+            tried = np.zeros((len(ask), len(self.trees)), bool)
+            tried[row[pi[mine]], pf[mine]] = True
+            p, reach = points[ask], best[ask]
+            bound = np.full(len(ask), np.inf)
+            for f, (lo, hi) in self.unsampled:
+                bound = np.minimum(bound, box_distance(p, lo, hi).min(axis=1))
+            for f in self.sampled:
+                r = np.flatnonzero(~tried[:, f])
+                box_gap = box_distance(p[r], self.lo[f:f + 1], self.hi[f:f + 1])[:, 0]
+                near = box_gap <= reach[r] + self.radius[f]
+                bound[r[~near]] = np.minimum(bound[r[~near]], box_gap[~near] - self.radius[f])
+                r = r[near]
+                if not len(r):
+                    continue
+                d, j = self.trees[f].query(p[r])
+                low = d - self.radius[f]
+                close = low <= reach[r]
+                if close.any():
+                    # The face lies in its patches' boxes: where they are farther, so is it.
+                    lo, hi = self.patch_boxes(f)
+                    low[close] = np.maximum(low[close],
+                                            box_distance(p[r[close]], lo, hi).min(axis=1))
+                    close = low <= reach[r]
+                bound[r[~close]] = np.minimum(bound[r[~close]], low[~close])
+                more[0].append(ask[r[close]])
+                more[1].append(np.full(np.count_nonzero(close), f))
+                more[2].append(self.uv[f][j[close]])
+            untried[ask] = bound
+        return tuple(np.concatenate(x) for x in more) + (untried,)
+
+
 def point_in_domain(domain, uv):
     """(inside (N,) bool, boundary distance (N,) in uv, exact below domain.index.reach and
     capped there) of parameter pairs against a face's domain."""
@@ -175,6 +330,7 @@ class FaceSet:
         self.samples = samples
         self.tree = cKDTree(samples.xyz)
         self._patch_boxes = None
+        self.cover = SampleCover(surfaces, domains, samples)
 
     def nearest_sample(self, points):
         """Index of each point's nearest sample."""
@@ -293,6 +449,82 @@ class FaceSet:
         if foot_start is not None:
             warm = foot_start.face[rows[pi]] == pf
             start[warm] = foot_start.uv[rows[pi[warm]]]
+        tried = self.try_faces(points, pi, pf, start)
+        # Hook (cover radius): faces none of whose samples is among the k nearest may still
+        # be nearer than the best candidate; SampleCover tries those that can be.
+        more_pi, more_pf, more_start, untried = self.cover.beyond(
+            points, pi, pf, idx[pi, cj], tried[0], tried[5], tried[2])
+        if len(more_pi):
+            more = self.try_faces(points, more_pi, more_pf, more_start)
+            pi, pf = np.concatenate([pi, more_pi]), np.concatenate([pf, more_pf])
+            tried = tuple(np.concatenate([x, y]) for x, y in zip(tried, more))
+        dist, lower, trusted, on_edge, converged_pair, closest, uv, normal, boundary = tried
+        m = len(pi)
+        # Per point: the best trusted candidate; doubtful candidates must not be able to beat it.
+        best_d = np.full(n, np.inf)
+        np.minimum.at(best_d, pi[trusted], dist[trusted])
+        is_best = trusted & (dist == best_d[pi])
+        best = np.full(n, -1)
+        best[pi[is_best]] = np.flatnonzero(is_best)
+        has_best = best >= 0
+        bp = np.where(has_best[pi], best[pi], 0)
+        # On an edge: the face across it reaches the same closest point (clamped there too, or,
+        # for a plane trimmed by that edge, the point lies in its plane). Such a partner is no
+        # threat, and the two outward normals together give the sign (their sum is the edge's
+        # pseudo-normal, which is right for any point whose closest point is on the edge).
+        planar = np.array([d.planar_scale is not None for d in self.domains])[pf]
+        partner = (has_best[pi] & on_edge[bp] & (np.arange(m) != bp) & converged_pair
+                   & ((on_edge & (np.linalg.norm(closest - closest[bp], axis=1) < 1e-7))
+                      | (planar & (np.abs(np.einsum("ij,ij->i", closest[bp] - closest, normal))
+                                   < 1e-9))))
+        threat = ~trusted & ~partner & (lower < best_d[pi] - 1e-12)
+        need = np.zeros(n, bool)
+        need[pi[threat]] = True
+        need |= ~has_best
+        # ... nor a face no sample of which was near enough to be tried (one without samples).
+        need |= untried < best_d - 1e-12
+        n_partner = np.bincount(pi[partner], minlength=n)
+        partner_normal = np.zeros((n, 3))
+        np.add.at(partner_normal, pi[partner], normal[partner])
+        good = ~need
+        edge = np.zeros(n, bool)
+        edge[good] = on_edge[best[good]]
+        need |= edge & (n_partner != 1)
+        need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
+        good = ~need
+        b = best[good]
+        # The lead of a point decided inside a face: the least gap from its winner to another
+        # candidate's lower bound (none at an edge, where the partner face is as near).
+        lead = np.full(n, np.inf)
+        other = np.arange(m) != bp
+        np.minimum.at(lead, pi[other], lower[other] - best_d[pi[other]])
+        lead = np.minimum(lead, untried - best_d)
+        decided = rows[good]
+        c = closest[b]
+        nrm = normal[b].copy()
+        e = edge[good]
+        pseudo = nrm + np.where(e[:, None], partner_normal[good], 0.0)
+        diff = points[good] - c
+        sign = np.where(np.einsum("ij,ij->i", diff, pseudo) < 0, -1.0, 1.0)
+        if e.any():
+            # At an edge the distance runs along p - c, not along either face's normal.
+            de = np.maximum(dist[b][e], 1e-300)
+            nrm[e] = sign[e, None] * diff[e] / de[:, None]
+        out.closest[decided] = c
+        out.face[decided] = pf[b]
+        out.uv[decided] = uv[b]
+        out.normal[decided] = nrm
+        out.distance[decided] = sign * dist[b]
+        out.fallback[decided] = False
+        out.lead[decided] = np.where(e, -np.inf, lead[good])
+        out.nearest[decided] = sample_dist[good, 0]
+        out.boundary[decided] = boundary[b]
+        return rows[np.flatnonzero(need)]
+
+    def try_faces(self, points, pi, pf, start):
+        """Newton on face pf[j] for point points[pi[j]] from (u, v) start[j], per face -> the
+        candidates' (distance, lower bound of the face's distance, trusted, on an edge,
+        converged, closest point, (u, v), outward normal, uv distance to the boundary)."""
         m = len(pi)
         dist = np.full(m, np.inf)
         lower = np.full(m, np.inf)       # a lower bound of the candidate's true face distance
@@ -339,63 +571,7 @@ class FaceSet:
                 trusted[j] = on_edge[j] = True
                 lower[j] = de
                 boundary[j] = 0.0
-        # Per point: the best trusted candidate; doubtful candidates must not be able to beat it.
-        best_d = np.full(n, np.inf)
-        np.minimum.at(best_d, pi[trusted], dist[trusted])
-        is_best = trusted & (dist == best_d[pi])
-        best = np.full(n, -1)
-        best[pi[is_best]] = np.flatnonzero(is_best)
-        has_best = best >= 0
-        bp = np.where(has_best[pi], best[pi], 0)
-        # On an edge: the face across it reaches the same closest point (clamped there too, or,
-        # for a plane trimmed by that edge, the point lies in its plane). Such a partner is no
-        # threat, and the two outward normals together give the sign (their sum is the edge's
-        # pseudo-normal, which is right for any point whose closest point is on the edge).
-        planar = np.array([d.planar_scale is not None for d in self.domains])[pf]
-        partner = (has_best[pi] & on_edge[bp] & (np.arange(m) != bp) & converged_pair
-                   & ((on_edge & (np.linalg.norm(closest - closest[bp], axis=1) < 1e-7))
-                      | (planar & (np.abs(np.einsum("ij,ij->i", closest[bp] - closest, normal))
-                                   < 1e-9))))
-        threat = ~trusted & ~partner & (lower < best_d[pi] - 1e-12)
-        need = np.zeros(n, bool)
-        need[pi[threat]] = True
-        need |= ~has_best
-        n_partner = np.bincount(pi[partner], minlength=n)
-        partner_normal = np.zeros((n, 3))
-        np.add.at(partner_normal, pi[partner], normal[partner])
-        good = ~need
-        edge = np.zeros(n, bool)
-        edge[good] = on_edge[best[good]]
-        need |= edge & (n_partner != 1)
-        need[good] |= best_d[good] > sample_dist[good, 0] + SAMPLE_SLACK
-        good = ~need
-        b = best[good]
-        # The lead of a point decided inside a face: the least gap from its winner to another
-        # candidate's lower bound (none at an edge, where the partner face is as near).
-        lead = np.full(n, np.inf)
-        other = np.arange(m) != bp
-        np.minimum.at(lead, pi[other], lower[other] - best_d[pi[other]])
-        decided = rows[good]
-        c = closest[b]
-        nrm = normal[b].copy()
-        e = edge[good]
-        pseudo = nrm + np.where(e[:, None], partner_normal[good], 0.0)
-        diff = points[good] - c
-        sign = np.where(np.einsum("ij,ij->i", diff, pseudo) < 0, -1.0, 1.0)
-        if e.any():
-            # At an edge the distance runs along p - c, not along either face's normal.
-            de = np.maximum(dist[b][e], 1e-300)
-            nrm[e] = sign[e, None] * diff[e] / de[:, None]
-        out.closest[decided] = c
-        out.face[decided] = pf[b]
-        out.uv[decided] = uv[b]
-        out.normal[decided] = nrm
-        out.distance[decided] = sign * dist[b]
-        out.fallback[decided] = False
-        out.lead[decided] = np.where(e, -np.inf, lead[good])
-        out.nearest[decided] = sample_dist[good, 0]
-        out.boundary[decided] = boundary[b]
-        return rows[np.flatnonzero(need)]
+        return dist, lower, trusted, on_edge, converged_pair, closest, uv, normal, boundary
 
     def on_boundary(self, f, p):
         """(distance, closest point, its (u, v), outward unit normal there, exact) of points
