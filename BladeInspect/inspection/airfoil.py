@@ -38,6 +38,8 @@ SCALARS = ("chord_mm", "axial_chord_mm", "stagger_deg", "max_thickness_mm",
            "outlet_angle_deg", "area_mm2", "twist_deg", "form_mm", "form_location_mm")
 LISTS = ("le_thickness_mm", "te_thickness_mm", "centroid_mm", "shift_mm")
 POSITION = ("twist_deg", "form_mm", "form_location_mm", "shift_mm")
+# Characteristics that are maxima over the points (their u includes the maximum's bias)
+MAXIMA = ("form_mm", "form_location_mm")
 CHARACTERISTICS = SCALARS + LISTS
 DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
@@ -437,15 +439,18 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     # The sensor's systematic error: one reading bias b per draw (rectangular within the stated
     # accuracy), each point's deviation moved by b s_i, s_i what is left of a unit bias along
     # its beam after the registration has taken up what a rigid motion can (1 without beams).
-    accuracy = (SensorModel().accuracy if opts.accuracy_mm is None else float(opts.accuracy_mm))
+    sensor = (SensorModel() if opts.accuracy_mm is None
+              else SensorModel(accuracy=float(opts.accuracy_mm)))
+    accuracy = sensor.accuracy
     response = uncertainty_mod.systematic_coefficients(result)
     response = np.ones(len(idx)) if response is None else np.asarray(response)[idx]
+    sigma, unit = _point_noise_model(result, idx, sensor, noise)
     draws = []
     for _ in range(max(int(opts.draws), 2)):
         d = chol @ rng.standard_normal(6)
         R = tf.rotation_from_vector(d[3:])
         moved = (smooth3 - centre) @ R.T + centre + d[:3]
-        moved = moved + out_normal * (noise * rng.standard_normal(len(moved)))[:, None]
+        moved = moved + out_normal * (sigma * unit(rng, len(moved)))[:, None]
         moved = moved + n0 * (rng.uniform(-accuracy, accuracy) * response)[:, None]
         p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
         try:
@@ -458,13 +463,44 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     keys = _flat(measured_values).keys()
     sd = {key: _draws_sd([d[key] for d in draws if key in d])
           for key in keys if sum(key in d for d in draws) >= 2}
+    # The contour's form values are maxima over the points: a draw's is biased up by its noise
+    # as the measured one is, so their u is the draws' RMS error about the noise-free smooth
+    # fit's value (bias included, as for a worst deviation; docs/fits.md).
+    base = frame.to_2d(_into_plane(smooth3, n0, frame.origin, frame.normal))
+    ordered = kernel.order_by_nominal(base, nom.profile)
+    fit = kernel.fit_section(ordered, nom.profile, pivot=nom.centroid_mm)
+    zone = kernel.contour(ordered, nom, fit)["all"]
+    for key in MAXIMA:
+        if key in sd and zone.get(key) is not None:
+            sd[key] = _draws_rms([d[key] for d in draws if key in d], zone[key])
     return _unflat(sd, measured_values)
+
+
+def _point_noise_model(result, idx, sensor, scatter):
+    """(sigma (n,), unit-variance sampler) of the section's readings' noise along the normal
+    for the draws: each reading's own sigma_beam(SNR) cos(theta) in the sensor's distribution
+    (inspection.uncertainty.normal_noise, the deviations' model); the section's point-to-point
+    scatter where a reading's SNR or beam gives none."""
+    sigma = uncertainty_mod.normal_noise(result, idx, sensor)
+    if result.snr is None:
+        sigma = np.full(len(idx), scatter)
+    sigma = np.where(np.isfinite(sigma), sigma, scatter)
+    return sigma, uncertainty_mod.unit_noise(sensor)
 
 
 # A draw farther than this many robust sigmas (1.4826 MAD) from the draws' median is a failure
 # of that re-fit (an offset station off the end of a nose), not scatter: 12 normal draws hold
 # one so far in a thousand sets (the MAD of 12 is itself loose; 5 would drop one in 35).
 DRAW_OUTLIER_SIGMAS = 10.0
+
+
+def _draws_rms(values, reference):
+    """RMS of the draws' errors about ``reference`` without the failed draws (as _draws_sd)."""
+    v = np.asarray(values, dtype=float)
+    spread = 1.4826 * np.median(np.abs(v - np.median(v)))
+    if spread > 0:
+        v = v[np.abs(v - np.median(v)) <= DRAW_OUTLIER_SIGMAS * spread]
+    return float(np.sqrt(np.mean((v - reference) ** 2))) if len(v) >= 2 else float("nan")
 
 
 def _draws_sd(values):
