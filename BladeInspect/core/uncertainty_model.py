@@ -21,9 +21,9 @@ sigma), in closed form.
 import numpy as np
 
 COMPETING_SIGMAS = 2.0
-DRAWS = 4000
+DRAWS = 1000
 _FIXED_POINT_ROUNDS = 4
-_MAX_SAMPLES = 4_000_000
+_MAX_SAMPLES = 500_000
 _MIN_DRAWS = 200
 # The sensor's noise stays within this many sigmas (uniform: sqrt 3; clipped normal: ~3)
 FOLD_SIGMAS = 4.0
@@ -34,17 +34,13 @@ def uniform_unit_noise(rng, shape):
     return rng.uniform(-np.sqrt(3.0), np.sqrt(3.0), shape)
 
 
-def competing(deviation, sigma, spread=None, competing_sigmas=COMPETING_SIGMAS):
-    """(index of the largest |deviation|, boolean mask of the readings competing with it).
-    ``spread``: (N,) 1 sigma of what the shared terms can move a reading against the worst
-    one (0 when not given)."""
+def competing(deviation, sigma, competing_sigmas=COMPETING_SIGMAS):
+    """(index of the largest |deviation|, boolean mask of the readings competing with it)."""
     dev = np.abs(np.asarray(deviation, dtype=float))
     sigma = np.asarray(sigma, dtype=float)
     worst = int(np.argmax(dev))
-    spread = np.zeros(len(dev)) if spread is None else np.asarray(spread, dtype=float)
     with np.errstate(invalid="ignore"):
-        mask = dev >= dev[worst] - competing_sigmas * np.sqrt(sigma[worst] ** 2 + sigma ** 2
-                                                              + spread ** 2)
+        mask = dev >= dev[worst] - competing_sigmas * np.sqrt(sigma[worst] ** 2 + sigma ** 2)
     mask[worst] = True
     return worst, mask
 
@@ -68,7 +64,8 @@ class SharedTerm:
 def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
               competing_sigmas=COMPETING_SIGMAS, draws=DRAWS, seed=0, equal_sigma_max=None):
     """The error of the reported max |deviation| as an estimate of the true largest
-    |deviation| (module notes): (terms {name: mm}, bias, number of competing readings).
+    |deviation| (module notes): (terms {name: mm}, bias, number of competing readings), the
+    bias that of the noise and the sampled shared terms together.
     The terms' root sum of squares is the RMS error, bias included: "noise_mm" that of the
     noise alone, then each SharedTerm in ``shared`` that moves the competitors differently
     what it adds, sampled with the noise (its largest push is what the maximum takes). A
@@ -83,10 +80,10 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
     sigma = np.asarray(sigma, dtype=float).reshape(-1)
     rng = np.random.default_rng(seed)
     probe = [t.sample(rng, _MIN_DRAWS) for t in shared]
-    w0 = int(np.argmax(np.abs(dev)))
-    relative = sum((t.moves(z) - t.moves(z, [w0])) ** 2 for t, z in zip(shared, probe))
-    spread = np.sqrt(np.mean(relative, axis=0)) if len(shared) else None
-    worst, mask = competing(dev, sigma, spread, competing_sigmas)
+    # The competitors are those the noise could have ranked above the worst. A reading further
+    # below that a shared term could push up is left out: its measured level already holds
+    # this scan's push, and adding a fresh one to it would count that push twice.
+    worst, mask = competing(dev, sigma, competing_sigmas)
     n = int(np.count_nonzero(mask))
     reported = abs(dev[worst])
     common = sigma[mask]
@@ -115,14 +112,13 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
         for k in range(len(varying) + 1):
             moved = noise + sum(pushes[:k]) if k else noise
             level = reported
-            for _ in range(_FIXED_POINT_ROUNDS):
+            for _ in range(_FIXED_POINT_ROUNDS + 1):
                 error = np.abs(side * level + moved).max(axis=1) - level
-                level = max(reported - float(error.mean()), 0.0)
-            error = np.abs(side * level + moved).max(axis=1) - level
+                if _ < _FIXED_POINT_ROUNDS:
+                    level = max(reported - float(error.mean()), 0.0)
             rms = float(np.sqrt(np.mean(error ** 2)))
             name = "noise_mm" if k == 0 else varying[k - 1].name
             terms[name] = float(np.sqrt(max(rms ** 2 - total ** 2, 0.0)))
             total = rms
-            if k == 0:
-                bias = float(error.mean())
+            bias = float(error.mean())
     return terms, bias, n

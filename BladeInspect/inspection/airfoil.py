@@ -27,6 +27,7 @@ from ..core import airfoil as kernel
 from ..core import contracts
 from ..core import decision as decision_mod
 from ..core import transforms as tf
+from ..core import uncertainty_model
 from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 from . import uncertainty as uncertainty_mod
@@ -398,8 +399,8 @@ def _section(nominal, plane, opts, result, rng):
     measured_values["zones"] = cont
     block["measured"] = measured_values
     if opts.draws:
-        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
-                                            measured_values)
+        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, fit, opts, noise,
+                                            rng, measured_values)
     return sr
 
 
@@ -418,7 +419,7 @@ def _measure_at(xyz, normals, frame, nom, opts):
     return ch, fit, cont, ordered, noise
 
 
-def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values):
+def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values):
     """1 sigma of each measured characteristic by re-fitting perturbed points (module notes)."""
     xyz0 = result.points_cad[idx]
     n0 = result.normal[idx]
@@ -463,17 +464,37 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     keys = _flat(measured_values).keys()
     sd = {key: _draws_sd([d[key] for d in draws if key in d])
           for key in keys if sum(key in d for d in draws) >= 2}
-    # The contour's form values are maxima over the points: a draw's is biased up by its noise
-    # as the measured one is, so their u is the draws' RMS error about the noise-free smooth
-    # fit's value (bias included, as for a worst deviation; docs/fits.md).
-    base = frame.to_2d(_into_plane(smooth3, n0, frame.origin, frame.normal))
-    ordered = kernel.order_by_nominal(base, nom.profile)
-    fit = kernel.fit_section(ordered, nom.profile, pivot=nom.centroid_mm)
-    zone = kernel.contour(ordered, nom, fit)["all"]
-    for key in MAXIMA:
-        if key in sd and zone.get(key) is not None:
-            sd[key] = _draws_rms([d[key] for d in draws if key in d], zone[key])
+    for key, bias in _maxima_bias(result, idx, pts, nom, fit, sigma, sensor).items():
+        if key in sd:
+            sd[key] = float(np.hypot(sd[key], bias))
     return _unflat(sd, measured_values)
+
+
+def _maxima_bias(result, idx, pts, nom, fit, sigma, sensor):
+    """{form key: bias} of the contour's form values, which are maxima over the section's
+    readings: the largest of several noisy readings lies above the true largest (as for a
+    worst deviation, inspection.uncertainty.maximum_error with the same noise, systematic
+    bias and pose). form_location_mm is twice the largest |deviation| before the section's
+    fit; form_mm the largest less the smallest deviation after it, both ends biased outwards.
+    The draws' scatter of a form value does not hold this bias (their maxima are as biased
+    as the measured one); u states both."""
+    model = uncertainty_mod.MeasurementModel(sensor=sensor)
+    shared = uncertainty_mod.shared_terms(result, idx, model)
+    flipped = [uncertainty_model.SharedTerm(t.name, -t.coefficients, t.sample)
+               for t in shared]
+    before = kernel.signed_deviation(pts, nom.profile)[0]
+    theta = -np.radians(fit.twist_deg)
+    c, s = np.cos(theta), np.sin(theta)
+    turn = np.array([[c, -s], [s, c]])
+    after = kernel.signed_deviation((pts - fit.pivot) @ turn.T + fit.pivot
+                                    - turn @ fit.shift_mm, nom.profile)[0]
+    # the ends of the after-fit range as maxima of readings clear of zero
+    span = float(after.max() - after.min()) + 1.0
+    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model)
+    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model)
+    _, bottom, _ = uncertainty_mod.maximum_error(after.max() + span - after, sigma, flipped,
+                                                 model)
+    return {"form_location_mm": 2.0 * location, "form_mm": top + bottom}
 
 
 def _point_noise_model(result, idx, sensor, scatter):
@@ -492,15 +513,6 @@ def _point_noise_model(result, idx, sensor, scatter):
 # of that re-fit (an offset station off the end of a nose), not scatter: 12 normal draws hold
 # one so far in a thousand sets (the MAD of 12 is itself loose; 5 would drop one in 35).
 DRAW_OUTLIER_SIGMAS = 10.0
-
-
-def _draws_rms(values, reference):
-    """RMS of the draws' errors about ``reference`` without the failed draws (as _draws_sd)."""
-    v = np.asarray(values, dtype=float)
-    spread = 1.4826 * np.median(np.abs(v - np.median(v)))
-    if spread > 0:
-        v = v[np.abs(v - np.median(v)) <= DRAW_OUTLIER_SIGMAS * spread]
-    return float(np.sqrt(np.mean((v - reference) ** 2))) if len(v) >= 2 else float("nan")
 
 
 def _draws_sd(values):

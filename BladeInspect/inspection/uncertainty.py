@@ -244,26 +244,38 @@ def worst_terms(result, candidates, model=None):
     candidates, dev, noise = candidates[usable], dev[usable], noise[usable]
     worst = int(candidates[np.argmax(np.abs(dev))])
     terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
+    sampled, _, n = maximum_error(dev, noise, shared_terms(result, candidates, model), model)
+    terms.update(sampled)
+    return worst, terms, n
+
+
+def maximum_error(values, noise, shared, model):
+    """core.uncertainty_model.max_error of these readings in the model's sensor noise."""
+    return uncertainty_model.max_error(
+        values, noise, unit_noise(model.sensor), shared,
+        equal_sigma_max=lambda k: max_of_draws(k, model.sensor.noise))
+
+
+def shared_terms(result, index, model):
+    """The errors common to the readings ``index`` as core.uncertainty_model.SharedTerm: the
+    systematic bias (b s_i, b uniform in +-accuracy) and, when finite, the pose (J_i d, d
+    drawn from the pose covariance)."""
     shared = []
     coefficient = systematic_coefficients(result)
     a = model.sensor.accuracy
     shared.append(uncertainty_model.SharedTerm(
-        "systematic_mm", np.ones(len(candidates)) if coefficient is None
-        else coefficient[candidates], lambda rng, k: rng.uniform(-a, a, (k, 1))))
+        "systematic_mm", np.ones(len(index)) if coefficient is None
+        else coefficient[index], lambda rng, k: rng.uniform(-a, a, (k, 1))))
     cov = np.asarray(result.pose_covariance, dtype=float)
     if np.all(np.isfinite(cov)):
-        normal = np.asarray(result.normal, dtype=float)[candidates]
-        arm = np.asarray(result.points_cad, dtype=float)[candidates] - np.asarray(result.center)
+        normal = np.asarray(result.normal, dtype=float)[index]
+        arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
         w, V = np.linalg.eigh(0.5 * (cov + cov.T))
         root = V * np.sqrt(np.clip(w, 0.0, None))
         shared.append(uncertainty_model.SharedTerm(
             "pose_mm", np.hstack([normal, np.cross(arm, normal)]),
             lambda rng, k: rng.standard_normal((k, 6)) @ root.T))
-    sampled, _, n = uncertainty_model.max_error(
-        dev, noise, unit_noise(model.sensor), shared,
-        equal_sigma_max=lambda k: max_of_draws(k, model.sensor.noise))
-    terms.update(sampled)
-    return worst, terms, n
+    return shared
 
 
 def worst_expanded_uncertainty(result, candidates, model=None):
