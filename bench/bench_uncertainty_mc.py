@@ -25,8 +25,10 @@ default re-fits), averaged over the first STATED trials.
 The worst deviation is a maximum over points: where several points compete for it the maximum
 is biased up and scatters less than one reading. The table therefore gives, beside the
 scatter (1 sd), the RMS error against the truth (the injected field's largest |value| over the
-same points; for an airfoil characteristic, the noise-free chain's value), and rows "max-aware"
-with U as the error of a maximum (uncertainty.worst_terms). Trials more than 5 robust sigmas
+same points; for an airfoil characteristic, the noise-free chain's value); the verdict's U is
+that of the error of a maximum (uncertainty.worst_terms). Column "judged" compares a maximum
+(a worst deviation, form_mm, form_location_mm; marked *) with its RMS error, any other value
+with its scatter. Trials more than 5 robust sigmas
 from the median are counted (column "out"), not averaged in. `--sensitivity` prints instead
 what the systematic term really does to each value through the chain (noise-free scans with a
 bias of +-accuracy).

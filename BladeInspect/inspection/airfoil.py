@@ -9,11 +9,14 @@ within ~1 um of the plane, where the two agree.
 
 Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
 draw moves the section's points by a pose drawn from the registration's covariance, lays
-fresh sensor noise (the section's own point-to-point scatter) on the measured profile's smooth
-fit at the same places, and adds one reading bias within the sensor's stated accuracy carried
-through the registration as inspection.uncertainty carries it for the deviations; the standard deviation of each characteristic over the draws is its
-uncertainty (a parametric bootstrap; bench/bench_airfoil_uncertainty.py compares it with the
-scatter over repeated simulated scans).
+fresh sensor noise on the measured profile's smooth fit at the same places -- each reading's
+own sigma along the normal, sigma_beam(SNR) cos(theta), in the sensor's distribution
+(inspection.uncertainty.normal_noise; the section's point-to-point scatter only for readings
+without SNR) -- and adds one reading bias within the sensor's stated accuracy carried
+through the registration as inspection.uncertainty carries it for the deviations; the standard
+deviation of each characteristic over the draws is its uncertainty (a parametric bootstrap;
+bench/bench_uncertainty_mc.py compares it with the whole chain's scatter). The contour's form
+values are maxima: their u adds the maximum's bias (_maxima_bias) to the draws' scatter.
 """
 
 import csv
@@ -500,13 +503,13 @@ def _maxima_bias(result, idx, pts, nom, fit, sigma, sensor):
 def _point_noise_model(result, idx, sensor, scatter):
     """(sigma (n,), unit-variance sampler) of the section's readings' noise along the normal
     for the draws: each reading's own sigma_beam(SNR) cos(theta) in the sensor's distribution
-    (inspection.uncertainty.normal_noise, the deviations' model); the section's point-to-point
-    scatter where a reading's SNR or beam gives none."""
-    sigma = uncertainty_mod.normal_noise(result, idx, sensor)
+    (inspection.uncertainty.normal_noise, the deviations' model); for readings without SNR
+    (another sensor's points) the section's point-to-point scatter as a normal noise."""
     if result.snr is None:
-        sigma = np.full(len(idx), scatter)
-    sigma = np.where(np.isfinite(sigma), sigma, scatter)
-    return sigma, uncertainty_mod.unit_noise(sensor)
+        return np.full(len(idx), scatter), lambda rng, n: rng.standard_normal(n)
+    sigma = uncertainty_mod.normal_noise(result, idx, sensor)
+    return (np.where(np.isfinite(sigma), sigma, scatter),
+            uncertainty_mod.unit_noise(sensor))
 
 
 # A draw farther than this many robust sigmas (1.4826 MAD) from the draws' median is a failure
@@ -700,8 +703,11 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                 "characteristics_file": opts.characteristics_file,
                 "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
                 "uncertainty_method": "re-fit of perturbed points: pose from the registration "
-                                      "covariance and sensor noise on the measured profile's "
-                                      "smooth fit, %d draws" % opts.draws,
+                                      "covariance, each reading's sensor noise along the "
+                                      "normal (sigma_beam cos incidence, the sensor's "
+                                      "distribution) on the measured profile's smooth fit and "
+                                      "the sensor's bias, %d draws; form values add the bias of "
+                                      "a maximum" % opts.draws,
                 "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1); a judged "
                                         "characteristic's U = %g u (its `decisions`)"
                                         % COVERAGE_FACTOR,

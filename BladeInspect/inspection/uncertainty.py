@@ -3,8 +3,10 @@
 A judged value is the signed deviation of one measured point (a section's worst, the part's
 worst). Its standard uncertainty combines, as independent terms (GUM, root sum of squares):
 
-- noise: the sensor's random error of that reading, sigma(SNR) of rig.sensor.SensorModel
-  (its sigma at SNR_ref scaled by sqrt(SNR_ref / SNR)); sigma_ref when the point has no SNR;
+- noise: the sensor's random error of that reading along the surface normal,
+  sigma(SNR) cos(theta) (normal_noise: sigma(SNR) of rig.sensor.SensorModel runs along the
+  beam, theta the incidence from the point's rotary angle; cos theta 1 without angle_deg);
+  sigma_ref when the point has no SNR;
 - systematic: the sensor's stated accuracy taken as a bias of unknown sign common to every
   reading, a rectangular distribution of half-width ``accuracy``: s_i * accuracy / sqrt(3).
   The bias lengthens every reading alike, moving each point along its beam; the registration
@@ -22,6 +24,10 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
 - fit: the pose covariance above is that of the least-squares fit of the same points; under a
   Chebyshev objective (minimax, tolerance) it states what the measurement determines, not that
   estimator's own, larger scatter, which is not included (core.fits, "Covariance").
+
+A worst deviation (a section's, a spot's, the part's: verdict.judge) is a maximum over points:
+its U is that of the error of a maximum (worst_terms, core.uncertainty_model), the upward bias
+of the largest of several noisy readings included in U rather than corrected.
 """
 
 from dataclasses import dataclass, field
@@ -48,8 +54,12 @@ class MeasurementModel:
     def to_json(self):
         return {
             "k": COVERAGE_FACTOR,
-            "noise": "sensor sigma(SNR): %.4g mm at SNR %g, times sqrt(SNR_ref / SNR)"
+            "noise": "sensor sigma(SNR) along the normal: %.4g mm at SNR %g, times "
+                     "sqrt(SNR_ref / SNR) cos(incidence)"
                      % (self.sensor.sigma_ref, self.sensor.snr_ref),
+            "worst": "a worst deviation's U is the error of the largest of the readings that "
+                     "compete for it (within %g combined noise sigmas), its upward bias "
+                     "included in U, not corrected" % COMPETING_SIGMAS,
             "systematic_mm": self.systematic_mm,
             "systematic": "stated accuracy %.4g mm as a rectangular bias of every reading: "
                           "s * accuracy / sqrt(3), s the deviation's change per unit bias "
