@@ -25,7 +25,8 @@ DRAWS = 1000
 _FIXED_POINT_ROUNDS = 4
 _MAX_SAMPLES = 500_000
 _MIN_DRAWS = 200
-# The sensor's noise stays within this many sigmas (uniform: sqrt 3; clipped normal: ~3)
+# A bound of the noise in sigmas when the caller gives none (uniform: sqrt 3; clipped normal
+# at 3 sigma: about 3)
 FOLD_SIGMAS = 4.0
 
 
@@ -62,7 +63,8 @@ class SharedTerm:
 
 
 def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
-              competing_sigmas=COMPETING_SIGMAS, draws=DRAWS, seed=0, equal_sigma_max=None):
+              competing_sigmas=COMPETING_SIGMAS, draws=DRAWS, seed=0, equal_sigma_max=None,
+              noise_bound_sigmas=FOLD_SIGMAS):
     """The error of the reported max |deviation| as an estimate of the true largest
     |deviation| (module notes): (terms {name: mm}, bias, number of competing readings), the
     bias that of the noise and the sampled shared terms together.
@@ -74,8 +76,8 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
     in closed form (as for a lone worst, n = 1). ``sigma``: each reading's noise 1 sigma along the deviation (mm).
     ``equal_sigma_max``: n -> (mean, sd) of the largest of n unit-variance draws in closed
     form, used instead of sampling the noise when the competitors share one sigma and their
-    level lies clear of zero (more than FOLD_SIGMAS sigmas, where |level + noise| is
-    level + noise)."""
+    level lies clear of zero (beyond ``noise_bound_sigmas``, the largest a reading's noise can
+    be in sigmas, where |level + noise| is level + noise)."""
     dev = np.asarray(deviation, dtype=float).reshape(-1)
     sigma = np.asarray(sigma, dtype=float).reshape(-1)
     rng = np.random.default_rng(seed)
@@ -98,7 +100,8 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
               and np.ptp(common) <= 1e-12 * common[0])
     if n == 1:
         terms["noise_mm"], bias = float(sigma[worst]), 0.0
-    elif closed and reported - common[0] * equal_sigma_max(n)[0] >= FOLD_SIGMAS * common[0]:
+    elif (closed and reported - common[0] * equal_sigma_max(n)[0]
+          >= noise_bound_sigmas * common[0]):
         mean, sd = equal_sigma_max(n)
         bias = float(common[0] * mean)
         terms["noise_mm"] = float(common[0] * np.hypot(mean, sd))
