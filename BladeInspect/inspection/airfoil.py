@@ -708,6 +708,9 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                       "distribution) on the measured profile's smooth fit and "
                                       "the sensor's bias, %d draws; form values add the bias of "
                                       "a maximum" % opts.draws,
+                # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
+                "uncertainty_relative_accuracy": (None if opts.draws < 2 else
+                                                  float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),
                 "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1); a judged "
                                         "characteristic's U = %g u (its `decisions`)"
                                         % COVERAGE_FACTOR,
