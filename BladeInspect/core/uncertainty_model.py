@@ -15,7 +15,9 @@ maximum less the bias itself (a fixed point). The readings' noise is each one's 
 the sensor's distribution (``unit_noise``: draws of unit variance, e.g. uniform, clipped
 normal). The error's mean (the bias) and standard deviation come from ``draws`` seeded
 samples of the competing readings; a lone competitor is a single reading (bias 0, its
-sigma), in closed form.
+sigma), in closed form. Errors common to the readings (``SharedTerm``: a reading bias the fit
+left unevenly, the pose) are sampled with the noise where they move the competitors
+differently, since the maximum then takes the largest push.
 """
 
 import numpy as np
