@@ -75,8 +75,11 @@ def suction_bump(nominal, height):
 class DecisionThroughVerdictTest(unittest.TestCase):
     """Constructed values at T - 2U, T - U/2, T + U/2, T + 2U, put on a cluster of points of a
     section: ISO 14253-1 gives pass, not proven, not proven, fail; simple acceptance pass,
-    pass, fail, fail. U from the stated model: the sensor's noise sigma at SNR_ref and its
-    accuracy a as a rectangular bias, a / sqrt(3) each, the pose covariance zero."""
+    pass, fail, fail. U from the stated model: the sensor's accuracy a as a rectangular bias,
+    a / sqrt(3), the pose covariance zero, and the noise term of a maximum: the six cluster
+    points tie for the worst, so the reported value is the largest of six readings of the
+    uniform noise U(-a, a), whose RMS error about their common level is, by the order
+    statistic's closed form, a sqrt(((n-1)/(n+1))^2 + 4n/((n+1)^2 (n+2))), n = 6."""
 
     @classmethod
     def setUpClass(cls):
@@ -84,7 +87,9 @@ class DecisionThroughVerdictTest(unittest.TestCase):
         cls.nominal = fx.demo_nominal()
         sensor = SensorModel()
         a = sensor.accuracy
-        cls.U = 2.0 * np.sqrt(2.0 * (a / np.sqrt(3.0)) ** 2)
+        n = 6
+        noise = a * np.sqrt(((n - 1.0) / (n + 1.0)) ** 2 + 4.0 * n / ((n + 1.0) ** 2 * (n + 2.0)))
+        cls.U = 2.0 * np.sqrt(noise ** 2 + (a / np.sqrt(3.0)) ** 2)
         cls.on = demo_cloud(cls.nominal, lambda p: np.zeros(len(p)))
         mid = cls.on[np.argmin(np.abs(cls.on[:, 2] - np.median(cls.on[:, 2])))]
         cls.cluster = np.argsort(np.linalg.norm(cls.on - mid, axis=1))[:6]

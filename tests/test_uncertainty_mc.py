@@ -4,9 +4,11 @@ text — under the default ISO 14253-1 rule, and the part's verdict is then not 
 value under simple acceptance passes (the files follow the rule, not a fixed word).
 
 The value is constructed: a cluster of points of one section moved along the CAD's normal to
-T - U/2, U stated by the model for points without SNR and a zero pose covariance:
-2 sqrt(2) a / sqrt(3) for the sensor's accuracy a (noise at SNR_ref and the systematic bias,
-a / sqrt(3) each). The Monte Carlo that checks U itself is bench/bench_uncertainty_mc.py."""
+T - U/2, U stated by the model for points without SNR and a zero pose covariance: the
+systematic bias a / sqrt(3) for the sensor's accuracy a and the noise term of the largest of
+the cluster's six tied readings of U(-a, a) (the order statistic's closed form, as
+tests/test_fit_pipeline.py states it). The Monte Carlo that checks U itself is
+bench/bench_uncertainty_mc.py."""
 import csv
 import dataclasses
 import html
@@ -29,7 +31,9 @@ class NotProvenInEveryFileTest(unittest.TestCase):
         from BladeInspect.rig.sensor import SensorModel
         cls.nominal = fx.demo_nominal()
         a = SensorModel().accuracy
-        cls.U = 2.0 * np.sqrt(2.0) * a / np.sqrt(3.0)
+        n = 6
+        noise = a * np.sqrt(((n - 1.0) / (n + 1.0)) ** 2 + 4.0 * n / ((n + 1.0) ** 2 * (n + 2.0)))
+        cls.U = 2.0 * np.sqrt(noise ** 2 + (a / np.sqrt(3.0)) ** 2)
         cls.value = T - cls.U / 2
         on = demo_cloud(cls.nominal, lambda p: np.zeros(len(p)))
         mid = on[np.argmin(np.abs(on[:, 2] - np.median(on[:, 2])))]

@@ -9,11 +9,14 @@ within ~1 um of the plane, where the two agree.
 
 Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
 draw moves the section's points by a pose drawn from the registration's covariance, lays
-fresh sensor noise (the section's own point-to-point scatter) on the measured profile's smooth
-fit at the same places, and adds one reading bias within the sensor's stated accuracy carried
-through the registration as inspection.uncertainty carries it for the deviations; the standard deviation of each characteristic over the draws is its
-uncertainty (a parametric bootstrap; bench/bench_airfoil_uncertainty.py compares it with the
-scatter over repeated simulated scans).
+fresh sensor noise on the measured profile's smooth fit at the same places -- each reading's
+own sigma along the normal, sigma_beam(SNR) cos(theta), in the sensor's distribution
+(inspection.uncertainty.normal_noise; the section's point-to-point scatter only for readings
+without SNR) -- and adds one reading bias within the sensor's stated accuracy carried
+through the registration as inspection.uncertainty carries it for the deviations; the standard
+deviation of each characteristic over the draws is its uncertainty (a parametric bootstrap;
+bench/bench_uncertainty_mc.py compares it with the whole chain's scatter). The contour's form
+values are maxima: their u adds the maximum's bias (_maxima_bias) to the draws' scatter.
 """
 
 import csv
@@ -27,6 +30,7 @@ from ..core import airfoil as kernel
 from ..core import contracts
 from ..core import decision as decision_mod
 from ..core import transforms as tf
+from ..core import uncertainty_model
 from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 from . import uncertainty as uncertainty_mod
@@ -38,6 +42,8 @@ SCALARS = ("chord_mm", "axial_chord_mm", "stagger_deg", "max_thickness_mm",
            "outlet_angle_deg", "area_mm2", "twist_deg", "form_mm", "form_location_mm")
 LISTS = ("le_thickness_mm", "te_thickness_mm", "centroid_mm", "shift_mm")
 POSITION = ("twist_deg", "form_mm", "form_location_mm", "shift_mm")
+# Characteristics that are maxima over the points (their u includes the maximum's bias)
+MAXIMA = ("form_mm", "form_location_mm")
 CHARACTERISTICS = SCALARS + LISTS
 DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
@@ -396,8 +402,8 @@ def _section(nominal, plane, opts, result, rng):
     measured_values["zones"] = cont
     block["measured"] = measured_values
     if opts.draws:
-        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, opts, noise, rng,
-                                            measured_values)
+        block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, fit, opts, noise,
+                                            rng, measured_values)
     return sr
 
 
@@ -416,7 +422,7 @@ def _measure_at(xyz, normals, frame, nom, opts):
     return ch, fit, cont, ordered, noise
 
 
-def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values):
+def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values):
     """1 sigma of each measured characteristic by re-fitting perturbed points (module notes)."""
     xyz0 = result.points_cad[idx]
     n0 = result.normal[idx]
@@ -437,15 +443,18 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     # The sensor's systematic error: one reading bias b per draw (rectangular within the stated
     # accuracy), each point's deviation moved by b s_i, s_i what is left of a unit bias along
     # its beam after the registration has taken up what a rigid motion can (1 without beams).
-    accuracy = (SensorModel().accuracy if opts.accuracy_mm is None else float(opts.accuracy_mm))
+    sensor = (SensorModel() if opts.accuracy_mm is None
+              else SensorModel(accuracy=float(opts.accuracy_mm)))
+    accuracy = sensor.accuracy
     response = uncertainty_mod.systematic_coefficients(result)
     response = np.ones(len(idx)) if response is None else np.asarray(response)[idx]
+    sigma, unit = _point_noise_model(result, idx, sensor, noise)
     draws = []
     for _ in range(max(int(opts.draws), 2)):
         d = chol @ rng.standard_normal(6)
         R = tf.rotation_from_vector(d[3:])
         moved = (smooth3 - centre) @ R.T + centre + d[:3]
-        moved = moved + out_normal * (noise * rng.standard_normal(len(moved)))[:, None]
+        moved = moved + out_normal * (sigma * unit(rng, len(moved)))[:, None]
         moved = moved + n0 * (rng.uniform(-accuracy, accuracy) * response)[:, None]
         p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
         try:
@@ -458,7 +467,49 @@ def _uncertainty(result, idx, frame, nom, ch, opts, noise, rng, measured_values)
     keys = _flat(measured_values).keys()
     sd = {key: _draws_sd([d[key] for d in draws if key in d])
           for key in keys if sum(key in d for d in draws) >= 2}
+    for key, bias in _maxima_bias(result, idx, pts, nom, fit, sigma, sensor).items():
+        if key in sd:
+            sd[key] = float(np.hypot(sd[key], bias))
     return _unflat(sd, measured_values)
+
+
+def _maxima_bias(result, idx, pts, nom, fit, sigma, sensor):
+    """{form key: bias} of the contour's form values, which are maxima over the section's
+    readings: the largest of several noisy readings lies above the true largest (as for a
+    worst deviation, inspection.uncertainty.maximum_error with the same noise, systematic
+    bias and pose). form_location_mm is twice the largest |deviation| before the section's
+    fit; form_mm the largest less the smallest deviation after it, both ends biased outwards.
+    The draws' scatter of a form value does not hold this bias (their maxima are as biased
+    as the measured one); u states both."""
+    model = uncertainty_mod.MeasurementModel(sensor=sensor)
+    shared = uncertainty_mod.shared_terms(result, idx, model)
+    flipped = [uncertainty_model.SharedTerm(t.name, -t.coefficients, t.sample)
+               for t in shared]
+    before = kernel.signed_deviation(pts, nom.profile)[0]
+    theta = -np.radians(fit.twist_deg)
+    c, s = np.cos(theta), np.sin(theta)
+    turn = np.array([[c, -s], [s, c]])
+    after = kernel.signed_deviation((pts - fit.pivot) @ turn.T + fit.pivot
+                                    - turn @ fit.shift_mm, nom.profile)[0]
+    # the ends of the after-fit range as maxima of readings clear of zero
+    span = float(after.max() - after.min()) + 1.0
+    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model)
+    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model)
+    _, bottom, _ = uncertainty_mod.maximum_error(after.max() + span - after, sigma, flipped,
+                                                 model)
+    return {"form_location_mm": 2.0 * location, "form_mm": top + bottom}
+
+
+def _point_noise_model(result, idx, sensor, scatter):
+    """(sigma (n,), unit-variance sampler) of the section's readings' noise along the normal
+    for the draws: each reading's own sigma_beam(SNR) cos(theta) in the sensor's distribution
+    (inspection.uncertainty.normal_noise, the deviations' model); for readings without SNR
+    (another sensor's points) the section's point-to-point scatter as a normal noise."""
+    if result.snr is None:
+        return np.full(len(idx), scatter), lambda rng, n: rng.standard_normal(n)
+    sigma = uncertainty_mod.normal_noise(result, idx, sensor)
+    return (np.where(np.isfinite(sigma), sigma, scatter),
+            uncertainty_mod.unit_noise(sensor))
 
 
 # A draw farther than this many robust sigmas (1.4826 MAD) from the draws' median is a failure
@@ -652,8 +703,14 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                 "characteristics_file": opts.characteristics_file,
                 "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
                 "uncertainty_method": "re-fit of perturbed points: pose from the registration "
-                                      "covariance and sensor noise on the measured profile's "
-                                      "smooth fit, %d draws" % opts.draws,
+                                      "covariance, each reading's sensor noise along the "
+                                      "normal (sigma_beam cos incidence, the sensor's "
+                                      "distribution) on the measured profile's smooth fit and "
+                                      "the sensor's bias, %d draws; form values add the bias of "
+                                      "a maximum" % opts.draws,
+                # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
+                "uncertainty_relative_accuracy": (None if opts.draws < 2 else
+                                                  float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),
                 "uncertainty_coverage": "standard uncertainty, 1 sigma (k = 1); a judged "
                                         "characteristic's U = %g u (its `decisions`)"
                                         % COVERAGE_FACTOR,

@@ -3,8 +3,10 @@
 A judged value is the signed deviation of one measured point (a section's worst, the part's
 worst). Its standard uncertainty combines, as independent terms (GUM, root sum of squares):
 
-- noise: the sensor's random error of that reading, sigma(SNR) of rig.sensor.SensorModel
-  (its sigma at SNR_ref scaled by sqrt(SNR_ref / SNR)); sigma_ref when the point has no SNR;
+- noise: the sensor's random error of that reading along the surface normal,
+  sigma(SNR) cos(theta) (normal_noise: sigma(SNR) of rig.sensor.SensorModel runs along the
+  beam, theta the incidence from the point's rotary angle; cos theta 1 without angle_deg);
+  sigma_ref when the point has no SNR;
 - systematic: the sensor's stated accuracy taken as a bias of unknown sign common to every
   reading, a rectangular distribution of half-width ``accuracy``: s_i * accuracy / sqrt(3).
   The bias lengthens every reading alike, moving each point along its beam; the registration
@@ -22,6 +24,10 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
 - fit: the pose covariance above is that of the least-squares fit of the same points; under a
   Chebyshev objective (minimax, tolerance) it states what the measurement determines, not that
   estimator's own, larger scatter, which is not included (core.fits, "Covariance").
+
+A worst deviation (a section's, a spot's, the part's: verdict.judge) is a maximum over points:
+its U is that of the error of a maximum (worst_terms, core.uncertainty_model), the upward bias
+of the largest of several noisy readings included in U rather than corrected.
 """
 
 from dataclasses import dataclass, field
@@ -29,8 +35,9 @@ from typing import Optional
 
 import numpy as np
 
+from ..core import uncertainty_model
 from ..core.errors import InputError
-from ..core.weights import beam_in_table
+from ..core.weights import SensorWeights, beam_in_table
 from ..rig.kinematics import read_rig_file
 from ..rig.sensor import SensorModel
 from ..rig.simulated import BEAM_MACHINE
@@ -47,8 +54,12 @@ class MeasurementModel:
     def to_json(self):
         return {
             "k": COVERAGE_FACTOR,
-            "noise": "sensor sigma(SNR): %.4g mm at SNR %g, times sqrt(SNR_ref / SNR)"
+            "noise": "sensor sigma(SNR) along the normal: %.4g mm at SNR %g, times "
+                     "sqrt(SNR_ref / SNR) cos(incidence)"
                      % (self.sensor.sigma_ref, self.sensor.snr_ref),
+            "worst": "a worst deviation's U is the error of the largest of the readings that "
+                     "compete for it (within %g combined noise sigmas), its upward bias "
+                     "included in U, not corrected" % COMPETING_SIGMAS,
             "systematic_mm": self.systematic_mm,
             "systematic": "stated accuracy %.4g mm as a rectangular bias of every reading: "
                           "s * accuracy / sqrt(3), s the deviation's change per unit bias "
@@ -89,11 +100,7 @@ def standard_terms(result, index, model=None):
     model = model or MeasurementModel()
     index = np.atleast_1d(np.asarray(index, dtype=int))
     n = len(index)
-    if result.snr is None:
-        noise = np.full(n, model.sensor.sigma_ref)
-    else:
-        snr = np.asarray(result.snr, dtype=float)[index]
-        noise = np.where(snr > 0, model.sensor.sigma(np.where(snr > 0, snr, 1.0)), np.inf)
+    noise = normal_noise(result, index, model.sensor)
     normal = np.asarray(result.normal, dtype=float)[index]
     arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
     J = np.hstack([normal, np.cross(arm, normal)])
@@ -110,10 +117,28 @@ def standard_terms(result, index, model=None):
     return terms
 
 
-def beam_directions(result):
-    """(N, 3) unit beam directions of the points in the CAD frame, from their rotary angles
-    (the nominal axis: a calibrated axis is within a fraction of a degree of it, which moves
-    these directions by as little), or None without an ``angle_deg`` column."""
+def normal_noise(result, index=None, sensor=None):
+    """(n,) 1 sigma of the readings' errors along the surface normal, what a deviation sees:
+    the noise runs along the beam, so it is sigma_beam(SNR) cos(theta), theta the incidence
+    between the beam and the normal (core.weights.SensorWeights, the same model the sensor
+    weights of the fit use); sigma_beam alone when the beams are not known (no angle_deg),
+    sigma_ref at SNR_ref when the readings have no SNR; inf where the SNR is not positive."""
+    sensor = sensor or SensorModel()
+    n_all = len(result.points_cad)
+    index = np.arange(n_all) if index is None else np.atleast_1d(np.asarray(index, dtype=int))
+    snr = (np.full(len(index), sensor.snr_ref) if result.snr is None
+           else np.asarray(result.snr, dtype=float)[index])
+    beams = _beams_measured(result)
+    if beams is None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(snr > 0, sensor.sigma_ref * np.sqrt(sensor.snr_ref / snr), np.inf)
+    model = SensorWeights(snr, beams[index], sensor.sigma_ref, sensor.snr_ref,
+                          sensor.max_incidence_rad)
+    return model.normal_sigma(result.measured_to_cad, np.asarray(result.normal)[index])
+
+
+def _beams_measured(result):
+    """(N, 3) unit beam directions in the measured frame from the rotary angles, or None."""
     from ..rig.kinematics import RigKinematics
     angles = (result.columns or {}).get("angle_deg")
     if angles is None:
@@ -121,8 +146,17 @@ def beam_directions(result):
     angles = np.asarray(angles, dtype=float)
     if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
         return None
-    to_cad = np.asarray(result.measured_to_cad, dtype=float)[:3, :3]
-    return beam_in_table(angles, RigKinematics().axis_direction, BEAM_MACHINE) @ to_cad.T
+    return beam_in_table(angles, RigKinematics().axis_direction, BEAM_MACHINE)
+
+
+def beam_directions(result):
+    """(N, 3) unit beam directions of the points in the CAD frame, from their rotary angles
+    (the nominal axis: a calibrated axis is within a fraction of a degree of it, which moves
+    these directions by as little), or None without an ``angle_deg`` column."""
+    beams = _beams_measured(result)
+    if beams is None:
+        return None
+    return beams @ np.asarray(result.measured_to_cad, dtype=float)[:3, :3].T
 
 
 def systematic_coefficients(result):
@@ -156,13 +190,15 @@ def expanded_uncertainty(result, index, model=None):
 # Points whose deviations lie within this many combined noise sigmas of the worst cannot be told
 # from it: any of them could have been the worst, and the reported one is the largest of their
 # noisy readings.
-COMPETING_SIGMAS = 2.0
+COMPETING_SIGMAS = uncertainty_model.COMPETING_SIGMAS
 
 
 def max_of_draws(n, noise="uniform"):
     """(mean, standard deviation) of the largest of ``n`` independent draws of the sensor's
     noise distribution scaled to unit variance (rig.sensor: uniform, or normal clipped at
-    NORMAL_CLIP_SIGMAS), from its order statistic's distribution F(x)^n on a fine grid."""
+    NORMAL_CLIP_SIGMAS), from its order statistic's distribution F(x)^n on a fine grid: the
+    closed form of worst_terms' sampled error for n readings of one sigma on a plateau well
+    away from zero (tests/test_worst_uncertainty.py holds the two together)."""
     from scipy.stats import norm
     from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
     n = max(int(n), 1)
@@ -182,28 +218,78 @@ def max_of_draws(n, noise="uniform"):
     return mean / s, float(np.sqrt(max(p @ (z - mean) ** 2, 0.0))) / s
 
 
+def unit_noise(sensor):
+    """The sensor's noise distribution at unit variance, as core.uncertainty_model draws it:
+    uniform, or normal clipped at NORMAL_CLIP_SIGMAS (rig.sensor)."""
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    if sensor.noise == "uniform":
+        return uncertainty_model.uniform_unit_noise
+    c = NORMAL_CLIP_SIGMAS
+    s = _clipped_normal_std(c)
+    return lambda rng, shape: np.clip(rng.standard_normal(shape), -c, c) / s
+
+
 def worst_terms(result, candidates, model=None):
     """The worst |deviation| among the points ``candidates`` and its standard uncertainty
     terms as the error of a maximum: (worst index, {term: mm}, number of competing points).
 
-    The terms common to neighbouring points (systematic, pose, calibration) move the worst with
-    the rest and stay as they are. The noise term is that of the largest of the n competing
-    readings (those within COMPETING_SIGMAS of the worst, the worst included): its RMS error
-    about a common true value, sigma * sqrt(mean^2 + sd^2) of max_of_draws(n) - for n = 1 the
-    single reading's sigma; for many competitors the selection bias of the maximum, which a
-    single point's sigma does not state (bench/bench_uncertainty_mc.py)."""
+    core.uncertainty_model.max_error: the competitors are the readings within
+    COMPETING_SIGMAS combined sigmas of the worst (their own noise along the normal,
+    normal_noise, and what the systematic bias and the pose can move them against it); the
+    terms' root sum of squares is the RMS error of their largest reading against the true
+    largest deviation, bias included. Noise is sampled in the sensor's distribution; the
+    systematic bias (b s_i, b uniform in +-accuracy) and the pose (J_i d, d from the pose
+    covariance) with it where they move the competitors differently (a bias the fit has taken
+    up at one point and not at its neighbour pushes one of them up), else they add their
+    variance at the worst as for a single reading; the calibration term is the single
+    reading's. The bias of the maximum is included in U, not corrected: the reported worst
+    deviation stays the measured one (docs/fits.md). A lone worst is a single reading."""
     model = model or MeasurementModel()
     candidates = np.atleast_1d(np.asarray(candidates, dtype=int))
-    dev = np.abs(np.asarray(result.deviation, dtype=float)[candidates])
-    worst = int(candidates[np.argmax(dev)])
-    noise = standard_terms(result, candidates, model)["noise_mm"]
-    w = int(np.argmax(dev))
-    competing = dev >= dev[w] - COMPETING_SIGMAS * np.sqrt(noise[w] ** 2 + noise ** 2)
-    n = int(np.count_nonzero(competing))
-    mean, sd = max_of_draws(n, model.sensor.noise)
+    dev = np.asarray(result.deviation, dtype=float)[candidates]
+    noise = normal_noise(result, candidates, model.sensor)
+    usable = np.isfinite(noise)
+    if not usable.any():
+        usable[:] = True
+    candidates, dev, noise = candidates[usable], dev[usable], noise[usable]
+    worst = int(candidates[np.argmax(np.abs(dev))])
     terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
-    terms["noise_mm"] = float(noise[w] * np.sqrt(mean ** 2 + sd ** 2))
+    sampled, _, n = maximum_error(dev, noise, shared_terms(result, candidates, model), model)
+    terms.update(sampled)
     return worst, terms, n
+
+
+def maximum_error(values, noise, shared, model):
+    """core.uncertainty_model.max_error of these readings in the model's sensor noise."""
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    bound = (np.sqrt(3.0) if model.sensor.noise == "uniform"
+             else NORMAL_CLIP_SIGMAS / _clipped_normal_std(NORMAL_CLIP_SIGMAS))
+    return uncertainty_model.max_error(
+        values, noise, unit_noise(model.sensor), shared,
+        equal_sigma_max=lambda k: max_of_draws(k, model.sensor.noise),
+        noise_bound_sigmas=bound)
+
+
+def shared_terms(result, index, model):
+    """The errors common to the readings ``index`` as core.uncertainty_model.SharedTerm: the
+    systematic bias (b s_i, b uniform in +-accuracy) and, when finite, the pose (J_i d, d
+    drawn from the pose covariance)."""
+    shared = []
+    coefficient = systematic_coefficients(result)
+    a = model.sensor.accuracy
+    shared.append(uncertainty_model.SharedTerm(
+        "systematic_mm", np.ones(len(index)) if coefficient is None
+        else coefficient[index], lambda rng, k: rng.uniform(-a, a, (k, 1))))
+    cov = np.asarray(result.pose_covariance, dtype=float)
+    if np.all(np.isfinite(cov)):
+        normal = np.asarray(result.normal, dtype=float)[index]
+        arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
+        w, V = np.linalg.eigh(0.5 * (cov + cov.T))
+        root = V * np.sqrt(np.clip(w, 0.0, None))
+        shared.append(uncertainty_model.SharedTerm(
+            "pose_mm", np.hstack([normal, np.cross(arm, normal)]),
+            lambda rng, k: rng.standard_normal((k, 6)) @ root.T))
+    return shared
 
 
 def worst_expanded_uncertainty(result, candidates, model=None):

@@ -147,17 +147,18 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
             worst = counted[np.argmax(counted_dev)]
             entry["worst_zone"] = sec.zone[np.flatnonzero(idx == worst)[0]] or None
             entry["worst_deviation_mm"] = float(dev[worst])
-            entry.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
-                result, worst, measurement_model)[0], tolerance, decision_rule))
+            # U of a maximum over the section's counted points (uncertainty.worst_terms)
+            entry.update(decided(dev[worst], uncertainty_mod.worst_expanded_uncertainty(
+                result, counted, measurement_model)[1], tolerance, decision_rule))
         if sec.cmm is not None:
             cmm_abs = np.abs(sec.cmm_deviation)
             entry["cmm_max_abs_mm"] = float(cmm_abs.max()) if len(cmm_abs) else None
             entry["cmm_pass"] = bool(len(cmm_abs) > 0 and (cmm_abs <= tolerance).all())
         sections_out.append(entry)
 
-    for spot, (_, worst, _) in zip(spot_out, spots):
-        spot.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
-            result, worst, measurement_model)[0], tolerance, decision_rule))
+    for spot, (_, worst, members) in zip(spot_out, spots):
+        spot.update(decided(dev[worst], uncertainty_mod.worst_expanded_uncertainty(
+            result, members, measurement_model)[1], tolerance, decision_rule))
     # The part's largest deviation among the fit's inliers (what minimax minimises), with its
     # own U and verdict: reported beside the sections'; the part's verdict is theirs and the
     # spots' (a defect the robust fit rejected is a spot, not an inlier).
@@ -168,8 +169,8 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
         worst = judged[np.argmax(np.abs(dev[judged]))]
         part = {"worst_deviation_mm": float(dev[worst]), "of": "the fit's inliers",
                 "xyz": result.points_cad[worst].tolist()}
-        part.update(decided(dev[worst], uncertainty_mod.expanded_uncertainty(
-            result, worst, measurement_model)[0], tolerance, decision_rule))
+        part.update(decided(dev[worst], uncertainty_mod.worst_expanded_uncertainty(
+            result, judged, measurement_model)[1], tolerance, decision_rule))
     decision = decision_mod.combine([s["verdict"] for s in sections_out if "verdict" in s]
                                     + [s["verdict"] for s in spot_out])
     passed = bool(not spots and all(s["pass"] is not False for s in sections_out)
