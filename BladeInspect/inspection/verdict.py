@@ -29,9 +29,10 @@ _ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction s
               "pressure": "pressure side", "": "unknown side"}
 
 
-def _spots(points, out_idx, neighbours):
-    """Groups of the out-of-tolerance points ``out_idx`` linked when one is among the other's
-    nearest measured points: (component label per out point, component sizes)."""
+def linked_groups(points, out_idx, neighbours):
+    """Groups of the points ``out_idx`` (the out-of-tolerance ones here; the fit's rejected
+    ones in inspection.airfoil) linked when one is among the other's nearest measured points:
+    (component label per point, component sizes)."""
     n = len(out_idx)
     if n == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
@@ -102,7 +103,7 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
         raise InputError("verdict: min_spot_points and spot_neighbours must be at least 1")
     dev = np.asarray(result.deviation, dtype=float)
     out_idx = np.flatnonzero(np.abs(dev) > tolerance)
-    labels, sizes = _spots(result.points_cad, out_idx, spot_neighbours)
+    labels, sizes = linked_groups(result.points_cad, out_idx, spot_neighbours)
     in_spot = np.zeros(len(dev), dtype=bool)
     in_spot[out_idx] = sizes[labels] >= int(min_spot_points) if len(out_idx) else False
     isolated = out_idx[~in_spot[out_idx]]
