@@ -27,7 +27,7 @@ import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, ".."))
-sys.path.insert(0, HERE)
+sys.path.insert(0, HERE)              # bench_airfoil_loop_edges
 from BladeInspect.core import airfoil, metal_angle_bound  # noqa: E402
 from tests.airfoil_shapes import ArcSection  # noqa: E402
 
@@ -53,7 +53,7 @@ def header(degrees):
 
 
 def dca(args, degrees):
-    from test_airfoil_metal_angle_bound import closed_form_crb
+    from tests.test_airfoil_metal_angle_bound import closed_form_crb
     sec = ArcSection(x_le=-24.0, x_te=27.0)
     rng = np.random.default_rng(11)
     for spacing in (0.02, 0.1):

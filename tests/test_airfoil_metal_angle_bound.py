@@ -16,14 +16,17 @@ import numpy as np
 from BladeInspect.core import airfoil, metal_angle_bound
 from tests.airfoil_shapes import ArcSection
 
-# The kernel's 1 sigma over SCANS seeded scans lies within this factor of the bound: at least
-# the bound (less the sampling error of a 1 sigma from SCANS scans, about 1/sqrt(2 SCANS) =
-# 11 %, and the kernel's window leaving out the last half edge radius, a few %), at most 1.7x
-# at the default 50 % window (measured: inlet 0.9x, outlet 1.5x over these 40 scans; at a 90 %
-# window 1.0x / 1.1x, bench/bench_airfoil_metal_angle.py). The former estimator, a quartic
-# fitted to the centres as sampled, was at 2.1x on the inlet (12.3 mdeg).
+# The kernel's 1 sigma over SCANS seeded scans lies within a factor of the bound: at least the
+# bound (less the sampling error of a 1 sigma from SCANS scans, about 1/sqrt(2 SCANS) = 11 %,
+# and the kernel's window leaving out the last half edge radius, a few %), at most HIGH times
+# it per window. Measured over these scans: at the default 50 % window 1.42x / 1.54x (inlet /
+# outlet; the former estimator, a quartic fitted to the centres as sampled: 1.45x / 1.54x --
+# the 50 % window is not yet efficient, its error heavy-tailed); at a 90 % window 1.0x / 1.1x
+# (the former estimator alike on these scans: its excess was one scan in 20 with a centre off
+# the locus, test_centre_off_the_locus_ignored).
 SCANS = 40
-LOW, HIGH = 0.75, 1.7
+LOW = 0.75
+HIGH = {airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT: 1.7, 90.0: 1.6}
 
 
 def closed_form_crb(sec, spacing, sigma, window_pct, degree=4, end="inlet"):
@@ -75,12 +78,18 @@ class MetalAngleAgainstItsBound(unittest.TestCase):
         cls.truth = airfoil.characteristics(prof)
         normal = prof.outward_normal(prof.point_params)
         rng = np.random.default_rng(20261202)
-        cls.err = {"inlet": [], "outlet": []}
-        for _ in range(SCANS):
-            noisy = cls.pts + rng.normal(0.0, cls.SIGMA, len(cls.pts))[:, None] * normal
-            ch = airfoil.characteristics(noisy, noise_mm=cls.SIGMA)
-            cls.err["inlet"].append(ch.inlet_angle_deg - cls.truth.inlet_angle_deg)
-            cls.err["outlet"].append(ch.outlet_angle_deg - cls.truth.outlet_angle_deg)
+        scans = [cls.pts + rng.normal(0.0, cls.SIGMA, len(cls.pts))[:, None] * normal
+                 for _ in range(SCANS)]
+        cls.errors = {}
+        for window in HIGH:
+            truth = airfoil.characteristics(prof, metal_angle_window_pct=window)
+            err = cls.errors[window] = {"inlet": [], "outlet": []}
+            for noisy in scans:
+                ch = airfoil.characteristics(noisy, noise_mm=cls.SIGMA,
+                                             metal_angle_window_pct=window)
+                err["inlet"].append(ch.inlet_angle_deg - truth.inlet_angle_deg)
+                err["outlet"].append(ch.outlet_angle_deg - truth.outlet_angle_deg)
+        cls.err = cls.errors[airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT]
 
     def test_exact_nominal_is_the_exact_tangent(self):
         self.assertAlmostEqual(self.truth.inlet_angle_deg, angle_of(self.sec.inlet_dir()),
@@ -89,16 +98,32 @@ class MetalAngleAgainstItsBound(unittest.TestCase):
                                delta=1e-3)
 
     def test_scatter_within_a_factor_of_the_bound(self):
-        for end in ("inlet", "outlet"):
-            crb = closed_form_crb(self.sec, self.SPACING, self.SIGMA,
-                                  airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT, end=end)
-            e = np.asarray(self.err[end])
-            sd = e.std(ddof=1)
-            with self.subTest(end=end, sd_mdeg=1e3 * sd, crb_mdeg=1e3 * crb):
-                self.assertGreater(sd, LOW * crb)
-                self.assertLess(sd, HIGH * crb)
-                # unbiased: the mean within 3 standard errors
-                self.assertLess(abs(e.mean()), 3.0 * sd / np.sqrt(len(e)))
+        for window, high in HIGH.items():
+            for end in ("inlet", "outlet"):
+                crb = closed_form_crb(self.sec, self.SPACING, self.SIGMA, window, end=end)
+                e = np.asarray(self.errors[window][end])
+                sd = e.std(ddof=1)
+                with self.subTest(window=window, end=end, sd_mdeg=1e3 * sd,
+                                  crb_mdeg=1e3 * crb):
+                    self.assertGreater(sd, LOW * crb)
+                    self.assertLess(sd, high * crb)
+                    # no bias beyond the mean's sampling error
+                    self.assertLess(abs(e.mean()), 3.5 * sd / np.sqrt(len(e)))
+
+    def test_centre_off_the_locus_ignored(self):
+        """Scan 14 of seed 11 (bench/bench_airfoil_metal_angle.py's first figures) has an
+        inscribed circle refined onto a wrong foot mid-locus, 0.13 mm off it: the former fit
+        read the inlet angle 49 mdeg off (8.5 x the bound); now within 3 x the bound."""
+        rng = np.random.default_rng(11)
+        prof = airfoil.Profile(self.pts)
+        normal = prof.outward_normal(prof.point_params)
+        for _ in range(15):
+            noisy = self.pts + rng.normal(0.0, self.SIGMA, len(self.pts))[:, None] * normal
+        ch = airfoil.characteristics(noisy, noise_mm=self.SIGMA)
+        window = airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT
+        for end, key in (("inlet", "inlet_angle_deg"), ("outlet", "outlet_angle_deg")):
+            crb = closed_form_crb(self.sec, self.SPACING, self.SIGMA, window, end=end)
+            self.assertLess(abs(getattr(ch, key) - getattr(self.truth, key)), 3.0 * crb)
 
     def test_bound_module_below_the_scatter(self):
         """core.metal_angle_bound's bound (a sub-model: a parabola deviation per side) is
