@@ -3,9 +3,9 @@
 The independent bound is a closed form of the definition's own model: the double-circular-arc
 section (tests/airfoil_shapes.py, sides exact circles, camber line an ellipse), each side a
 quartic in x over the kernel's window (x along the exact end tangent from the exact edge
-centre, over the window's share of the exact camber ellipse plus the skipped half edge
-radius), its points those the section is built from, normal noise sigma (sigma / cos(slope)
-in y); the camber line's slope at the edge is the mean of the two sides' slopes (the
+centre; the window from the skipped half edge radius over its share of the exact camber
+ellipse), its points those the section is built from, normal noise sigma (sigma / cos(slope)
+in y); the camber line's slope at the edge (x = 0) is the mean of the two sides' slopes (the
 inscribed circle's tangent bisects its contacts' tangents). CRB = 1/4 sum over the sides of
 g^T F^-1 g. No code of BladeInspect is used to compute it.
 """
@@ -16,17 +16,15 @@ import numpy as np
 from BladeInspect.core import airfoil, metal_angle_bound
 from tests.airfoil_shapes import ArcSection
 
-# The kernel's 1 sigma over SCANS seeded scans lies within a factor of the bound: at least the
-# bound (less the sampling error of a 1 sigma from SCANS scans, about 1/sqrt(2 SCANS) = 11 %,
-# and the kernel's window leaving out the last half edge radius, a few %), at most HIGH times
-# it per window. Measured over these scans: at the default 50 % window 1.42x / 1.54x (inlet /
-# outlet; the former estimator, a quartic fitted to the centres as sampled: 1.45x / 1.54x --
-# the 50 % window is not yet efficient, its error heavy-tailed); at a 90 % window 1.0x / 1.1x
-# (the former estimator alike on these scans: its excess was one scan in 20 with a centre off
-# the locus, test_centre_off_the_locus_ignored).
+# The kernel's 1 sigma over SCANS seeded scans lies within [LOW, HIGH] times the bound: at
+# least the bound less the sampling error of a 1 sigma from SCANS scans (about
+# 1/sqrt(2 SCANS) = 11 %), at most 1.35x. Measured over these scans: 1.04x / 1.13x (inlet /
+# outlet) at the default 50 % window, 1.14x / 1.04x at 90 % (the former estimator alike on
+# these scans; its excess was the rare scan with a centre off the locus,
+# test_centre_off_the_locus_ignored).
 SCANS = 40
-LOW = 0.75
-HIGH = {airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT: 1.7, 90.0: 1.6}
+LOW = 0.8
+HIGH = {airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT: 1.35, 90.0: 1.35}
 
 
 def closed_form_crb(sec, spacing, sigma, window_pct, degree=4, end="inlet"):
@@ -42,13 +40,14 @@ def closed_form_crb(sec, spacing, sigma, window_pct, degree=4, end="inlet"):
     xe = np.linspace(sec.C_le[0], sec.C_te[0], 20001)
     ellipse = np.array([sec.ellipse(x) for x in xe])
     locus = np.sum(np.linalg.norm(np.diff(ellipse, axis=0), axis=1))
-    x_far = 0.5 * r + window_pct / 100.0 * locus
+    x_near = 0.5 * r
+    x_far = x_near + window_pct / 100.0 * locus
     var = 0.0
     for origin, radius in ((sec.Os, sec.Rs), (sec.Op, sec.Rp)):
         on = np.abs(np.linalg.norm(pts - origin, axis=1) - radius) < 1e-9
         q = pts[on] - centre
         x = q @ t
-        keep = (x >= 0.0) & (x <= x_far)
+        keep = (x >= x_near) & (x <= x_far)
         radial = pts[on][keep] - origin
         radial /= np.linalg.norm(radial, axis=1)[:, None]
         tangent = np.column_stack([-radial[:, 1], radial[:, 0]])
@@ -57,7 +56,8 @@ def closed_form_crb(sec, spacing, sigma, window_pct, degree=4, end="inlet"):
         V = np.vander(x[keep] / x_far, degree + 1, increasing=True)
         F = (V / sigma_y[:, None] ** 2).T @ V
         g = np.zeros(degree + 1)
-        # d(angle)/d(coefficient of x/x_far) at x = 0, half of it (the mean of two sides)
+        # d(angle)/d(coefficient of x/x_far) at x = 0, half of it (the mean of two sides); the
+        # side's slope there about its slope at the window's start
         g[1] = 0.5 * np.cos(slope[np.argmin(x[keep])]) ** 2 / x_far
         var += g @ np.linalg.solve(F, g)
     return float(np.degrees(np.sqrt(var)))
@@ -125,19 +125,22 @@ class MetalAngleAgainstItsBound(unittest.TestCase):
             crb = closed_form_crb(self.sec, self.SPACING, self.SIGMA, window, end=end)
             self.assertLess(abs(getattr(ch, key) - getattr(self.truth, key)), 3.0 * crb)
 
-    def test_bound_module_below_the_scatter(self):
-        """core.metal_angle_bound's bound (a sub-model: a parabola deviation per side) is
-        below the estimator's scatter and scales as sigma / sqrt(n)."""
+    def test_bound_module_agrees_with_the_closed_form(self):
+        """core.metal_angle_bound's bound (the kernel's own rule differentiated on the
+        nominal, a degree-4 deviation per side over the window's arc) is the closed form's
+        within 10 % (0.05 mm spacing, the inlet)."""
         pts = self.sec.points(0.05)
         ch = airfoil.characteristics(pts)
-        b2 = metal_angle_bound.metal_angle_bound(pts, ch, pts, self.SIGMA, degree=2)
-        b2s = metal_angle_bound.metal_angle_bound(pts, ch, pts[::2], 2 * self.SIGMA, degree=2)
-        for end in ("inlet", "outlet"):
-            sd = np.std(self.err[end], ddof=1) * np.sqrt(0.05 / self.SPACING)
-            self.assertLess(b2[end]["crb_deg"], sd)
-            self.assertAlmostEqual(b2s[end]["crb_deg"] / b2[end]["crb_deg"],
-                                   2.0 * np.sqrt(2.0), delta=0.15)
-            self.assertGreater(b2[end]["spacing_for_target_mm"], 0.0)
+        end = "inlet"
+        span = metal_angle_bound.window_span_mm(ch, end)
+        g = metal_angle_bound.angle_gradient(pts, ch, end, span, 4)
+        F, n = metal_angle_bound.fisher(pts, self.SIGMA, ch, end, span, 4)
+        used = np.abs(g) > 0
+        crb = np.degrees(np.sqrt(g[used] @ np.linalg.solve(F[np.ix_(used, used)], g[used])))
+        closed = closed_form_crb(self.sec, 0.05, self.SIGMA,
+                                 airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT, end=end)
+        self.assertAlmostEqual(crb / closed, 1.0, delta=0.10)
+        self.assertGreater(n, 100)
 
 
 if __name__ == "__main__":

@@ -42,6 +42,8 @@ _FEET = 300                 # feet on one side seeding the inscribed circles
 _END_FEET = 17              # finer feet closing in on each end of the camber line
 _END_ROUNDS = 3
 _SEED_STRIDE = 4
+_RUN_GAP = 2                 # failed circles a run of camber-line circles may step over,
+_RUN_MIN = 10                # between runs at least this long
 # Consecutive input segments turning by more than this make a corner (not a rounded edge).
 _CORNER_DEG = 20.0
 _CORNER_RUN = 5
@@ -334,11 +336,25 @@ def _medial_axis(profile, a, b):
     # (a degenerate bisector that slid onto the axis) does not start it.
     edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
     starts, stops = edges[::2], edges[1::2]
+    # metal-angle hook: a lone circle mid-locus that fails (a foot refined onto a wrong
+    # stationary point) must not cut the camber line in two -- its longer half alone put
+    # the metal angle's window on half the locus (28 mdeg on the demo blade's 90 % section
+    # under a 0.2 um deviation); two runs of at least _RUN_MIN circles each, apart by at most
+    # _RUN_GAP failed ones, are one (short runs are the ill-conditioned ends' and strays').
+    merged = []
+    for first, stop in zip(starts, stops):
+        if merged and first - merged[-1][1] <= _RUN_GAP and stop - first >= _RUN_MIN \
+                and merged[-1][1] - merged[-1][2] >= _RUN_MIN:
+            merged[-1] = [merged[-1][0], stop, first]
+        else:
+            merged.append([first, stop, first])
+    starts = np.array([m[0] for m in merged], dtype=int)
+    stops = np.array([m[1] for m in merged], dtype=int)
     longest = int(np.argmax(stops - starts)) if len(starts) else 0
     if not len(starts) or stops[longest] - starts[longest] < 4:
         raise InputError("airfoil profile: fewer than 4 inscribed circles between its sides; "
                          "not an airfoil-like closed profile")
-    run = np.arange(starts[longest], stops[longest])
+    run = starts[longest] + np.flatnonzero(ok[starts[longest]:stops[longest]])
     # The two ends' rounds are independent: each round closes in on both at once (one
     # vectorised call for the feet of both ends).
     brackets = {}
