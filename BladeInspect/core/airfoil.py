@@ -44,6 +44,7 @@ _END_ROUNDS = 3
 _SEED_STRIDE = 4
 _RUN_GAP = 2                 # failed circles a run of camber-line circles may step over,
 _RUN_MIN = 10                # between runs at least this long
+_RUN_SHARE = 0.25            # and this share of the two
 # Consecutive input segments turning by more than this make a corner (not a rounded edge).
 _CORNER_DEG = 20.0
 _CORNER_RUN = 5
@@ -338,12 +339,14 @@ def _medial_axis(profile, a, b):
     # metal-angle hook: a lone circle mid-locus that fails (a foot refined onto a wrong
     # stationary point) must not cut the camber line in two -- its longer half alone put
     # the metal angle's window on half the locus (28 mdeg on the demo blade's 90 % section
-    # under a 0.2 um deviation); two runs of at least _RUN_MIN circles each, apart by at most
-    # _RUN_GAP failed ones, are one (short runs are the ill-conditioned ends' and strays').
+    # under a 0.2 um deviation); two runs apart by at most _RUN_GAP failed circles are one
+    # when each is at least _RUN_MIN circles and _RUN_SHARE of the two (a gap mid-locus; short
+    # runs are the ill-conditioned ends', a corner's and strays').
     merged = []
     for first, stop in zip(starts, stops):
-        if merged and first - merged[-1][1] <= _RUN_GAP and stop - first >= _RUN_MIN \
-                and merged[-1][1] - merged[-1][2] >= _RUN_MIN:
+        left, right = merged[-1][1] - merged[-1][2] if merged else 0, stop - first
+        if merged and first - merged[-1][1] <= _RUN_GAP \
+                and min(left, right) >= max(_RUN_MIN, _RUN_SHARE * (left + right)):
             merged[-1] = [merged[-1][0], stop, first]
         else:
             merged.append([first, stop, first])
