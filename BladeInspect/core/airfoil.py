@@ -514,6 +514,8 @@ def _end_quartic(c, r, edge, window_pct):
     quartic's coefficients (np.polyfit's, one column per axis). On the exact nominal no centre
     is dropped: the fit, and so the angle, is the former rule's to the bit."""
     s = _arc_from_end(c)
+    # The last stretch of the locus bends towards the centre of curvature of the edge's
+    # tightest point when the edge is not a circle: it is left out of the fit.
     skip = _END_SKIP * (r[-1] if edge is None else edge.radius)
 
     def window_of(s):
