@@ -36,11 +36,16 @@ KEYS = (("inlet", "inlet_angle_deg"), ("outlet", "outlet_angle_deg"))
 
 def row(label, end, errs, nominal, bounds, extra=""):
     e = 1e3 * np.asarray(errs)
+    read = np.isfinite(e)
+    if not read.all():
+        extra += "; measured in %d of %d scans" % (read.sum(), len(e))
+    e = e[read]
     cells = " ".join("%6.2f" % (1e3 * b[end]["crb_deg"]) for b in bounds)
     need = bounds[-1][end]
     print("  %-10s %-6s %9.4f %7.2f %7.2f %7.2f  %s  %6d %7.1f um %5.2f um%s"
-          % (label, end, nominal, e.mean(), e.std(ddof=1) if len(e) > 1 else np.nan,
-             np.abs(e).max(), cells, need["n_points"], 1e3 * need["spacing_for_target_mm"],
+          % (label, end, nominal, e.mean() if len(e) else np.nan,
+             e.std(ddof=1) if len(e) > 1 else np.nan, np.abs(e).max() if len(e) else np.nan,
+             cells, need["n_points"], 1e3 * need["spacing_for_target_mm"],
              1e3 * need["sigma_for_target_mm"], extra))
 
 
