@@ -58,6 +58,7 @@ class SurfaceData:
             if np.all(self.weights == self.weights.flat[0]):
                 self.weights = None
         self._homogeneous = None
+        self._power = None
 
     @property
     def rational(self):
@@ -72,6 +73,13 @@ class SurfaceData:
                 w = self.weights[..., None]
                 self._homogeneous = np.concatenate([self.poles * w, w], axis=2)
         return self._homogeneous
+
+    def power_patches(self):
+        """The surface's PowerPatches, built on first use: Newton's projection evaluates the
+        same surface many times."""
+        if self._power is None:
+            self._power = PowerPatches(self)
+        return self._power
 
 
 def find_span(knots, degree, t):
@@ -154,7 +162,13 @@ def _evaluate_chunk(surf, u, v, order):
             + (sv[:, None] - q + np.arange(q + 1))[:, None, :]).reshape(len(u), -1)
     block = hom.reshape(-1, hom.shape[2])[flat]                    # (N, (p+1)(q+1), 3|4)
     Dall = np.matmul(W, block)                                      # (N, combos, 3|4)
-    D = {kl: Dall[:, i] for i, kl in enumerate(combos)}
+    return _divide_out(surf, {kl: Dall[:, i] for i, kl in enumerate(combos)}, order)
+
+
+def _divide_out(surf, D, order):
+    """[S, Su, Sv(, Suu, Suv, Svv)] from the derivatives D[k, l] of the (homogeneous) surface:
+    the quotient rule for a rational one."""
+    combos = _COMBOS[:(1, 3, 6)[order]]
     if not surf.rational:
         return [D[kl] for kl in combos]
     A = {kl: d[:, :3] for kl, d in D.items()}
@@ -229,6 +243,7 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
     (u, v, S, Su, Sv, converged)."""
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     n = len(points)
+    patches = surf.power_patches()
     (ulo, uhi), (vlo, vhi) = surf.u_range, surf.v_range
     u = _wrap_or_clamp(np.asarray(u0, dtype=float) * np.ones(n), ulo, uhi, surf.closed_u)
     v = _wrap_or_clamp(np.asarray(v0, dtype=float) * np.ones(n), vlo, vhi, surf.closed_v)
@@ -246,7 +261,7 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
         if len(active) == 0:
             break
         ua, va, pa = u[active], v[active], points[active]
-        S, Su, Sv, Suu, Suv, Svv = evaluate(surf, ua, va, order=2)
+        S, Su, Sv, Suu, Suv, Svv = patches.evaluate(ua, va)
         r = S - pa
         f = np.einsum("ij,ij->i", r, r)
         worse = f > prev_f[active] * (1 + 1e-12) + 1e-24
@@ -262,7 +277,7 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
             u[wm] = _wrap_or_clamp(prev_u[wm] + scale[wm] * last_du[wm], ulo, uhi, surf.closed_u)
             v[wm] = _wrap_or_clamp(prev_v[wm] + scale[wm] * last_dv[wm], vlo, vhi, surf.closed_v)
             if len(ws):
-                out_S[ws], out_Su[ws], out_Sv[ws] = evaluate(surf, u[ws], v[ws], order=1)
+                out_S[ws], out_Su[ws], out_Sv[ws] = patches.evaluate(u[ws], v[ws], order=1)
             keep = ~worse
             active_next_retry = wm
             active = active[keep]
@@ -325,7 +340,8 @@ def project(surf, points, u0, v0, max_iter=40, tol=1e-11):
         u[g_idx], v[g_idx] = un[go], vn[go]
         active = np.concatenate([g_idx, active_next_retry])
     if len(active):
-        out_S[active], out_Su[active], out_Sv[active] = evaluate(surf, u[active], v[active], order=1)
+        out_S[active], out_Su[active], out_Sv[active] = patches.evaluate(u[active], v[active],
+                                                                          order=1)
     return u, v, out_S, out_Su, out_Sv, converged
 
 
@@ -353,53 +369,33 @@ class PowerPatches:
         # coefficient of s^k r^l: sum over the span's poles of both Taylor rows
         coef = np.einsum("ikr,ijrqc,jlq->ijlkc", Au, block, Av)
         self._c = hom.shape[2]
-        # (power of r, power of s, coordinate, patch): the patch index last, so a batch of
-        # points gathers its patches as rows of N contiguous values and the products below
-        # run over N at a time.
+        # (patch, power of r, (power of s, coordinate)): a point's patch is one gathered row
+        # block, contracted with the powers of r and then of s by two batched matrix products.
         self._coef = np.ascontiguousarray(
-            coef.reshape(len(su) * len(sv), q + 1, p + 1, self._c).transpose(1, 2, 3, 0))
+            coef.reshape(len(su) * len(sv), q + 1, (p + 1) * self._c))
 
-    def evaluate(self, u, v):
-        """(S, Su, Sv, Suu, Suv, Svv) at N parameter pairs, each (N, 3), as
-        ``evaluate(surf, u, v, order=2)``."""
+    def evaluate(self, u, v, order=2):
+        """Points and derivatives at N parameter pairs, as ``evaluate(surf, u, v, order)``:
+        (S, Su, Sv, Suu, Suv, Svv) for order 2, (S, Su, Sv) for 1, (S,) for 0; each (N, 3)."""
         surf = self.surf
         p, q = surf.degree_u, surf.degree_v
         u = np.atleast_1d(np.asarray(u, dtype=float))
         v = np.atleast_1d(np.asarray(v, dtype=float))
         u, v = np.broadcast_arrays(u, v)
         if len(u) > CHUNK:
-            parts = [self.evaluate(u[s:s + CHUNK], v[s:s + CHUNK]) for s in range(0, len(u), CHUNK)]
+            parts = [self.evaluate(u[s:s + CHUNK], v[s:s + CHUNK], order)
+                     for s in range(0, len(u), CHUNK)]
             return tuple(np.concatenate(d) for d in zip(*parts))
         (su, hu, _), (sv, hv, _) = self._u, self._v
         iu = find_span(surf.knots_u, p, u) - su[0]
         iv = find_span(surf.knots_v, q, v) - sv[0]
-        Mu = _powers(u - surf.knots_u[su[iu]], hu[iu], p)     # (3, p+1, N)
-        Mv = _powers(v - surf.knots_v[sv[iv]], hv[iv], q)
-        C = np.take(self._coef, iu * len(sv) + iv, axis=3)  # (q+1, p+1, c, N)
-        # sum over powers of r (0th..2nd v-derivative), then over powers of s
-        G = Mv[:, 0, None, None, :] * C[0]
-        for l in range(1, q + 1):
-            G += Mv[:, l, None, None, :] * C[l]                # (3, p+1, c, N)
-        D = {}
-        for kv, ku_max in ((0, 3), (1, 2), (2, 1)):
-            T = Mu[:ku_max, 0, None, :] * G[kv, 0]
-            for k in range(1, p + 1):
-                T += Mu[:ku_max, k, None, :] * G[kv, k]         # (ku_max, c, N)
-            for ku in range(ku_max):
-                D[ku, kv] = T[ku].T
-        if not surf.rational:
-            return tuple(D[kl] for kl in _COMBOS)
-        # Quotient rule, as in _evaluate_chunk.
-        A = {kl: d[:, :3] for kl, d in D.items()}
-        w = {kl: d[:, 3:4] for kl, d in D.items()}
-        w0 = w[0, 0]
-        S = A[0, 0] / w0
-        Su = (A[1, 0] - w[1, 0] * S) / w0
-        Sv = (A[0, 1] - w[0, 1] * S) / w0
-        Suu = (A[2, 0] - 2 * w[1, 0] * Su - w[2, 0] * S) / w0
-        Suv = (A[1, 1] - w[1, 0] * Sv - w[0, 1] * Su - w[1, 1] * S) / w0
-        Svv = (A[0, 2] - 2 * w[0, 1] * Sv - w[0, 2] * S) / w0
-        return S, Su, Sv, Suu, Suv, Svv
+        Mu = _powers(u - surf.knots_u[su[iu]], hu[iu], p, order)      # (N, order+1, p+1)
+        Mv = _powers(v - surf.knots_v[sv[iv]], hv[iv], q, order)
+        G = np.matmul(Mv, self._coef[iu * len(sv) + iv])              # (N, order+1, (p+1)c)
+        G = G.reshape(len(u), order + 1, p + 1, self._c)
+        T = np.matmul(Mu[:, None], G)                    # (N, kv, ku, c): d^ku/du d^kv/dv
+        D = {(ku, kv): T[:, kv, ku] for ku, kv in _COMBOS[:(1, 3, 6)[order]]}
+        return tuple(_divide_out(surf, D, order))
 
 
 def _span_taylor(knots, degree):
@@ -419,20 +415,19 @@ def _span_taylor(knots, degree):
     return spans, h, D * (h[:, None] ** np.arange(p + 1) / fact)[:, :, None]
 
 
-def _powers(x, h, degree):
-    """(3, degree+1, N): s^k and its first and second derivatives in the surface's own
+def _powers(x, h, degree, order):
+    """(N, order+1, degree+1): s^k and its derivatives up to `order` in the surface's own
     parameter, for s = x / h."""
     n = len(x)
-    s = x / h
     inv = 1.0 / h
-    M = np.zeros((3, degree + 1, n))
-    M[0, 0] = 1.0
-    pw = [np.ones(n), s]
-    for k in range(2, degree + 1):
-        pw.append(pw[-1] * s)
-    for k in range(1, degree + 1):
-        M[0, k] = pw[k]
-        M[1, k] = k * pw[k - 1] * inv
-        if k >= 2:
-            M[2, k] = k * (k - 1) * pw[k - 2] * inv * inv
+    k = np.arange(degree + 1.0)
+    M = np.zeros((n, order + 1, degree + 1))
+    pw = M[:, 0]
+    pw[:, 0] = 1.0
+    pw[:, 1:] = (x * inv)[:, None]
+    np.cumprod(pw, axis=1, out=pw)
+    if order >= 1:
+        M[:, 1, 1:] = pw[:, :-1] * (k[1:] * inv[:, None])
+    if order >= 2:
+        M[:, 2, 2:] = pw[:, :-2] * (k[2:] * (k[2:] - 1) * (inv * inv)[:, None])
     return M
