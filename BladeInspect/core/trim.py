@@ -114,5 +114,9 @@ class TrimDomain:
             len2 = np.einsum("ij,ij->i", ab, ab)
             t = np.clip(np.einsum("ij,ij->i", ap, ab) / np.where(len2 > 0, len2, 1.0), 0.0, 1.0)
             d = np.linalg.norm(ap - t[:, None] * ab, axis=1)
-            np.minimum.at(dist, q, d)
+            # bucket_pairs lists each query's pairs together, in query order: a minimum per run
+            # (ufunc.at is slow on numpy 1.24).
+            first = np.flatnonzero(np.concatenate([[True], q[1:] != q[:-1]]))
+            owners = q[first]
+            dist[owners] = np.minimum(dist[owners], np.minimum.reduceat(d, first))
         return inside, dist
