@@ -104,36 +104,33 @@ def basis_derivatives(knots, degree, span, t, n):
     for j in range(1, p + 1):
         left[j] = t - knots[span + 1 - j]
         right[j] = knots[span + j] - t
-        saved = np.zeros(m)
-        for r in range(j):
-            ndu[j, r] = right[r + 1] + left[j - r]
-            temp = ndu[r, j - 1] / ndu[j, r]
-            ndu[r, j] = saved + right[r + 1] * temp
-            saved = left[j - r] * temp
-        ndu[j, j] = saved
+        # the textbook's inner loop over r < j, as whole-column operations
+        ndu[j, :j] = right[1:j + 1] + left[j:0:-1]
+        temp = ndu[:j, j - 1] / ndu[j, :j]
+        ndu[:j, j] = right[1:j + 1] * temp
+        ndu[j, j] = 0.0
+        ndu[1:j + 1, j] += left[j:0:-1] * temp
     ders = np.zeros((m, n + 1, p + 1))
     for j in range(p + 1):
         ders[:, 0, j] = ndu[j, p]
-    a = np.empty((2, p + 1, m))
-    for r in range(p + 1):
-        s1, s2 = 0, 1
-        a[0, 0] = 1.0
-        for k in range(1, n + 1):
-            d = np.zeros(m)
-            rk, pk = r - k, p - k
-            if r >= k:
-                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
-                d += a[s2, 0] * ndu[rk, pk]
-            j1 = 1 if rk >= -1 else -rk
-            j2 = k - 1 if r - 1 <= pk else p - r
-            for j in range(j1, j2 + 1):
-                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
-                d += a[s2, j] * ndu[rk + j, pk]
-            if r <= pk:
-                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
-                d += a[s2, k] * ndu[r, pk]
-            ders[:, k, r] = d
-            s1, s2 = s2, s1
+    # The textbook's loop over the basis function r, as whole-column operations: for the k-th
+    # derivative, the j-th term is defined for k - j <= r <= p - j (j = 0 and j = k included).
+    a = np.empty((2, p + 1, p + 1, m))      # [s, j, r]
+    a[0, 0] = 1.0
+    s1, s2 = 0, 1
+    for k in range(1, min(n, p) + 1):      # derivatives above the degree stay zero
+        pk = p - k
+        d = np.zeros((p + 1, m))
+        a[s2, 0, k:] = a[s1, 0, k:] / ndu[pk + 1, :pk + 1]
+        d[k:] += a[s2, 0, k:] * ndu[:pk + 1, pk]
+        for j in range(1, k):
+            a[s2, j, k - j:p - j + 1] = ((a[s1, j, k - j:p - j + 1] - a[s1, j - 1, k - j:p - j + 1])
+                                         / ndu[pk + 1, :pk + 1])
+            d[k - j:p - j + 1] += a[s2, j, k - j:p - j + 1] * ndu[:pk + 1, pk]
+        a[s2, k, :pk + 1] = -a[s1, k - 1, :pk + 1] / ndu[pk + 1, :pk + 1]
+        d[:pk + 1] += a[s2, k, :pk + 1] * ndu[:pk + 1, pk]
+        ders[:, k] = d.T
+        s1, s2 = s2, s1
     factor = float(p)
     for k in range(1, n + 1):
         ders[:, k] *= factor
