@@ -349,7 +349,7 @@ class PowerPatches:
     """A surface as one polynomial patch per pair of knot spans, in the span's own parameters
     s = (u - u_i) / (u_{i+1} - u_i) and r likewise: a point and its derivatives are then
     powers of (s, r) and two batched matrix products with the patch's coefficients, without
-    the Cox-de Boor recurrence -- about ten times faster than ``evaluate`` (order 2) on the
+    the Cox-de Boor recurrence -- eight to ten times faster than ``evaluate`` (order 2) on the
     demo blade's bicubic sides, for code that evaluates one surface many times (Newton's
     projection, the ray cast). Agrees with it to ~1e-13
     relative: the coefficients are the Taylor expansions of the basis functions at each
