@@ -73,6 +73,11 @@ class TrimDomain:
         cells = (c0u[ids] + local // nv[ids]) * self.shape[1] + c0v[ids] + local % nv[ids]
         self._cells = csr(cells, ids, self.shape[0] * self.shape[1])
         self.reach = float(self.cell.min())
+        # Per segment, contiguous: start (u, v), direction (u, v), squared length (1 when 0).
+        d = b - a
+        self._columns = (np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]),
+                         np.ascontiguousarray(d[:, 0]), np.ascontiguousarray(d[:, 1]),
+                         np.where((d * d).sum(axis=1) > 0, d[:, 0] ** 2 + d[:, 1] ** 2, 1.0))
 
     def _band(self, v):
         return np.clip(((v - self.band_origin) / self.band).astype(int), 0, self.n_bands - 1)
@@ -84,35 +89,34 @@ class TrimDomain:
         """(inside (N,) bool, distance to the boundary (N,), capped at `reach`)."""
         uv = np.asarray(uv, dtype=float).reshape(-1, 2)
         n = len(uv)
-        a, b = self.segments[:, 0], self.segments[:, 1]
+        pu, pv = uv[:, 0], uv[:, 1]
+        au, av, du, dv, len2 = self._columns
         # Even-odd count of crossings of the ray from each point towards +u.
-        row = self._band(uv[:, 1])
-        in_rows = ((uv[:, 1] >= self.band_origin)
-                   & (uv[:, 1] < self.band_origin + self.n_bands * self.band))
-        q, s = bucket_pairs(np.where(in_rows, row, 0), *self._rows)
-        keep = in_rows[q]
-        q, s = q[keep], s[keep]
-        ay, by = a[s, 1], b[s, 1]
-        py = uv[q, 1]
-        straddle = (ay > py) != (by > py)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x_cross = a[s, 0] + (py - ay) * (b[s, 0] - a[s, 0]) / (by - ay)
-        hit = straddle & (uv[q, 0] < x_cross)
+        rows = np.flatnonzero((pv >= self.band_origin)
+                              & (pv < self.band_origin + self.n_bands * self.band))
+        q, s = bucket_pairs(self._band(pv[rows]), *self._rows)
+        q = rows[q]
+        py = pv[q]
+        ay = av[s]
+        straddle = (ay > py) != (ay + dv[s] > py)
+        q, s, py, ay = q[straddle], s[straddle], py[straddle], ay[straddle]
+        hit = pu[q] < au[s] + (py - ay) * du[s] / dv[s]
         inside = np.bincount(q[hit], minlength=n) % 2 == 1
         # Distance to the nearest segment among those registered in the point's cell.
         dist = np.full(n, self.reach)
-        iu = ((uv[:, 0] - self.origin[0]) / self.cell[0]).astype(int)
-        iv = ((uv[:, 1] - self.origin[1]) / self.cell[1]).astype(int)
-        in_grid = (iu >= 0) & (iu < self.shape[0]) & (iv >= 0) & (iv < self.shape[1])
-        cell = np.where(in_grid, iu * self.shape[1] + iv, 0)
-        q, s = bucket_pairs(cell, *self._cells)
-        keep = in_grid[q]
-        q, s = q[keep], s[keep]
+        iu = ((pu - self.origin[0]) / self.cell[0]).astype(int)
+        iv = ((pv - self.origin[1]) / self.cell[1]).astype(int)
+        cells = np.flatnonzero((iu >= 0) & (iu < self.shape[0]) & (iv >= 0) & (iv < self.shape[1]))
+        q, s = bucket_pairs(iu[cells] * self.shape[1] + iv[cells], *self._cells)
         if len(q):
-            ab = b[s] - a[s]
-            ap = uv[q] - a[s]
-            len2 = np.einsum("ij,ij->i", ab, ab)
-            t = np.clip(np.einsum("ij,ij->i", ap, ab) / np.where(len2 > 0, len2, 1.0), 0.0, 1.0)
-            d = np.linalg.norm(ap - t[:, None] * ab, axis=1)
-            np.minimum.at(dist, q, d)
+            q = cells[q]
+            ab_u, ab_v = du[s], dv[s]
+            ap_u, ap_v = pu[q] - au[s], pv[q] - av[s]
+            t = np.clip((ap_u * ab_u + ap_v * ab_v) / len2[s], 0.0, 1.0)
+            d = np.sqrt((ap_u - t * ab_u) ** 2 + (ap_v - t * ab_v) ** 2)
+            # bucket_pairs lists each query's pairs together, in query order: a minimum per run
+            # (ufunc.at is slow on numpy 1.24).
+            first = np.flatnonzero(np.concatenate([[True], q[1:] != q[:-1]]))
+            owners = q[first]
+            dist[owners] = np.minimum(dist[owners], np.minimum.reduceat(d, first))
         return inside, dist
