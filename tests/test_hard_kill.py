@@ -91,14 +91,66 @@ def start_simrig(procs, log):
     raise AssertionError("simrig printed no port within %d s" % START_TIMEOUT_S)
 
 
+def cli_process(wrapper):
+    """The pid of the CLI's Python process that the ``./bladeinspect`` wrapper runs as its
+    child (None while it has not started): the process that writes the checkpoint."""
+    try:
+        with open("/proc/%d/task/%d/children" % (wrapper.pid, wrapper.pid)) as fh:
+            children = [int(pid) for pid in fh.read().split()]
+    except OSError:
+        return None
+    for pid in children:
+        try:
+            with open("/proc/%d/cmdline" % pid, "rb") as fh:
+                if b"BladeInspect.cli" in fh.read():
+                    return pid
+        except OSError:
+            continue
+    return None
+
+
+def process_state(pid):
+    """The kernel's one-letter state of ``pid`` ('T' stopped, 'Z' dead but not reaped), or
+    None once it is gone."""
+    try:
+        with open("/proc/%d/stat" % pid) as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return None
+
+
+def wait_for_state(pid, done):
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        state = process_state(pid)
+        if state is None or done(state):
+            return
+        time.sleep(0.001)
+    raise AssertionError("process %d stuck in state %s" % (pid, process_state(pid)))
+
+
 def kill_when(proc, ready, what, log):
     """SIGKILL ``proc`` as soon as ``ready()`` holds (polled); the process must still be
-    running then (the kill must land mid-run)."""
+    running then (the kill must land mid-run).
+
+    The CLI is stopped (SIGSTOP) before ``ready()`` is asked again and killed only if it still
+    holds: on a loaded machine the run can finish the pass, or the section, between a poll and
+    the kill, and the test would then judge a kill that did not land where it says."""
     deadline = time.monotonic() + RUN_TIMEOUT_S
     while time.monotonic() < deadline:
         if ready():
+            cli = cli_process(proc)
+            if cli is None:   # ready() reads what the CLI wrote, so it has been running
+                raise AssertionError("no CLI process under the wrapper %d" % proc.pid)
+            os.kill(cli, signal.SIGSTOP)
+            wait_for_state(cli, lambda state: state in "TtZ")
+            if not ready():
+                os.kill(cli, signal.SIGCONT)
+                continue
+            os.kill(cli, signal.SIGKILL)
             proc.send_signal(signal.SIGKILL)
             proc.wait(timeout=30)
+            wait_for_state(cli, lambda state: state == "Z")
             return
         if proc.poll() is not None:
             raise AssertionError("the run ended (%s) before %s: %s"
