@@ -13,7 +13,7 @@ from tests.helpers import GuiMacroChecks
                      "xvfb-run or freecad missing: the GUI cannot be started headless")
 class TestWorkbenchGui(GuiMacroChecks, unittest.TestCase):
     MACRO = "gui_macro.py"
-    TIMEOUT_S = 300   # the scenario takes about 1.5 min on two busy cores
+    TIMEOUT_S = 900   # the scenario takes about 1.5 min on two busy cores; 900: a hang
     MIN_CHECKS = 15
 
     def test_every_step_ran(self):
