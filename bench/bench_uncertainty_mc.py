@@ -11,31 +11,33 @@ the model states, drawn from its distribution:
 - the sensor's noise, gross errors, rounding and gating (rig.sensor.SensorModel.read on the
   recorded true distances and incidences, a fresh stream per trial);
 - the sensor's stated accuracy as a systematic term: one bias per trial, uniform in
-  +-accuracy, added to every reading; the trials' biases are stratified (systematic_draws), so
+  +-accuracy, added to every reading; the trials' biases are stratified (core.mc_sampling), so
   that a few trials cover the whole range;
 - the rig calibration's error: the rotary axis the rig really has differs from the believed one
   by an error drawn from `calibrate`'s own covariance (one simulated calibration run here);
 
 and goes on as the loop does: believed kinematics -> table-frame points -> ICP with the loop's
-default weights (the sensor model's, inspection.weighting) of the blind and planned points together (started at the true pose: the coarse stage finds the basin,
-not the answer) -> Table 2 from the planned rows -> verdict on the whole result (each section's
-worst deviation and the part's worst, with U) -> airfoil characteristics (no re-fits in the
-trials). The stated u (k = 1) is U / 2 of the verdict, and the airfoil stage's own u (its
-default re-fits), averaged over the first STATED trials.
+default weights (the sensor model's, inspection.weighting) of the blind and planned points
+together (started at the true pose: the coarse stage finds the basin, not the answer) ->
+Table 2 from the planned rows -> verdict on the whole result (each section's worst deviation
+and the part's worst, with U) -> airfoil characteristics (no re-fits in the trials). The
+stated u (k = 1) is U / 2 of the verdict, and the airfoil stage's own u (its default re-fits),
+averaged over the first STATED trials.
 
 The worst deviation is a maximum over points: where several points compete for it the maximum
 is biased up and scatters less than one reading. The table therefore gives, beside the
 scatter (1 sd), the RMS error against the truth (the injected field's largest |value| over the
 same points; for an airfoil characteristic, the noise-free chain's value); the verdict's U is
-that of the error of a maximum (uncertainty.worst_terms). A value's scatter and RMS error take the part that follows the trial's
-bias from the bias's known spread and only the rest from the trials (scatter_and_rms): a value
-the bias drives (a thickness, a chord) would otherwise be judged on a handful of draws of one
-uniform variable. Column "judged" compares a maximum
-(a worst deviation, form_mm, form_location_mm; marked *) with its RMS error, any other value
-with its scatter. Trials more than 5 robust sigmas
-from the median are counted (column "out"), not averaged in. `--sensitivity` prints instead
-what the systematic term really does to each value through the chain (noise-free scans with a
-bias of +-accuracy).
+that of the error of a maximum (uncertainty.worst_terms). A value's scatter and RMS error take
+the part that follows the trial's bias from the bias's known spread and only the rest from the
+trials (core.mc_sampling.scatter_and_rms): a value the bias drives (a thickness, a chord) would
+otherwise be judged on a handful of draws of one uniform variable. Column "judged" compares a
+maximum (a worst deviation, form_mm, form_location_mm; marked *) with its RMS error, any other
+value with its scatter. Trials more than 5 robust sigmas from the median are counted (column
+"out"), not averaged in. `--sensitivity` prints instead what the systematic term really does
+to each value through the chain (noise-free scans with a bias of +-accuracy).
+bench/bench_bias_take_up.py shows how the fit takes up the bias against the model's linear
+take-up.
 
     scripts/fcpython bench/bench_uncertainty_mc.py [--blade demo|rotor67|both] [--trials 40]
         [--seed 2026] [--stated 2] [--errors noise,systematic,calibration] [--sensitivity]
@@ -54,6 +56,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+from BladeInspect.core import mc_sampling  # noqa: E402
 from BladeInspect.core import stats as stats_mod  # noqa: E402
 from BladeInspect.core import transforms as tf  # noqa: E402
 from BladeInspect.inspection import airfoil as airfoil_mod  # noqa: E402
@@ -229,7 +232,7 @@ class Chain:
         """One measurement of the recorded scan with the model's errors drawn afresh: the
         judged values {name: value}, their stated u (k = 1) {name: u} and the truth.
         ``bias_mm``: this trial's reading bias (run() draws the trials' biases stratified,
-        systematic_draws); None draws one here when "systematic" is in ``errors``."""
+        core.mc_sampling); None draws one here when "systematic" is in ``errors``."""
         from BladeInspect.measurement.calibration_uncertainty import kinematics_with
         rec = self.rec
         reading, snr = self.sensor.read(rec["distance"], rec["incidence"], rng)
@@ -290,48 +293,16 @@ def is_maximum(key):
         key.endswith(" " + m) for m in airfoil_mod.MAXIMA)
 
 
-def systematic_draws(rng, trials, accuracy):
-    """One reading bias per trial, uniform in +-accuracy, stratified (Latin hypercube): trial k
-    draws from its own one of ``trials`` equal strata, in random order. Each trial's bias is
-    still uniform in +-accuracy, but a few trials cover the whole range: with independent
-    draws, 6 of Rotor 67's 8 (seed 2026) fell within -5.7..-4.4 um, and the values the bias
-    drives (a thickness moves by -1.7 b) read as a tight mode 8 um off the noise-free value."""
-    strata = rng.permutation(trials) + rng.uniform(0.0, 1.0, trials)
-    return accuracy * (2.0 * strata / trials - 1.0)
-
-
-def scatter_and_rms(err, bias, bias_sd):
-    """(1 sd, RMS) of a value's error over the trials, the bias's part from its known spread.
-
-    The error is split into the part that follows the trial's drawn reading bias (the least-
-    squares line err = alpha + c b over the trials) and the residual r uncorrelated with b,
-    so var = c^2 var(b) + var(r) holds whatever the response's shape; var(b) = accuracy^2 / 3
-    is known, not estimated from the trials' few biases (a control variate). The mean square
-    error against the truth is c^2 var(b) + mean((err - c b)^2), b's mean being zero. Without
-    a drawn bias (bias None) the plain sample figures."""
-    err = np.asarray(err, dtype=float)
-    n = len(err)
-    if bias is None or n < 4:
-        return float(np.std(err, ddof=1)), float(np.sqrt(np.mean(err ** 2)))
-    b = np.asarray(bias, dtype=float)
-    A = np.column_stack([np.ones(n), b - b.mean()])
-    (alpha, c), *_ = np.linalg.lstsq(A, err, rcond=None)
-    resid = err - A @ (alpha, c)
-    var_r = float(resid @ resid) / (n - 2)
-    mean_r = float(np.mean(err - c * b))
-    sd = np.sqrt(c * c * bias_sd ** 2 + var_r)
-    rms = np.sqrt(c * c * bias_sd ** 2 + mean_r ** 2 + var_r * (n - 1) / n)
-    return float(sd), float(rms)
-
-
 def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
     t0 = time.perf_counter()
     chain = Chain(name, seed, record_seed)
     rng = np.random.default_rng(seed)
     reference, _, _, _ = chain.trial(np.random.default_rng(0), errors=())
     accuracy = chain.sensor.accuracy
-    biases = (systematic_draws(np.random.default_rng([seed, 1]), trials, accuracy)
-              if "systematic" in errors else None)
+    # the trials' reading biases stratified, and their share of each value's variance from
+    # their known spread (core.mc_sampling: a few trials of a uniform term otherwise decide)
+    biases = (mc_sampling.stratified_uniform(np.random.default_rng([seed, 1]), trials,
+                                             accuracy) if "systematic" in errors else None)
     values, stated, truth = {}, {}, {}
     pose = []
     for k in range(trials):
@@ -371,8 +342,8 @@ def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
         # in: a gross failure of one trial (an edge not found) is not the chain's scatter.
         mad = 1.4826 * np.median(np.abs(err - np.median(err)))
         keep = np.abs(err - np.median(err)) <= OUTLIER_SIGMAS * max(mad, 1e-12)
-        sd, rms = scatter_and_rms(err[keep], None if biases is None else biases[keep],
-                                  accuracy / np.sqrt(3.0))
+        sd, rms = mc_sampling.scatter_and_rms(
+            err[keep], None if biases is None else biases[keep], accuracy / np.sqrt(3.0))
         ratio, ratio_rms = u / sd if sd > 0 else np.nan, u / rms if rms > 0 else np.nan
         ok, ok_rms = 0.7 <= ratio <= 1.3, 0.7 <= ratio_rms <= 1.3
         # A maximum's U states its error against the truth (bias included), not its scatter.
