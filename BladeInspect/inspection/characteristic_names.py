@@ -1,12 +1,14 @@
 """What a metrology engineer reads for each airfoil characteristic (issue 15 item 5): its name,
-its unit and a one-line meaning, keyed by the result.json field name (``chord_mm``; ``le_thickness_mm[1]`` for a list element). The report writes these
-names, the workbench shows them through Qt's translation. The field name stays what the files
-and ``--characteristics`` use; a tooltip or a note gives it beside the name.
+its unit and a one-line meaning, keyed by the result.json field name (``chord_mm``;
+``le_thickness_mm[1]`` for a list element). The report writes these names, the workbench shows
+them through Qt's translation. The field name stays what the files and ``--characteristics``
+use; a tooltip gives it beside the name.
 
 Texts are marked with QT_TRANSLATE_NOOP in the workbench's context so that
 scripts/update-translations collects them; this layer does not import FreeCAD, so the marker is
 the identity here and the GUI translates the text when it shows it. Functions take ``tr``, the
 translator (the identity for the report)."""
+
 
 def QT_TRANSLATE_NOOP(context, text):   # noqa: N802 (the name scripts/update-translations reads)
     return text
@@ -189,7 +191,7 @@ def sensitivity_row_name(row, tr=_same, values=None):
 
 
 # Table 2's columns (inspection.report.section_rows' header) as a narrow panel shows them: a
-# short header over two lines and its meaning. The share-within column's header carries its
+# short header over two lines and its meaning (the CMM columns' headers are short already). The share-within column's header carries its
 # band ("0.02 mm (%)"), matched by WITHIN_SUFFIX.
 SECTION_COLUMNS = {
     "Section": (QT_TRANSLATE_NOOP("BladeInspect", "Section"),
@@ -199,20 +201,20 @@ SECTION_COLUMNS = {
                                                  "to tip")),
     "Points": (QT_TRANSLATE_NOOP("BladeInspect", "Points"),
                QT_TRANSLATE_NOOP("BladeInspect", "Registered points in the section's band")),
-    "CMM points": (QT_TRANSLATE_NOOP("BladeInspect", "CMM\npoints"),
+    "CMM points": (QT_TRANSLATE_NOOP("BladeInspect", "CMM points"),
                    QT_TRANSLATE_NOOP("BladeInspect", "CMM points in the section")),
     "Max |dev| (mm)": (QT_TRANSLATE_NOOP("BladeInspect", "Max |dev|\nmm"),
                        QT_TRANSLATE_NOOP("BladeInspect", "Largest absolute deviation from "
                                                          "the CAD in the section (mm)")),
-    "CMM max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM max\nmm"),
+    "CMM max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM max"),
                 QT_TRANSLATE_NOOP("BladeInspect", "The CMM's largest absolute deviation "
                                                   "(mm)")),
     "RMS (mm)": (QT_TRANSLATE_NOOP("BladeInspect", "RMS\nmm"),
                  QT_TRANSLATE_NOOP("BladeInspect", "RMS of the deviations in the section "
                                                    "(mm)")),
-    "CMM RMS": (QT_TRANSLATE_NOOP("BladeInspect", "CMM RMS\nmm"),
+    "CMM RMS": (QT_TRANSLATE_NOOP("BladeInspect", "CMM RMS"),
                 QT_TRANSLATE_NOOP("BladeInspect", "RMS of the CMM's deviations (mm)")),
-    "CMM %": (QT_TRANSLATE_NOOP("BladeInspect", "CMM\nwithin %"),
+    "CMM %": (QT_TRANSLATE_NOOP("BladeInspect", "CMM %"),
               QT_TRANSLATE_NOOP("BladeInspect", "Share of the CMM's points within the band")),
     "LE max |dev|": (QT_TRANSLATE_NOOP("BladeInspect", "LE max\nmm"),
                      QT_TRANSLATE_NOOP("BladeInspect", "Largest absolute deviation at the "
@@ -220,10 +222,10 @@ SECTION_COLUMNS = {
     "TE max |dev|": (QT_TRANSLATE_NOOP("BladeInspect", "TE max\nmm"),
                      QT_TRANSLATE_NOOP("BladeInspect", "Largest absolute deviation at the "
                                                        "trailing edge (mm)")),
-    "CMM LE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM LE\nmm"),
+    "CMM LE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM LE max"),
                    QT_TRANSLATE_NOOP("BladeInspect", "The CMM's largest absolute deviation "
                                                      "at the leading edge (mm)")),
-    "CMM TE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM TE\nmm"),
+    "CMM TE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM TE max"),
                    QT_TRANSLATE_NOOP("BladeInspect", "The CMM's largest absolute deviation "
                                                      "at the trailing edge (mm)")),
 }

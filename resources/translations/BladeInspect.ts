@@ -123,32 +123,22 @@
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM
-points</source>
+        <source>CMM %</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM
-within %</source>
+        <source>CMM LE max</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM LE
-mm</source>
+        <source>CMM RMS</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM RMS
-mm</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM TE
-mm</source>
+        <source>CMM TE max</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -163,8 +153,12 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM max
-mm</source>
+        <source>CMM max</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM points</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
