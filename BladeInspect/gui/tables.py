@@ -61,6 +61,8 @@ def _header(table, columns, translator=tr):
     for c, (label, tip) in enumerate(columns):
         item = QtGui.QTableWidgetItem(translator(label))
         item.setToolTip(translator(tip))
+        if c == 0:   # the names' column: its header's start stays in view when it narrows
+            item.setTextAlignment(int(QtCore.Qt.AlignLeft | QtCore.Qt.AlignVCenter))
         table.setHorizontalHeaderItem(c, item)
 
 
@@ -101,8 +103,15 @@ def _group_row(table, r, text, verdict=None):
 
 def fit_columns(table, stretch_column=NAME_COLUMN):
     """Every column as wide as its contents but ``stretch_column``, which takes what is left
-    of the panel's width; no row numbers (the rows are named)."""
-    table.verticalHeader().setVisible(False)
+    of the panel's width, its names wrapped over two lines when the panel is narrow (the rows
+    as tall as they need); no row numbers (the rows are named)."""
+    rows = table.verticalHeader()
+    rows.setVisible(False)
+    for r in range(table.rowCount()):
+        # a group line keeps one line's height, not the wrapped height of the first column
+        if table.columnSpan(r, 0) == 1:
+            rows.setSectionResizeMode(r, QtGui.QHeaderView.ResizeToContents)
+    table.setWordWrap(True)
     table.setTextElideMode(QtCore.Qt.ElideRight)
     header = table.horizontalHeader()
     for c in range(table.columnCount()):
@@ -119,14 +128,14 @@ def _number(value, signed=False):
 
 
 def tolerance_text(lower, upper):
-    """A tolerance zone on the deviation as a narrow column shows it: ±T, lower / upper, or
-    one-sided."""
+    """A tolerance zone on the deviation as a narrow column shows it: ±T, the upper limit
+    over the lower, or one-sided."""
     if lower is None and upper is None:
         return ""
     if lower is not None and upper is not None:
         if abs(lower + upper) <= 1e-12 * max(abs(lower), abs(upper), 1.0):
             return "\u00b1%g" % upper
-        return "%+g / %+g" % (lower, upper)
+        return "%+g\n%+g" % (upper, lower)
     return ("\u2264 %+g" % upper) if lower is None else ("\u2265 %+g" % lower)
 
 
@@ -204,17 +213,21 @@ def sensitivity_table(sensitivity):
             "BladeInspect", "Value under this fit objective; the cell's colour is its "
                             "verdict (tooltip)")) for o in objectives] + [SENSITIVITY_CHANGE]
     groups = sensitivity_groups(sensitivity)
-    n_rows = sum(1 + len(rows) for _, rows in groups) + 1
+    # a line per section only when it heads several rows (the airfoil characteristics')
+    grouped = any(len(rows) > 1 for label, rows in groups if label is not None)
+    n_rows = sum(grouped + len(rows) for _, rows in groups) + 1
     table = QtGui.QTableWidget(n_rows, len(columns))
     _header(table, columns)
     r = 0
     for label, rows in groups:
-        _group_row(table, r, tr(names.PART) if label is None else tr(names.SECTION) % label)
-        r += 1
+        if grouped:
+            _group_row(table, r, tr(names.PART) if label is None else tr(names.SECTION) % label)
+            r += 1
         for row in rows:
             _, key = names.sensitivity_row_parts(row)
-            name = tr(names.WORST_DEVIATION) if key is None else names.display_name(
-                key, definitions, tr)
+            name = (tr(names.WORST_DEVIATION) if key is None else names.display_name(
+                key, definitions, tr)) if grouped else names.sensitivity_row_name(
+                row, tr, definitions)
             unit = names.unit(key, tr) if key else "mm"
             table.setItem(r, 0, _item(name, "%s\n%s" % (
                 name, names.meaning(key, tr) if key else row["characteristic"])))
