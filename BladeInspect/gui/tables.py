@@ -261,7 +261,8 @@ def largest_change_name(sensitivity):
 def section_table(header, rows):
     """Table 2 (inspection.report.section_rows): short headers over two lines with their
     meaning as tooltip; the columns share the panel's width, none narrower than the widest
-    cell (a table with CMM columns may then scroll)."""
+    cell. With the CMM's columns beside the optical ones it is wider than a 640 px panel and
+    scrolls sideways."""
     table = QtGui.QTableWidget(len(rows), len(header))
     _header(table, [names.section_column(h, tr) for h in header], _same)
     for r, row in enumerate(rows):
@@ -270,6 +271,10 @@ def section_table(header, rows):
     table.verticalHeader().setVisible(False)
     table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
     header_view = table.horizontalHeader()
+    if any(h.startswith("CMM ") for h in header):
+        # twice the columns: wider than a task panel, each as wide as its header and cells
+        header_view.setSectionResizeMode(QtGui.QHeaderView.ResizeToContents)
+        return table
     # the cells' widest (headers wrap; a cell's number must not be elided)
     header_view.setMinimumSectionSize(max([table.sizeHintForColumn(c)
                                            for c in range(table.columnCount())] + [1]))

@@ -191,7 +191,8 @@ def sensitivity_row_name(row, tr=_same, values=None):
 
 
 # Table 2's columns (inspection.report.section_rows' header) as a narrow panel shows them: a
-# short header over two lines and its meaning (the CMM columns' headers are short already). The share-within column's header carries its
+# short header over two lines and its meaning ("CMM points", "CMM max", "CMM RMS" are short
+# already, and the GUI test finds the columns by them). The share-within column's header carries its
 # band ("0.02 mm (%)"), matched by WITHIN_SUFFIX.
 SECTION_COLUMNS = {
     "Section": (QT_TRANSLATE_NOOP("BladeInspect", "Section"),
@@ -214,7 +215,7 @@ SECTION_COLUMNS = {
                                                    "(mm)")),
     "CMM RMS": (QT_TRANSLATE_NOOP("BladeInspect", "CMM RMS"),
                 QT_TRANSLATE_NOOP("BladeInspect", "RMS of the CMM's deviations (mm)")),
-    "CMM %": (QT_TRANSLATE_NOOP("BladeInspect", "CMM %"),
+    "CMM %": (QT_TRANSLATE_NOOP("BladeInspect", "CMM\n%"),
               QT_TRANSLATE_NOOP("BladeInspect", "Share of the CMM's points within the band")),
     "LE max |dev|": (QT_TRANSLATE_NOOP("BladeInspect", "LE max\nmm"),
                      QT_TRANSLATE_NOOP("BladeInspect", "Largest absolute deviation at the "
@@ -222,10 +223,10 @@ SECTION_COLUMNS = {
     "TE max |dev|": (QT_TRANSLATE_NOOP("BladeInspect", "TE max\nmm"),
                      QT_TRANSLATE_NOOP("BladeInspect", "Largest absolute deviation at the "
                                                        "trailing edge (mm)")),
-    "CMM LE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM LE max"),
+    "CMM LE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM LE\nmm"),
                    QT_TRANSLATE_NOOP("BladeInspect", "The CMM's largest absolute deviation "
                                                      "at the leading edge (mm)")),
-    "CMM TE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM TE max"),
+    "CMM TE max": (QT_TRANSLATE_NOOP("BladeInspect", "CMM TE\nmm"),
                    QT_TRANSLATE_NOOP("BladeInspect", "The CMM's largest absolute deviation "
                                                      "at the trailing edge (mm)")),
 }

@@ -123,12 +123,14 @@
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM %</source>
+        <source>CMM
+%</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM LE max</source>
+        <source>CMM LE
+mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -138,7 +140,8 @@
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>CMM TE max</source>
+        <source>CMM TE
+mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
