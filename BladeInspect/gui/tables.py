@@ -1,8 +1,10 @@
 """The result tables of the task panels (Table 2, the airfoil characteristics, the fit
 sensitivity) laid out for a task panel about 640 px wide: characteristics by their display
 names (inspection.characteristic_names) with their unit, short headers over two lines with the
-full meaning as a tooltip, one column that takes the width left (its text elided, whole in the
-tooltip), rows grouped under a line per section, verdicts coloured."""
+full meaning as a tooltip, the names' column takes the width left (wrapped over two lines when
+the panel is narrow, whole with the field name in the tooltip), rows grouped under a line per
+section, verdicts coloured. A characteristics table fits a 640 px panel without scrolling
+sideways (tests/gui_loop_macro.py checks it; 560 px in tests/gui_airfoil_macro.py)."""
 from PySide import QtCore, QtGui
 
 from ..inspection import airfoil as airfoil_mod
@@ -38,7 +40,7 @@ AIRFOIL_COLUMNS = (
      QT_TRANSLATE_NOOP("BladeInspect", "pass, not proven, fail (the decision rule with U), "
                                        "not judged without a tolerance")),
 )
-# The column that takes the width left over (its text elided, whole in its tooltip).
+# The column that takes the width left over (its names wrapped, whole in their tooltip).
 NAME_COLUMN = 0
 VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
 # Sensitivity columns before and after the objectives'
