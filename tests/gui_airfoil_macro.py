@@ -7,6 +7,7 @@ import sys
 
 import FreeCAD
 import FreeCADGui as Gui
+from PySide import QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
 from tests.gui_harness import (OUT, active_panel, check, run_scenario,  # noqa: E402
@@ -32,7 +33,7 @@ class ConsoleLines:
 def run():
     start_workbench(560)
     from BladeInspect.app import airfoil_objects, objects
-    from BladeInspect.gui import commands, progress, taskpanels, viewproviders
+    from BladeInspect.gui import commands, progress, tables, taskpanels, viewproviders
     from BladeInspect.inspection.simulate import simulate_measurement
     doc = FreeCAD.newDocument("Airfoil")
     state = {}
@@ -62,6 +63,11 @@ def run():
         check("registration panel shows the fit-sensitivity table",
               reg_panel is not None and reg_panel.sensitivity is not None)
         window_shot("airfoil_task_panel_fit_sensitivity")
+        if reg_panel is not None and reg_panel.sensitivity is not None:
+            table = reg_panel.sensitivity.findChild(QtGui.QTableWidget)
+            check("the fit-sensitivity table does not scroll sideways",
+                  table.horizontalScrollBar().maximum() == 0,
+                  (table.width(), table.horizontalScrollBar().maximum()))
         Gui.Control.closeDialog()
         state.update(blade=blade, reg=regs[0])
 
@@ -79,6 +85,13 @@ def run():
         settle(0.3)
         options = active_panel(taskpanels.AirfoilOptionsPanel)
         check("airfoil options panel open", options is not None)
+        # tolerances that give each verdict: the chord well inside its zone, the stagger's
+        # zone narrower than its U (~0.01 deg), the LE radius's zone away from zero
+        limits = os.path.join(OUT, "limits.csv")
+        with open(limits, "w") as fh:
+            fh.write("characteristic,section,lower,upper\nchord_mm,all,-0.05,0.05\n"
+                     "stagger_deg,all,-0.002,0.002\nle_radius_mm,all,0.05,0.1\n")
+        options.characteristics.setText(limits)
         with ConsoleLines() as lines:
             options.accept()
             settle()
@@ -91,6 +104,20 @@ def run():
         blocks = airfoil_objects.analysis_of(group)["airfoil"]
         check("table has a row per section and characteristic", panel is not None and
               panel.table.rowCount() == len(panel.rows) > 5 * len(blocks), len(panel.rows))
+        if panel is not None:
+            table = panel.table
+            names = [table.item(r, 0).text() for r in range(table.rowCount())]
+            check("characteristics by their names and units, not their keys",
+                  "Max. thickness" in names and not any("_mm" in n for n in names)
+                  and table.item(names.index("Max. thickness"), 1).text() == "mm", names[:12])
+            colours = {table.item(r, tables.VERDICT_COLUMN).text():
+                       table.item(r, tables.VERDICT_COLUMN).background().color().name()
+                       for r in range(table.rowCount()) if table.columnSpan(r, 0) == 1}
+            check("verdict cells coloured", colours.get("pass") == tables.VERDICT_COLOURS[
+                "pass"] and colours.get("fail") == tables.VERDICT_COLOURS["fail"], colours)
+            check("the characteristics table does not scroll sideways",
+                  table.horizontalScrollBar().maximum() == 0,
+                  (table.width(), table.horizontalScrollBar().maximum()))
         window_shot("airfoil_task_panel_characteristics")
         Gui.Control.closeDialog()
         kinds = [objects.proxy_type(o) for o in group.Group]

@@ -246,6 +246,11 @@ def run():
             if o.ViewObject is not None:
                 o.ViewObject.Visibility = o == dmap[0]
         window_shot("loop_inspection_table")
+        check("Table 2 and the fit-sensitivity table do not scroll sideways at 640 px",
+              panel is not None and all(t.horizontalScrollBar().maximum() == 0
+                                        for t in panel.form.findChildren(QtGui.QTableWidget)),
+              panel and [(t.width(), t.horizontalScrollBar().maximum())
+                         for t in panel.form.findChildren(QtGui.QTableWidget)])
         view_shot("loop_inspection_map")
         button = getattr(panel, "airfoil_button", None)
         if button is not None:
@@ -256,6 +261,10 @@ def run():
               airfoil_panel is not None and airfoil_panel.table.rowCount() > 0,
               "button" if button is not None else "no button")
         window_shot("loop_inspection_airfoil")
+        check("the airfoil characteristics do not scroll sideways at 640 px",
+              airfoil_panel is not None
+              and airfoil_panel.table.horizontalScrollBar().maximum() == 0,
+              airfoil_panel and airfoil_panel.table.horizontalScrollBar().maximum())
         Gui.Control.closeDialog()
 
     @step("inspect cancelled once its paths are drawn leaves the document as it was")

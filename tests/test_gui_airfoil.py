@@ -12,7 +12,7 @@ from tests.helpers import GuiMacroChecks
 class TestAirfoilGui(GuiMacroChecks, unittest.TestCase):
     MACRO = "gui_airfoil_macro.py"
     TIMEOUT_S = 400
-    MIN_CHECKS = 12
+    MIN_CHECKS = 16
     LOG_NAME = "freecad-airfoil.log"
 
     def test_every_step_ran(self):

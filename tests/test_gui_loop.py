@@ -14,7 +14,7 @@ from tests.helpers import GuiMacroChecks
 class TestLoopCommandsGui(GuiMacroChecks, unittest.TestCase):
     MACRO = "gui_loop_macro.py"
     TIMEOUT_S = 240   # about a minute on two busy cores
-    MIN_CHECKS = 30
+    MIN_CHECKS = 32
     LOG_NAME = "loop.log"
     CHECKS_NAME = "loop_checks.json"
 

@@ -11,9 +11,9 @@ from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
 from ..core import decision
 from ..core.airfoil import CHORD_METHODS
-from ..inspection import airfoil as airfoil_mod
 from ..inspection import fitting
 from ..inspection.result import rival_lines
+from . import tables
 from .i18n import QT_TRANSLATE_NOOP, translate
 
 
@@ -329,16 +329,6 @@ SENSITIVITY_ROWS_SHOWN = 12
 TABLE_ROWS_SHOWN = 9
 
 
-def table_widget(header, rows):
-    table = QtGui.QTableWidget(len(rows), len(header))
-    table.setHorizontalHeaderLabels([translate("BladeInspect", h) for h in header])
-    for r, row in enumerate(rows):
-        for c, cell in enumerate(row):
-            table.setItem(r, c, QtGui.QTableWidgetItem(str(cell)))
-    table.resizeColumnsToContents()
-    return table
-
-
 def fit_rows_height(table, max_rows):
     """Make ``table`` tall enough for its header and up to ``max_rows`` rows (a scroll bar
     beyond), so a short table shows whole in a task panel instead of scrolling in a strip."""
@@ -352,24 +342,27 @@ def fit_rows_height(table, max_rows):
 
 
 def sensitivity_widget(sensitivity):
-    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change; an
-    objective's unit and verdict below its name, so that the columns fit a task panel."""
+    """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change
+    (gui.tables: grouped by section, a value's cell coloured by its verdict)."""
     box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
     layout = QtGui.QVBoxLayout(box)
-    header, rows = fitting.report_rows(sensitivity)
-    table = table_widget([h.replace(" (", "\n(", 1) for h in header], rows)
+    table = tables.sensitivity_table(sensitivity)
     fit_rows_height(table, SENSITIVITY_ROWS_SHOWN)
     layout.addWidget(table)
+    lines = [translate("BladeInspect", "Deviation from the nominal under each fit objective; "
+                       "the colour is its verdict (green pass, amber not proven, red fail, "
+                       "none: not judged), the verdict and U in the tooltip.")]
     largest = sensitivity.get("largest_change")
     if largest:
-        label = QtGui.QLabel(translate("BladeInspect", "Largest change: %s, %.4f mm; the "
-                                       "verdict %s with the fit.")
-                             % (largest["characteristic"], largest["change_mm"],
-                                translate("BladeInspect", "changes")
-                                if sensitivity["verdict_changes"]
-                                else translate("BladeInspect", "does not change")))
-        label.setWordWrap(True)
-        layout.addWidget(label)
+        lines.append(translate("BladeInspect", "Largest change: %s, %.4f mm; the verdict %s "
+                               "with the fit.")
+                     % (tables.largest_change_name(sensitivity), largest["change_mm"],
+                        translate("BladeInspect", "changes")
+                        if sensitivity["verdict_changes"]
+                        else translate("BladeInspect", "does not change")))
+    label = QtGui.QLabel("\n".join(lines))
+    label.setWordWrap(True)
+    layout.addWidget(label)
     return box
 
 
@@ -414,7 +407,7 @@ class TablePanel(_ResultPanel):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
-        self.table = table_widget(header, rows)
+        self.table = tables.section_table(header, rows)
         fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
         if note:
@@ -457,42 +450,6 @@ class AirfoilOptionsPanel(FormPanel):
         return True
 
 
-AIRFOIL_HEADER = (QT_TRANSLATE_NOOP("BladeInspect", "section"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "characteristic"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "nominal"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "actual"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "deviation"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "\u00b1U (k=2)"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "tolerance"),
-                  QT_TRANSLATE_NOOP("BladeInspect", "verdict"))
-
-
-def _number(value, signed=False):
-    if value is None:
-        return ""
-    return ("%+.4f" if signed else "%.4f") % value
-
-
-def airfoil_rows(blocks):
-    """The characteristics table: per section and characteristic, nominal, actual, deviation,
-    the expanded uncertainty U (k = 2; the decision's, else 2u of the block's standard
-    uncertainty), the tolerance and the verdict (inspection.airfoil.csv_rows)."""
-    rows = []
-    for row in airfoil_mod.csv_rows(blocks):
-        # by the CSV's column names, so that a column added to airfoil.csv does not shift these
-        r = dict(zip(airfoil_mod.CSV_HEADER, row))
-        lower, upper, u = r["lower"], r["upper"], r["uncertainty"]
-        expanded = r.get("U_k2") if r.get("U_k2") is not None else (
-            None if u is None else 2.0 * u)
-        tolerance = "" if lower is None and upper is None else "%s .. %s" % (
-            _number(lower, True) or "-", _number(upper, True) or "+")
-        rows.append([r["section"], r["characteristic"], _number(r["nominal"]),
-                     _number(r["measured"]), _number(r["deviation"], True),
-                     "" if expanded is None else "%.4f" % expanded, tolerance,
-                     translate("BladeInspect", r["verdict"])])
-    return rows
-
-
 class AirfoilPanel(_ResultPanel):
     """The airfoil characteristics of every section (result.json's airfoil blocks), the
     airfoil verdict and the lean and bow."""
@@ -501,8 +458,9 @@ class AirfoilPanel(_ResultPanel):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("BladeInspect", "Airfoil characteristics"))
         layout = QtGui.QVBoxLayout(self.form)
-        self.rows = airfoil_rows(analysis.get("airfoil", []))
-        self.table = table_widget(AIRFOIL_HEADER, self.rows)
+        # per section a line and its characteristics (gui.tables)
+        self.rows = tables.airfoil_rows(analysis.get("airfoil", []))
+        self.table = tables.airfoil_table(self.rows)
         self.table.setMinimumHeight(420)
         layout.addWidget(self.table)
         lines = [analysis.get("airfoil_verdict", {}).get("summary", "")]

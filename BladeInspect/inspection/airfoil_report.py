@@ -8,12 +8,15 @@ import html
 import numpy as np
 
 from . import airfoil as stage_mod
+from . import characteristic_names
 from .report_table import pdf_table
 
 # Inscribed circles drawn per profile besides the largest one.
 N_CIRCLES = 5
-TABLE_HEADER = ["Characteristic", "Nominal", "Actual", "Deviation", "+-u (1 sigma)",
+TABLE_HEADER = ["Characteristic", "Unit", "Nominal", "Actual", "Deviation", "+-u (1 sigma)",
                 "U (k=2)", "Tolerance", "Verdict"]
+# Column widths on the page (fractions of the table's): the names need about a quarter.
+TABLE_WIDTHS = [0.24, 0.07, 0.09, 0.09, 0.09, 0.09, 0.08, 0.14, 0.11]
 
 
 def _num(v, key, sign=""):
@@ -22,7 +25,7 @@ def _num(v, key, sign=""):
 
 
 def characteristics_rows(block):
-    """One row per characteristic (name[i] for list elements) of one section block."""
+    """One row per characteristic of one section block, by its display name and unit."""
     if block["nominal"] is None:
         return []
     nom = stage_mod._flat(block["nominal"])
@@ -36,7 +39,8 @@ def characteristics_rows(block):
             "-inf" if t["lower"] is None else "%+g" % t["lower"],
             "+inf" if t["upper"] is None else "%+g" % t["upper"])
         decision = (block.get("decisions") or {}).get(key, {})
-        rows.append([key, _num(nom[key], key), _num(mea.get(key), key),
+        rows.append([characteristic_names.display_name(key, block["nominal"]),
+                     characteristic_names.unit(key), _num(nom[key], key), _num(mea.get(key), key),
                      _num(dev.get(key), key, "+"),
                      _num(unc.get(key), key), _num(decision.get("U"), key), tol,
                      block["verdicts"].get(key, "-")])
@@ -152,7 +156,7 @@ def add_pages(pdf, parts, table):
             continue
         fig = plt.figure(figsize=(8.27, 11.69))
         pdf_table(fig, [0.04, 0.04, 0.92, 0.9], TABLE_HEADER,
-                  rows or [["-"] * len(TABLE_HEADER)], 6.5,
+                  rows or [["-"] * len(TABLE_HEADER)], 6.5, col_widths=TABLE_WIDTHS,
                   title="Airfoil characteristics, section %s (%.1f %% span): %s"
                   % (block["label"], block["height_pct"], block.get("verdict", "-")),
                   title_size=10, loc="upper center")

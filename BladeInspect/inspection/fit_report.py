@@ -4,7 +4,7 @@ test uncertainty ratio of every judged value, the fit used and the fit-sensitivi
 import html
 
 from ..core import decision as decision_mod
-from . import fitting
+from . import characteristic_names, fitting
 from .report_table import pdf_table
 
 VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
@@ -93,7 +93,8 @@ def html_parts(result, verdict, table_html):
         largest = s["largest_change"]
         parts += ["<h2>Fit sensitivity</h2>", table_html(header, rows),
                   "<p>Largest change: %s, %.4f mm between objectives.%s</p>" % (
-                      html.escape(largest["characteristic"]), largest["change_mm"],
+                      html.escape(characteristic_names.sensitivity_row_name(largest)),
+                      largest["change_mm"],
                       " The verdict depends on the fit." if s["verdict_changes"] else "")
                   if largest else ""]
     return parts
@@ -116,5 +117,8 @@ def pdf_page(plt, result, verdict, dpi):
         fig.add_axes(rect).axis("off")
     if result.fit_sensitivity:
         header, rows = fitting.report_rows(result.fit_sensitivity)
-        pdf_table(fig, [0.06, 0.05, 0.88, 0.4], header, rows, 6.5, title="Fit sensitivity")
+        # the names (about 35 characters) a third of the width, the objectives share the rest
+        n_fits = len(header) - 3
+        pdf_table(fig, [0.06, 0.05, 0.88, 0.4], header, rows, 6.5, title="Fit sensitivity",
+                  col_widths=[0.32, 0.06] + [0.54 / n_fits] * n_fits + [0.08])
     return fig

@@ -25,6 +25,7 @@ from ..core import fits
 from ..core import stats as stats_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
+from . import characteristic_names
 from . import sections as sections_mod
 from . import weighting
 
@@ -399,19 +400,24 @@ def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
 
 
 def report_rows(sensitivity_doc):
-    """(header, rows) of the report's fit-sensitivity table."""
+    """(header, rows) of the report's fit-sensitivity table: each row's characteristic by its
+    display name (inspection.characteristic_names) and unit, then its value and verdict under
+    each objective and its change."""
+    names = characteristic_names
     objectives = sensitivity_doc["objectives"]
-    header = ["characteristic"] + ["%s (mm, verdict)" % o for o in objectives] + ["change (mm)"]
+    definitions = sensitivity_doc.get("airfoil_definitions")
+    header = ["Characteristic", "Unit"] + ["%s (verdict)" % o for o in objectives] + ["Change"]
     rows = []
     for row in sensitivity_doc["rows"]:
         # airfoil rows (inspection.airfoil.add_to_sensitivity) carry value and unit
-        unit = "" if row.get("unit", "mm") == "mm" else " " + row["unit"]
+        _, key = names.sensitivity_row_parts(row)
+        unit = names.unit(key) if key else "mm"
         value = [row["by_fit"][o].get("value_mm", row["by_fit"][o].get("value"))
                  for o in objectives]
-        rows.append([row["characteristic"]] + [
-            ("-" if v is None else "%+.4f%s %s" % (v, unit, row["by_fit"][o]["verdict"] or ""))
+        rows.append([names.sensitivity_row_name(row, values=definitions), unit] + [
+            ("-" if v is None else "%+.4f %s" % (v, row["by_fit"][o]["verdict"] or ""))
             for v, o in zip(value, objectives)]
-            + ["%.4f%s" % (row.get("change_mm", row.get("change")), unit)])
-    rows.append(["part verdict"] + [sensitivity_doc["verdict_by_fit"][o] or ""
-                                    for o in objectives] + [""])
+            + ["%.4f" % row.get("change_mm", row.get("change"))])
+    rows.append([names.PART_VERDICT, ""] + [sensitivity_doc["verdict_by_fit"][o] or ""
+                                            for o in objectives] + [""])
     return header, rows

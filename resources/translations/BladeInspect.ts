@@ -4,6 +4,11 @@
 <context>
     <name>BladeInspect</name>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>% chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>%s. Pose uncertainty %.2f µm after the planned scan (%.2f µm after the blind scan); ICP weights: %s. Files in %s</source>
         <translation type="unfinished"></translation>
@@ -26,6 +31,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>A letter (x, y, z, -x, ...) or a vector</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Actual</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -53,6 +63,16 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Airfoil characteristics...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Area enclosed by the profile</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Axial chord</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -102,6 +122,29 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM
+%</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM LE
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM RMS</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM TE
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>CMM file</source>
         <translation type="unfinished"></translation>
@@ -109,6 +152,21 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>CMM files (*.csv *.txt *.dat);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM max</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>CMM points in the section</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -142,8 +200,38 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Camber line's tangent at the LE, from the engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Camber line's tangent at the TE, from the engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>Cancel</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Centroid %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Centroid of the section area, in the CAD frame</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Change</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Characteristic</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -157,6 +245,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Chord (%s)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord at the hub</source>
         <translation type="unfinished"></translation>
@@ -164,6 +257,16 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord at the tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Chord by the method named (nose-tail: LE point to TE point; caliper; tangent)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Chord line's angle from the engine axis in the section plane</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -194,13 +297,38 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Dev.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/legend.py"/>
         <source>Deviation [mm]</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Deviation from the nominal under each fit objective; the colour is its verdict (green pass, amber not proven, red fail, none: not judged), the verdict and U in the tooltip.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>Deviation map</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Deviation: actual - nominal</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Diameter of the largest inscribed circle</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Displacement of the measured section against the nominal in its plane (x along the engine axis)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -211,6 +339,16 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Expanded uncertainty U (k = 2): the decision's, else 2 u of the stated standard uncertainty</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Extent of the profile along the engine axis</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -226,6 +364,16 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Fixture pose of the simulated rig and the registration's sampling</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Form and location error</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Form error</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -249,6 +397,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Inlet metal angle</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Inspect</source>
         <translation type="unfinished"></translation>
@@ -256,6 +409,17 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Inspection: Table 2 at the nominal sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>LE max
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>LE radius</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -269,8 +433,43 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>LE thickness at %s mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Largest absolute deviation at the leading edge (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Largest absolute deviation at the trailing edge (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Largest absolute deviation from the CAD in the section (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Largest change: %s, %.4f mm; the verdict %s with the fit.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Largest contour deviation after the section's own 2D best fit</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Largest contour deviation before the section's 2D fit</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Largest minus smallest value over the objectives</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -294,6 +493,22 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Max |dev|
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Max. thickness</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Max. thickness position</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>Measured points</source>
         <translation type="unfinished"></translation>
@@ -306,6 +521,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Most cambered point / chord</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Nominal</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -324,8 +544,23 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Outlet metal angle</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Outlier fraction</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Part</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Part verdict</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -336,6 +571,11 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Point spacing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Points</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -359,6 +599,32 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>RMS
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>RMS of the CMM's deviations (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>RMS of the deviations in the section (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Radius of the circle fitted to the leading-edge zone</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Radius of the circle fitted to the trailing-edge zone</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Random seed of the coarse stage</source>
         <translation type="unfinished"></translation>
@@ -372,6 +638,11 @@
         <location filename="../../BladeInspect/gui/commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Register</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Registered points in the section's band</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -420,6 +691,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Rotation of the measured section against the nominal (its 2D best fit)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Scan</source>
@@ -427,7 +703,13 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Section %s</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -436,8 +718,23 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Section area</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Section height, % of the span from hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Section heights (%)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Section label</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -472,6 +769,21 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Share of the CMM's points within the band</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Share of the section's points within ±%s mm of the CAD</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Shift %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Sides</source>
         <translation type="unfinished"></translation>
@@ -492,8 +804,19 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Span
+%</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Sphere diameter</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Stagger angle</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -522,6 +845,17 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>TE max
+mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>TE radius</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>TE radius at the hub</source>
         <translation type="unfinished"></translation>
@@ -532,13 +866,48 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>TE thickness at %s mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The CAD's value (or the characteristics file's)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>The CMM's largest absolute deviation (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>The CMM's largest absolute deviation at the leading edge (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>The CMM's largest absolute deviation at the trailing edge (mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The characteristic; its field name in airfoil.json, airfoil.csv and the --characteristics file in the tooltip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>The fine ICP's weights: snr, the paper's SNR-linear weights; sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' angle_deg); default: sensor when the points carry snr and angle_deg, else snr</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The measured value</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -557,13 +926,38 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Thickness normal to the camber line at this distance from the LE point</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Thickness normal to the camber line at this distance from the TE point</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tilt from +Y: %.4f deg about Z, %.4f deg about X. Sphere measured %.4f mm (nominal %.4f); circle residual RMS %.4f mm.</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Tol.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Tolerance on the deviation (lower / upper limit)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Twist</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -574,6 +968,43 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Twist, hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Unit</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Unit of the nominal, actual, deviation, U and tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Value under this fit objective; the cell's colour is its verdict (tooltip)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Verdict</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Where the largest inscribed circle lies, % of the chord from the LE</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Within
+±%s mm
+%%</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Worst deviation</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -593,11 +1024,6 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>actual</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>all six</source>
         <translation type="unfinished"></translation>
     </message>
@@ -608,17 +1034,12 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>characteristic</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>deviation</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>does not change</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>fail</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -638,17 +1059,37 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>nominal</source>
+        <source>none</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>none</source>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>not judged</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>not measured</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>not proven</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>opening %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>pass</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>pass, not proven, fail (the decision rule with U), not judged without a tolerance</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -659,11 +1100,6 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>reading %s and cutting the sections</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>section</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -682,18 +1118,14 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>tolerance</source>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>x (engine axis)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>verdict</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
-        <source>±U (k=2)</source>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>±U
+k=2</source>
         <translation type="unfinished"></translation>
     </message>
 </context>

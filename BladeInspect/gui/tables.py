@@ -1,0 +1,284 @@
+"""The result tables of the task panels (Table 2, the airfoil characteristics, the fit
+sensitivity) laid out for a task panel about 640 px wide: characteristics by their display
+names (inspection.characteristic_names) with their unit, short headers over two lines with the
+full meaning as a tooltip, the names' column takes the width left (wrapped over two lines when
+the panel is narrow, whole with the field name in the tooltip), rows grouped under a line per
+section, verdicts coloured. A characteristics table fits a 640 px panel without scrolling
+sideways (tests/gui_loop_macro.py checks it; 560 px in tests/gui_airfoil_macro.py)."""
+from PySide import QtCore, QtGui
+
+from ..inspection import airfoil as airfoil_mod
+from ..inspection import characteristic_names as names
+from .i18n import QT_TRANSLATE_NOOP, translate
+
+# Cell colours of the verdicts (light, so that the text stays readable); a verdict not listed
+# (not judged) keeps the table's colour.
+VERDICT_COLOURS = {"pass": "#c8e6c9", "fail": "#ffcdd2", "not proven": "#ffe0b2",
+                   "not measured": "#ffcdd2"}
+GROUP_COLOUR = "#e0e0e0"
+
+AIRFOIL_COLUMNS = (
+    (QT_TRANSLATE_NOOP("BladeInspect", "Characteristic"),
+     QT_TRANSLATE_NOOP("BladeInspect", "The characteristic; its field name in airfoil.json, "
+                                       "airfoil.csv and the --characteristics file in the "
+                                       "tooltip")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Unit"),
+     QT_TRANSLATE_NOOP("BladeInspect", "Unit of the nominal, actual, deviation, U and "
+                                       "tolerance")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Nominal"),
+     QT_TRANSLATE_NOOP("BladeInspect", "The CAD's value (or the characteristics file's)")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Actual"),
+     QT_TRANSLATE_NOOP("BladeInspect", "The measured value")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Dev."),
+     QT_TRANSLATE_NOOP("BladeInspect", "Deviation: actual - nominal")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "\u00b1U\nk=2"),
+     QT_TRANSLATE_NOOP("BladeInspect", "Expanded uncertainty U (k = 2): the decision's, else "
+                                       "2 u of the stated standard uncertainty")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Tol."),
+     QT_TRANSLATE_NOOP("BladeInspect", "Tolerance on the deviation (lower / upper limit)")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Verdict"),
+     QT_TRANSLATE_NOOP("BladeInspect", "pass, not proven, fail (the decision rule with U), "
+                                       "not judged without a tolerance")),
+)
+# The column that takes the width left over (its names wrapped, whole in their tooltip).
+NAME_COLUMN = 0
+VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
+# Sensitivity columns before and after the objectives'
+SENSITIVITY_LEADING = (AIRFOIL_COLUMNS[0], AIRFOIL_COLUMNS[1])
+SENSITIVITY_CHANGE = (QT_TRANSLATE_NOOP("BladeInspect", "Change"),
+                      QT_TRANSLATE_NOOP("BladeInspect", "Largest minus smallest value over "
+                                                        "the objectives"))
+
+
+def tr(text):
+    return translate("BladeInspect", text)
+
+
+def _same(text):
+    return text
+
+
+def _header(table, columns, translator=tr):
+    """Header labels with tooltips from (label, tip) pairs, translated by ``translator``."""
+    for c, (label, tip) in enumerate(columns):
+        item = QtGui.QTableWidgetItem(translator(label))
+        item.setToolTip(translator(tip))
+        if c == 0:   # the names' column: its header's start stays in view when it narrows
+            item.setTextAlignment(int(QtCore.Qt.AlignLeft | QtCore.Qt.AlignVCenter))
+        table.setHorizontalHeaderItem(c, item)
+
+
+def _item(text, tip=None, align=None):
+    item = QtGui.QTableWidgetItem(text)
+    if tip:
+        item.setToolTip(tip)
+    if align is not None:
+        item.setTextAlignment(align)
+    return item
+
+
+NUMBER = int(QtCore.Qt.AlignRight | QtCore.Qt.AlignVCenter)
+
+
+def colour_verdict(item, verdict):
+    colour = VERDICT_COLOURS.get(verdict)
+    if colour:
+        item.setBackground(QtGui.QBrush(QtGui.QColor(colour)))
+    return item
+
+
+def verdict_item(verdict):
+    return colour_verdict(_item(tr(verdict) if verdict else ""), verdict)
+
+
+def _group_row(table, r, text, verdict=None):
+    """A line across the table naming the rows under it (a section, the part)."""
+    item = _item(text)
+    font = item.font()
+    font.setBold(True)
+    item.setFont(font)
+    item.setBackground(QtGui.QBrush(QtGui.QColor(VERDICT_COLOURS.get(verdict,
+                                                                     GROUP_COLOUR))))
+    table.setItem(r, 0, item)
+    table.setSpan(r, 0, 1, table.columnCount())
+
+
+def fit_columns(table, stretch_column=NAME_COLUMN):
+    """Every column as wide as its contents but ``stretch_column``, which takes what is left
+    of the panel's width, its names wrapped over two lines when the panel is narrow (the rows
+    as tall as they need); no row numbers (the rows are named)."""
+    rows = table.verticalHeader()
+    rows.setVisible(False)
+    for r in range(table.rowCount()):
+        # a group line keeps one line's height, not the wrapped height of the first column
+        if table.columnSpan(r, 0) == 1:
+            rows.setSectionResizeMode(r, QtGui.QHeaderView.ResizeToContents)
+    table.setWordWrap(True)
+    table.setTextElideMode(QtCore.Qt.ElideRight)
+    header = table.horizontalHeader()
+    for c in range(table.columnCount()):
+        header.setSectionResizeMode(c, QtGui.QHeaderView.Stretch if c == stretch_column
+                                    else QtGui.QHeaderView.ResizeToContents)
+    table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
+    return table
+
+
+def _number(value, signed=False):
+    if value is None:
+        return ""
+    return ("%+.4f" if signed else "%.4f") % value
+
+
+def tolerance_text(lower, upper):
+    """A tolerance zone on the deviation as a narrow column shows it: ±T, the upper limit
+    over the lower, or one-sided."""
+    if lower is None and upper is None:
+        return ""
+    if lower is not None and upper is not None:
+        if abs(lower + upper) <= 1e-12 * max(abs(lower), abs(upper), 1.0):
+            return "\u00b1%g" % upper
+        return "%+g\n%+g" % (upper, lower)
+    return ("\u2264 %+g" % upper) if lower is None else ("\u2265 %+g" % lower)
+
+
+# ---------------------------------------------------------------- airfoil characteristics
+
+def airfoil_rows(blocks):
+    """The characteristics table's rows: per section a group line ``[text, verdict]``, then
+    per characteristic [key, name, unit, nominal, actual, deviation, U (k = 2; the decision's,
+    else 2u of the block's standard uncertainty), tolerance, verdict] (from
+    inspection.airfoil.csv_rows, by its column names)."""
+    by_label = {b["label"]: b for b in blocks}
+    rows, shown = [], None
+    for row in airfoil_mod.csv_rows(blocks):
+        r = dict(zip(airfoil_mod.CSV_HEADER, row))
+        block = by_label[r["section"]]
+        if r["section"] != shown:
+            shown = r["section"]
+            rows.append([tr("Section %s, %.1f %% span: %s") % (
+                shown, block["height_pct"], tr(block.get("verdict") or "")),
+                block.get("verdict")])
+        u = r["uncertainty"]
+        expanded = r.get("U_k2") if r.get("U_k2") is not None else (
+            None if u is None else 2.0 * u)
+        key = r["characteristic"]
+        rows.append([key, names.display_name(key, block["nominal"], tr),
+                     names.unit(key, tr), _number(r["nominal"]), _number(r["measured"]),
+                     _number(r["deviation"], True), _number(expanded),
+                     tolerance_text(r["lower"], r["upper"]), r["verdict"]])
+    return rows
+
+
+def airfoil_table(rows):
+    """The table of airfoil_rows (group lines spanning it)."""
+    table = QtGui.QTableWidget(len(rows), len(AIRFOIL_COLUMNS))
+    _header(table, AIRFOIL_COLUMNS)
+    for r, row in enumerate(rows):
+        if len(row) == 2:
+            _group_row(table, r, *row)
+            continue
+        key, name, unit = row[:3]
+        table.setItem(r, 0, _item(name, "%s\n%s" % (name, names.meaning(key, tr))))
+        table.setItem(r, 1, _item(unit))
+        for c, text in enumerate(row[3:-1], 2):
+            table.setItem(r, c, _item(text, align=NUMBER))
+        table.setItem(r, VERDICT_COLUMN, verdict_item(row[-1]))
+    return fit_columns(table)
+
+
+# ---------------------------------------------------------------- fit sensitivity
+
+def _objective_label(objective):
+    # "least-squares" over two lines: the objectives' columns stay as narrow as their numbers
+    return objective.replace("-", "-\n", 1)
+
+
+def sensitivity_groups(sensitivity):
+    """The fit_sensitivity rows grouped by section (in the order the sections first appear),
+    the part's last: [(label or None for the part, [row, ...])]."""
+    groups = {}
+    for row in sensitivity["rows"]:
+        label, _ = names.sensitivity_row_parts(row)
+        groups.setdefault(label, []).append(row)
+    part = groups.pop(None, [])
+    return list(groups.items()) + [(None, part)]
+
+
+def sensitivity_table(sensitivity):
+    """Each characteristic under each fit objective: its value (the deviation) in a cell
+    coloured by that objective's verdict, the verdict and U in the tooltip; the part's verdict
+    per objective last."""
+    objectives = sensitivity["objectives"]
+    definitions = sensitivity.get("airfoil_definitions")
+    columns = list(SENSITIVITY_LEADING) + [
+        (_objective_label(o), QT_TRANSLATE_NOOP(
+            "BladeInspect", "Value under this fit objective; the cell's colour is its "
+                            "verdict (tooltip)")) for o in objectives] + [SENSITIVITY_CHANGE]
+    groups = sensitivity_groups(sensitivity)
+    # a line per section only when it heads several rows (the airfoil characteristics')
+    grouped = any(len(rows) > 1 for label, rows in groups if label is not None)
+    n_rows = sum(grouped + len(rows) for _, rows in groups) + 1
+    table = QtGui.QTableWidget(n_rows, len(columns))
+    _header(table, columns)
+    r = 0
+    for label, rows in groups:
+        if grouped:
+            _group_row(table, r, tr(names.PART) if label is None else tr(names.SECTION) % label)
+            r += 1
+        for row in rows:
+            _, key = names.sensitivity_row_parts(row)
+            name = (tr(names.WORST_DEVIATION) if key is None else names.display_name(
+                key, definitions, tr)) if grouped else names.sensitivity_row_name(
+                row, tr, definitions)
+            unit = names.unit(key, tr) if key else "mm"
+            table.setItem(r, 0, _item(name, "%s\n%s" % (
+                name, names.meaning(key, tr) if key else row["characteristic"])))
+            table.setItem(r, 1, _item(unit))
+            for c, objective in enumerate(objectives, 2):
+                cell = row["by_fit"][objective]
+                value = cell.get("value_mm", cell.get("value"))
+                U = cell.get("U_mm", cell.get("U"))
+                tip = "%s: %s" % (objective, tr(cell.get("verdict") or ""))
+                if U is not None:
+                    tip += ", U = %.4f %s" % (U, unit)
+                table.setItem(r, c, colour_verdict(
+                    _item(_number(value, True), tip, NUMBER), cell.get("verdict")))
+            table.setItem(r, len(columns) - 1, _item(
+                "%.4f" % row.get("change_mm", row.get("change")), align=NUMBER))
+            r += 1
+    table.setItem(r, 0, _item(tr(names.PART_VERDICT)))
+    for c, objective in enumerate(objectives, 2):
+        table.setItem(r, c, verdict_item(sensitivity["verdict_by_fit"][objective]))
+    return fit_columns(table)
+
+
+def largest_change_name(sensitivity):
+    """The largest change's characteristic by its display name."""
+    return names.sensitivity_row_name(sensitivity["largest_change"], tr,
+                                      sensitivity.get("airfoil_definitions"))
+
+
+# ---------------------------------------------------------------- Table 2
+
+def section_table(header, rows):
+    """Table 2 (inspection.report.section_rows): short headers over two lines with their
+    meaning as tooltip; the columns share the panel's width, none narrower than the widest
+    cell. With the CMM's columns beside the optical ones it is wider than a 640 px panel and
+    scrolls sideways."""
+    table = QtGui.QTableWidget(len(rows), len(header))
+    _header(table, [names.section_column(h, tr) for h in header], _same)
+    for r, row in enumerate(rows):
+        for c, cell in enumerate(row):
+            table.setItem(r, c, _item(str(cell), align=None if c == 0 else NUMBER))
+    table.verticalHeader().setVisible(False)
+    table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
+    header_view = table.horizontalHeader()
+    if any(h.startswith("CMM ") for h in header):
+        # twice the columns: wider than a task panel, each as wide as its header and cells
+        header_view.setSectionResizeMode(QtGui.QHeaderView.ResizeToContents)
+        return table
+    # the cells' widest (headers wrap; a cell's number must not be elided)
+    header_view.setMinimumSectionSize(max([table.sizeHintForColumn(c)
+                                           for c in range(table.columnCount())] + [1]))
+    header_view.setSectionResizeMode(QtGui.QHeaderView.Stretch)
+    return table

@@ -1,0 +1,112 @@
+"""Every characteristic a section's airfoil block holds has a display name and a unit
+(inspection.characteristic_names), so that a field added to the block without a name fails
+here instead of showing as its JSON key in the report and the workbench; the same for Table 2's
+columns and the fit-sensitivity rows. The unit is checked against the field name's own suffix
+(the contract's naming: _mm, _mm2, _deg, _pct), not against the table."""
+import types
+import unittest
+
+from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import characteristic_names as names
+from BladeInspect.inspection import report
+from tests.helpers import demo_nominal
+
+# The unit each contract suffix stands for.
+SUFFIX_UNITS = (("_mm2", "mm\u00b2"), ("_mm", "mm"), ("_deg", "\u00b0"), ("_pct", "% chord"))
+# Fields of a block's values that are not characteristics (they define one).
+DEFINITIONS = {"chord_method", "edge_offsets_mm"}
+
+
+def _suffix_unit(key):
+    base = key.split("[", 1)[0]
+    return next(unit for suffix, unit in SUFFIX_UNITS if base.endswith(suffix))
+
+
+class AirfoilBlockNames(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        nominal = demo_nominal()
+        planes = stage_mod.nominal_planes(nominal, [50.0])
+        stage = stage_mod.run_stage(nominal, planes, stage_mod.Options(draws=0))
+        cls.values = stage.sections[0].block["nominal"]
+        cls.keys = list(stage_mod._flat(cls.values))
+
+    def test_every_numeric_field_of_the_block_is_a_named_characteristic(self):
+        for field, value in self.values.items():
+            if field in DEFINITIONS:
+                continue
+            numeric = isinstance(value, (int, float)) or (
+                isinstance(value, list) and all(isinstance(v, (int, float)) for v in value))
+            if numeric:
+                self.assertIn(field, names.NAMES, "no display name for %r" % field)
+
+    def test_every_key_has_a_name_unit_and_meaning(self):
+        self.assertGreater(len(self.keys), 20)
+        for key in self.keys:
+            name = names.display_name(key, self.values)
+            self.assertNotEqual(name, key)
+            self.assertNotIn("_", name, key)
+            self.assertNotIn("%", name, key)      # every template filled
+            self.assertEqual(names.unit(key), _suffix_unit(key), key)
+            self.assertIn(key, names.meaning(key))
+
+    def test_names_tell_the_keys_apart(self):
+        shown = [names.display_name(k, self.values) for k in self.keys]
+        self.assertEqual(len(set(shown)), len(shown), shown)
+
+    def test_names_follow_the_run(self):
+        self.assertEqual(names.display_name("chord_mm", self.values), "Chord (nose-tail)")
+        self.assertEqual(names.display_name("chord_mm", {"chord_method": "caliper"}),
+                         "Chord (caliper)")
+        offsets = self.values["edge_offsets_mm"]
+        self.assertEqual(names.display_name("te_thickness_mm[%d]" % (len(offsets) - 1),
+                                            self.values),
+                         "TE thickness at %g mm" % offsets[-1])
+
+    def test_every_field_the_stage_knows_is_named(self):
+        for field in stage_mod.CHARACTERISTICS:
+            self.assertIn(field, names.NAMES)
+        for field in stage_mod.LISTS:
+            self.assertTrue(field in names.EDGE_FIELDS or field in names.AXES, field)
+
+
+class SensitivityRows(unittest.TestCase):
+    """fit_sensitivity's rows are named "section L worst deviation", "part worst deviation"
+    (inspection.fitting) and "section L key" (inspection.airfoil.add_to_sensitivity)."""
+
+    def test_rows_split_into_section_and_characteristic(self):
+        for row, parts in (({"characteristic": "section 2 worst deviation"}, ("2", None)),
+                           ({"characteristic": "part worst deviation"}, (None, None)),
+                           ({"characteristic": "section root 1 le_thickness_mm[1]",
+                             "airfoil": True}, ("root 1", "le_thickness_mm[1]"))):
+            self.assertEqual(names.sensitivity_row_parts(row), parts)
+
+    def test_row_names(self):
+        definitions = {"chord_method": "tangent", "edge_offsets_mm": [0.25, 0.5]}
+        self.assertEqual(names.sensitivity_row_name(
+            {"characteristic": "section 3 le_thickness_mm[1]", "airfoil": True},
+            values=definitions), "Section 3: LE thickness at 0.5 mm")
+        self.assertEqual(names.sensitivity_row_name(
+            {"characteristic": "section 3 chord_mm", "airfoil": True}, values=definitions),
+            "Section 3: Chord (tangent)")
+        self.assertEqual(names.sensitivity_row_name({"characteristic": "part worst deviation"}),
+                         "Part: Worst deviation")
+
+
+class SectionTableColumns(unittest.TestCase):
+    def test_every_table_2_column_has_a_short_header_and_a_meaning(self):
+        for cmm in (None, "cmm.csv"):
+            table = types.SimpleNamespace(cmm_source=cmm, within=0.025, sections=[])
+            header, _ = report.section_rows(table)
+            for column in header:
+                short, meaning = names.section_column(column)
+                self.assertNotEqual(meaning, column, column)
+                # no header line much longer than its widest number ("0.0000", "100.00")
+                self.assertLessEqual(max(len(line) for line in short.split("\n")), 10, short)
+        short, meaning = names.section_column("0.025 mm (%)")
+        self.assertIn("0.025", short)
+        self.assertIn("0.025", meaning)
+
+
+if __name__ == "__main__":
+    unittest.main()
