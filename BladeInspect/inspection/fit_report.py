@@ -5,7 +5,7 @@ import html
 
 from ..core import decision as decision_mod
 from . import characteristic_names, fitting
-from .report_table import pdf_table
+from .report_table import PORTRAIT, pdf_table_pages, rows_that_fit
 
 VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
                 decision_mod.FAIL: "FAIL"}
@@ -100,25 +100,33 @@ def html_parts(result, verdict, table_html):
     return parts
 
 
-def pdf_page(plt, result, verdict, dpi):
-    """One A4 page: the decision table, the measurement model, the fit and its sensitivity."""
-    fig = plt.figure(figsize=(8.27, 11.69))
+def pdf_pages(plt, result, verdict):
+    """A4 pages: the decision table, the measurement model, the fit and its sensitivity, each
+    table continued on further pages rather than cut off."""
+    fig = plt.figure(figsize=PORTRAIT)
     fig.text(0.06, 0.95, "Decision rule, uncertainty and fit", fontsize=14, weight="bold")
     y = 0.92
     for line in [verdict.get("decision_rule_text", "")] + model_lines(verdict) + \
             fit_lines(result):
         fig.text(0.06, y, line, fontsize=7, wrap=True)
         y -= 0.02
+    sensitivity = (fitting.report_rows(result.fit_sensitivity) if result.fit_sensitivity
+                   else None)
     header, rows = decision_rows(verdict)
-    rect = [0.06, 0.5, 0.88, max(0.05, y - 0.52)]
+    bottom = 0.5 if sensitivity else 0.05
+    rect = [0.06, bottom, 0.88, max(0.05, y - bottom - 0.02)]
+    pages = [fig]
     if rows:
-        pdf_table(fig, rect, header, rows, 7)
-    else:
-        fig.add_axes(rect).axis("off")
-    if result.fit_sensitivity:
-        header, rows = fitting.report_rows(result.fit_sensitivity)
+        pages += pdf_table_pages(plt, header, rows, 7, None, first=(fig, rect))
+    if sensitivity:
+        header, rows = sensitivity
         # the names (about 35 characters) a third of the width, the objectives share the rest
         n_fits = len(header) - 3
-        pdf_table(fig, [0.06, 0.05, 0.88, 0.4], header, rows, 6.5, title="Fit sensitivity",
-                  col_widths=[0.32, 0.06] + [0.54 / n_fits] * n_fits + [0.08])
-    return fig
+        options = dict(col_widths=[0.32, 0.06] + [0.54 / n_fits] * n_fits + [0.08])
+        lower = [0.06, 0.05, 0.88, 0.4]
+        # on the first page when it all fits there, else on pages of its own
+        first = (pages[-1], lower) if len(pages) == 1 and \
+            len(rows) <= rows_that_fit(fig, lower) else None
+        pages += pdf_table_pages(plt, header, rows, 6.5, "Fit sensitivity", first=first,
+                                 **options)
+    return pages

@@ -477,10 +477,10 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         plt.close(fig)
         n_pages += 1
 
-        fig = fit_report.pdf_page(plt, result, verdict, PDF_DPI)   # hook: issue 16
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        for fig in fit_report.pdf_pages(plt, result, verdict):   # hook: issue 16
+            pdf.savefig(fig, dpi=PDF_DPI)
+            plt.close(fig)
+            n_pages += 1
 
         fig = figure_views(result, table, tolerance)
         parts += ["<h2>Deviation map</h2>", _img(_png(fig), "deviation map, three views")]
