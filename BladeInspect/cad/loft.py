@@ -43,7 +43,10 @@ GROSS_BOUNDS = 2.0
 GROSS_RUN = 2
 # Readings this near a pass's ends are never judged gross: a pass runs out onto an edge, whose
 # turn the neighbours on one side cannot predict.
-END_READINGS = 2
+END_READINGS = 3
+# More readings than this called gross means the curve, not the data, is at fault (a pass
+# whose readings could not be put in order): none are left out then.
+MAX_GROSS_FRACTION = 0.1
 MAX_REFINE_ROUNDS = 16
 # The sensor's SNR scale (0..100): sigma_beam = sigma_ref sqrt(SNR_REF / SNR) (rig.sensor).
 SNR_REF = 100.0
@@ -245,26 +248,39 @@ def _runs(mask):
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
 
 
-def _gross_readings(over, params, points, weights, knots, degree, bounds, rejected):
-    """Readings beyond their bound that the rule calls gross errors: a run of at most
-    GROSS_RUN, at least END_READINGS from either end, whose removal leaves a curve that passes
-    the readings on both sides within their bounds and misses each of the run's by more than
-    GROSS_BOUNDS of its bound."""
+def _gross_readings(over, params, points, weights, knots, degree, residuals, bounds,
+                    rejected):
+    """Readings beyond their bound that the rule calls gross errors. Candidates are the peaks
+    of residual / bound above GROSS_BOUNDS in the runs of readings beyond their bounds, at
+    least END_READINGS from either end of the pass, each with its worse neighbour when that is
+    above GROSS_BOUNDS too (GROSS_RUN readings at most). A candidate is gross if the curve
+    fitted without the candidates misses it by more than GROSS_BOUNDS of its bound while
+    passing the nearest readings kept on both sides within theirs (a spike pulls its
+    neighbours off with it; a turn the knots do not resolve stays off)."""
     n = len(points)
-    candidates = [(a, b) for a, b in _runs(over) if b - a <= GROSS_RUN
-                  and a >= END_READINGS and b <= n - END_READINGS]
+    ratio = residuals / bounds
+    peaks = []
+    for a, b in _runs(over):
+        for k in range(max(a, END_READINGS), min(b, n - END_READINGS)):
+            if ratio[k] > GROSS_BOUNDS and ratio[k] >= ratio[k - 1] and ratio[k] > ratio[k + 1]:
+                pair = max((k - 1, k + 1), key=lambda j: ratio[j])
+                if GROSS_RUN > 1 and ratio[pair] > GROSS_BOUNDS and over[pair]:
+                    peaks.append((min(k, pair), max(k, pair) + 1))
+                else:
+                    peaks.append((k, k + 1))
     gross = np.zeros(n, dtype=bool)
-    if not candidates:
+    if not peaks:
         return gross
     out = rejected.copy()
-    for a, b in candidates:
-        out[a:b] = True
+    for lo, hi in peaks:
+        out[lo:hi] = True
     _, _, miss = _fit_on_knots(params, points, weights * ~out, knots, degree, corrections=1)
-    for a, b in candidates:
-        sides = [k for k in (a - 1, b) if not rejected[k]]
-        if (np.all(miss[a:b] > GROSS_BOUNDS * bounds[a:b])
+    kept = np.flatnonzero(~out)
+    for lo, hi in peaks:
+        sides = kept[np.clip(np.searchsorted(kept, [lo, hi]) - [1, 0], 0, len(kept) - 1)]
+        if (np.all(miss[lo:hi] > GROSS_BOUNDS * bounds[lo:hi])
                 and np.all(miss[sides] <= bounds[sides])):
-            gross[a:b] = True
+            gross[lo:hi] = True
     return gross
 
 
@@ -319,12 +335,15 @@ def fit_section_pass(points, snr=None, sigma_ref=None, n_poles=None, degree=DEGR
         over = (residuals > bounds) & ~rejected
         if not over.any():
             break
-        gross = _gross_readings(over, params, ordered, weights, knots, degree, bounds,
-                                rejected)
-        rejected |= gross
-        shape = over & ~gross
-        if not shape.any():
+        gross = _gross_readings(over, params, ordered, weights, knots, degree, residuals,
+                                bounds, rejected)
+        if np.count_nonzero(rejected | gross) > MAX_GROSS_FRACTION * len(ordered):
+            gross[:] = False
+        if gross.any():
+            # The readings the gross ones pulled off come back once they are left out.
+            rejected |= gross
             continue
+        shape = over
         unique = np.unique(knots)
         spans = np.unique(np.clip(np.searchsorted(unique, params[shape], side="right") - 1,
                                   0, len(unique) - 2))
