@@ -58,10 +58,7 @@ def main():
               % (np.median(to_curves), np.percentile(to_curves, 90), to_curves.max(),
                  np.count_nonzero(to_curves > 0.02)))
         if recon.surfaces:
-            on_side = [g for g in recon.groups if g["curve"] is not None and any(
-                g["side"] == e["side"] for e in recon.surface_errors)]
-            sides = {e["side"] for e in recon.surface_errors}
-            del on_side
+            sides = _lofted_sides(recon)
             surfaces = Part.Compound([s.toShape() for s in recon.surfaces])
             in_surface = np.zeros(len(xyz), dtype=bool)
             sec, ang = rows[:, 4], rows[:, 5]
@@ -72,9 +69,32 @@ def main():
             to_surfaces = occ_distances(surfaces, xyz[in_surface])
             print("  readings of lofted sides to their surfaces (OCC): %d, median %.4f  "
                   "max %.4f mm" % (in_surface.sum(), np.median(to_surfaces), to_surfaces.max()))
-        print("  sigma_ref %s mm; rejected as gross: %d; stated: %s" % (
-            None if recon.sigma_ref is None else "%.4f" % recon.sigma_ref, n_rejected,
-            [(e["side"], round(e["max_gap_mm"], 4)) for e in recon.surface_errors]))
+        # getattr: the same command measures the code before the stated bounds existed.
+        sigma_ref = getattr(recon, "sigma_ref", None)
+        print("  stated: sigma_ref %s mm; readings left out as gross: %d; largest fit error "
+              "%.4f mm; per lofted side, largest gap %s" % (
+                  None if sigma_ref is None else "%.4f" % sigma_ref, n_rejected,
+                  max(e["max"] for e in recon.fit_errors),
+                  [(e["side"], round(e["max_gap_mm"], 4))
+                   for e in getattr(recon, "surface_errors", [])]))
+        print("  readings within 4 sigma_beam(SNR) of the curves (sigma_ref = the sensor's "
+              "3.46 um): %d of %d" % (np.count_nonzero(
+                  to_curves <= 4 * SENSOR_SIGMA_REF * np.sqrt(100.0 / snr)), len(xyz)))
+
+
+SENSOR_SIGMA_REF = 0.006 / np.sqrt(3.0)   # the simulated sensor's uniform +-6 um at SNR 100
+
+
+def _lofted_sides(recon):
+    """The sides that have a surface: those on at least two sections (cad.loft's rule), minus
+    any the notes say got none."""
+    with_curves = {}
+    for g in recon.groups:
+        if g["curve"] is not None:
+            with_curves.setdefault(g["side"], set()).add(g["section"])
+    skipped = {int(n.split()[1].rstrip(":")) for n in recon.notes
+               if n.startswith("side ") and "no surface" in n}
+    return {side for side, secs in with_curves.items() if len(secs) >= 2} - skipped
 
 
 if __name__ == "__main__":

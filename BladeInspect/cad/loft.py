@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
+from scipy.linalg import solveh_banded
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
 from scipy.spatial import cKDTree
@@ -85,14 +86,26 @@ def uniform_knots(n_poles, degree=DEGREE):
 
 def _least_squares_poles(params, points, knots, degree, weights=None):
     """Poles minimising the (weighted) squared residuals; a faint second-difference penalty
-    keeps the system regular where a knot span holds no points."""
+    keeps the system regular where a knot span holds no points. The normal equations of a
+    B-spline are banded (degree off-diagonals), so they are solved in band form."""
     n_poles = len(knots) - degree - 1
-    A = BSpline.design_matrix(np.clip(params, 0.0, 1.0), knots, degree).toarray()
-    Aw = A if weights is None else A * weights[:, None]
+    A = BSpline.design_matrix(np.clip(params, 0.0, 1.0), knots, degree)
+    Aw = A if weights is None else A.multiply(np.asarray(weights)[:, None]).tocsr()
+    normal = (A.T @ Aw).toarray()
     D = np.diff(np.eye(n_poles), 2, axis=0)
-    normal = A.T @ Aw
     ridge = 1e-9 * np.trace(normal) / n_poles
-    return np.linalg.solve(normal + ridge * D.T @ D, Aw.T @ points)
+    normal += ridge * (D.T @ D)
+    width = max(degree, 2)
+    band = np.zeros((width + 1, n_poles))
+    for k in range(width + 1):
+        band[width - k, k:] = np.diagonal(normal, k)
+    rhs = np.asarray(Aw.T @ points)
+    try:
+        return solveh_banded(band, rhs)
+    except np.linalg.LinAlgError:
+        # Not numerically positive definite (spans with no reading and the penalty's linear
+        # null space): the least-norm solution.
+        return np.linalg.lstsq(normal, rhs, rcond=None)[0]
 
 
 def _closest_params(spline, points, params):
