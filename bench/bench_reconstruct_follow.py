@@ -69,6 +69,11 @@ def main():
             to_surfaces = occ_distances(surfaces, xyz[in_surface])
             print("  readings of lofted sides to their surfaces (OCC): %d, median %.4f  "
                   "max %.4f mm" % (in_surface.sum(), np.median(to_surfaces), to_surfaces.max()))
+        # The reconstruction against the part itself: points of every curve to the blade.
+        on_curves = np.vstack([[tuple(p) for p in c.discretize(200)] for c in recon.curves])
+        off_part = occ_distances(blade, apply_transform(table_to_cad, on_curves))
+        print("  curve points to the true blade (OCC): p99 %.4f  max %.4f mm"
+              % (np.percentile(off_part, 99), off_part.max()))
         # getattr: the same command measures the code before the stated bounds existed.
         sigma_ref = getattr(recon, "sigma_ref", None)
         print("  stated: sigma_ref %s mm; readings left out as gross: %d; largest fit error "

@@ -328,13 +328,32 @@ def fit_section_pass(points, snr=None, sigma_ref=None, n_poles=None, degree=DEGR
     scale = noise_scale(snr, len(pts))
     # A fixed starting order: the same points in any row order give the same curve.
     first = np.lexsort(pts.T[::-1])
-    pts, scale = pts[first], scale[first]
-    order, along = order_points(pts)
-    ordered, scale = pts[order], scale[order]
+    order, along = order_points(pts[first])
     if along[-1] <= 1e-9:
         raise InputError("section points: all %d points coincide" % len(pts))
+    walk = first[order]
     if sigma_ref is None:
-        sigma_ref = noise_sigma_ref(pseudo_residuals(ordered, along, scale))
+        sigma_ref = noise_sigma_ref(pseudo_residuals(pts[walk], along, scale[walk]))
+    fit = _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree)
+    if fit.beyond_bound:
+        # A pass folded round an edge thinner than its point spacing has no order that the
+        # points alone give (near neighbours lie across the edge): the order the readings
+        # were taken in, the rows', is tried then, and the better kept.
+        rows = np.arange(len(pts))
+        steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+        if not np.array_equal(rows, walk) and not np.array_equal(rows, walk[::-1]) \
+                and np.all(steps > 0):
+            again = _fit_walk(pts, scale, rows, np.concatenate([[0.0], np.cumsum(steps)]),
+                              sigma_ref, n_poles, degree)
+            if (again.beyond_bound, again.max) < (fit.beyond_bound, fit.max):
+                fit = again
+    return fit
+
+
+def _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree):
+    """fit_section_pass's refinement on the readings taken in the order ``walk`` (indices of
+    ``pts``), ``along`` their distances along the way."""
+    ordered, scale = pts[walk], scale[walk]
     bounds = np.maximum(FOLLOW_SIGMAS * sigma_ref * scale, FOLLOW_FLOOR_MM)
     weights = 1.0 / scale ** 2
     params = along / along[-1]
@@ -367,7 +386,7 @@ def fit_section_pass(points, snr=None, sigma_ref=None, n_poles=None, degree=DEGR
         spline, params, residuals = _fit_on_knots(params, ordered, weights * ~rejected, knots,
                                                   degree)
     back = np.empty(len(ordered), dtype=int)
-    back[first[order]] = np.arange(len(ordered))
+    back[walk] = np.arange(len(ordered))
     return SectionFit(curve=_to_part_curve(knots, spline.c, degree),
                       residuals=residuals[back], bounds=bounds[back], rejected=rejected[back],
                       sigma_ref=float(sigma_ref), params=params[back])
