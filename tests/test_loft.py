@@ -259,6 +259,15 @@ class Reconstruct(unittest.TestCase):
                 d = np.array([sides.distToShape(Part.Vertex(V(*p)))[0] for p in pts])
                 self.assertLess(np.median(d), 0.002)
                 self.assertLess(d.max(), 0.008)
+            # Every reading lies on its side's lofted surface within 4 sigma of the noise, by
+            # OCC's own distance, and within the gap the reconstruction states.
+            faces = Part.Compound([s.toShape() for s in recon.surfaces])
+            moved = apply_transform(move, xyz)
+            gaps = np.array([faces.distToShape(Part.Vertex(V(*p)))[0] for p in moved[::7]])
+            self.assertLess(gaps.max(), 4 * NOISE_RMS)
+            self.assertLessEqual(gaps.max(),
+                                 max(e["max_gap_mm"] for e in recon.surface_errors) + 1e-6)
+            self.assertEqual(sum(e["n_rejected"] for e in recon.fit_errors), 0)
             self.assertEqual(recon.samples.shape[1], 3)
             self.assertGreater(len(recon.samples), 5000)
             # The samples lie on the lofted surfaces: spot-check against OCC.
