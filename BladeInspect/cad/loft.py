@@ -1,16 +1,21 @@
 """Section curves and lofted surfaces from measured section passes (paper 3.1.2).
 
 Each pass of the sensor over one side of one section gives points along a plane curve. They
-are approximated by a cubic B-spline on a uniform (clamped) knot vector in the least-squares
-sense, with the points' curve parameters corrected towards their closest curve points. The
-curves of one side, across the sections, are made compatible (same degree and knots, each
-reparametrised by normalised arc length) and skinned: their poles are interpolated across the
-sections, so each section curve is an iso-parametric curve of the lofted surface.
+are approximated by a cubic B-spline in the weighted least-squares sense, with the points'
+curve parameters corrected towards their closest curve points. The knots start uniform and are
+refined where the curve misses a point by more than FOLLOW_SIGMAS of that reading's noise, so
+the curve follows every reading it keeps within that bound; readings are left out only as
+isolated gross errors, by the rule of ``fit_section_pass``, and are reported. The curves of one
+side, across the sections, are made compatible (same degree and knots, each reparametrised by
+normalised arc length, refitted until within COMPATIBLE_TOLERANCE_MM of itself) and skinned:
+their poles are interpolated across the sections, so each section curve is an iso-parametric
+curve of the lofted surface.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
+from scipy.linalg import solveh_banded
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
 from scipy.spatial import cKDTree
@@ -27,10 +32,29 @@ ANGLE_CLUSTER_GAP_DEG = 20.0
 # Between neighbouring sections a view's angle follows the blade's twist, well below this.
 ANGLE_TRACK_DEG = 60.0
 PARAMETER_CORRECTIONS = 3
-OUTLIER_SIGMAS = 4.0
-OUTLIER_FLOOR_MM = 0.002
-MAX_OUTLIER_FRACTION = 0.1
-OUTLIER_ROUNDS = 3
+# Every reading kept lies within FOLLOW_SIGMAS of its noise from its curve: a uniform error's
+# largest value is sqrt(3) sigma, a normal one's beyond 4 sigma once in 16000.
+FOLLOW_SIGMAS = 4.0
+# Below this the bound is the fit's own resolution, not the sensor's noise.
+FOLLOW_FLOOR_MM = 0.002
+# A reading (or two neighbouring readings) is a gross error only if the curve fitted without
+# it passes its neighbours within their bounds and misses it by more than this many bounds;
+# a smaller miss is the shape, and the knots are refined there instead.
+GROSS_BOUNDS = 2.0
+GROSS_RUN = 2
+# Readings this near a pass's ends are never judged gross: a pass runs out onto an edge, whose
+# turn the neighbours on one side cannot predict.
+END_READINGS = 3
+# More readings than this called gross means the curve, not the data, is at fault (a pass
+# whose readings could not be put in order): none are left out then.
+MAX_GROSS_FRACTION = 0.1
+MAX_REFINE_ROUNDS = 16
+# The sensor's SNR scale (0..100): sigma_beam = sigma_ref sqrt(SNR_REF / SNR) (rig.sensor).
+SNR_REF = 100.0
+SNR_FLOOR = 1.0
+# The Gaussian |z|'s median: a robust scale from absolute deviations.
+HALF_NORMAL_MEDIAN = 0.6744897501960817
+COMPATIBLE_TOLERANCE_MM = 1e-4
 # Curves of one side more different in length than this cover different parts of the blade.
 MAX_LENGTH_RATIO = 1.5
 SAMPLES_U = 160
@@ -42,9 +66,16 @@ class Reconstruction:
     curves: list             # Part.BSplineCurve, one per (section, side) group fitted
     surfaces: list           # Part.BSplineSurface, one per side seen on >= 2 sections
     samples: np.ndarray      # (M, 3) points of the surfaces (of the curves if none)
-    fit_errors: list         # dicts: section, side, n_points, rms, max (mm)
+    fit_errors: list         # dicts: section, side, n_points, rms, max (mm), SectionFit.record
     groups: list             # dicts: section, side, angle_deg, n_points, curve index or None
     notes: list = field(default_factory=list)   # groups skipped and why
+    # The sensor noise at SNR_REF the curves' bounds were scaled from (mm): measured from the
+    # pseudo-residuals of every pass together, since the passes share one sensor.
+    sigma_ref: float = None
+    # dicts per surface: side, sections, max_gap_mm (largest distance from a reading kept to
+    # its surface, at the reading's own section: the curve's miss plus the compatible refit's
+    # stray), compatible_stray_mm.
+    surface_errors: list = field(default_factory=list)
 
 
 def uniform_knots(n_poles, degree=DEGREE):
@@ -53,15 +84,28 @@ def uniform_knots(n_poles, degree=DEGREE):
     return np.concatenate([np.zeros(degree), inner, np.ones(degree)])
 
 
-def _least_squares_poles(params, points, knots, degree):
-    """Poles minimising the squared residuals; a faint second-difference penalty keeps the
-    system regular where a knot span holds no points."""
+def _least_squares_poles(params, points, knots, degree, weights=None):
+    """Poles minimising the (weighted) squared residuals; a faint second-difference penalty
+    keeps the system regular where a knot span holds no points. The normal equations of a
+    B-spline are banded (degree off-diagonals), so they are solved in band form."""
     n_poles = len(knots) - degree - 1
-    A = BSpline.design_matrix(np.clip(params, 0.0, 1.0), knots, degree).toarray()
+    A = BSpline.design_matrix(np.clip(params, 0.0, 1.0), knots, degree)
+    Aw = A if weights is None else A.multiply(np.asarray(weights)[:, None]).tocsr()
+    normal = (A.T @ Aw).toarray()
     D = np.diff(np.eye(n_poles), 2, axis=0)
-    normal = A.T @ A
     ridge = 1e-9 * np.trace(normal) / n_poles
-    return np.linalg.solve(normal + ridge * D.T @ D, A.T @ points)
+    normal += ridge * (D.T @ D)
+    width = max(degree, 2)
+    band = np.zeros((width + 1, n_poles))
+    for k in range(width + 1):
+        band[width - k, k:] = np.diagonal(normal, k)
+    rhs = np.asarray(Aw.T @ points)
+    try:
+        return solveh_banded(band, rhs)
+    except np.linalg.LinAlgError:
+        # Not numerically positive definite (spans with no reading and the penalty's linear
+        # null space): the least-norm solution.
+        return np.linalg.lstsq(normal, rhs, rcond=None)[0]
 
 
 def _closest_params(spline, points, params):
@@ -122,16 +166,153 @@ def _spline_of(curve):
     return BSpline((knots - lo) / (hi - lo), poles, curve.Degree)
 
 
-def fit_section_curve(points, n_poles=None, degree=DEGREE):
-    """A cubic B-spline least-squares approximation of one section pass.
+@dataclass
+class SectionFit:
+    """One pass's curve and how it follows the readings it was fitted to (mm). ``residuals``
+    and ``bounds`` are per reading, in the order given; ``rejected`` marks the readings left
+    out as gross errors; ``sigma_ref`` is the noise at SNR_REF the bounds were scaled from."""
+    curve: object
+    residuals: np.ndarray
+    bounds: np.ndarray
+    rejected: np.ndarray
+    sigma_ref: float
+    params: np.ndarray          # each reading's curve parameter on [0, 1]
+
+    @property
+    def kept(self):
+        return ~self.rejected
+
+    @property
+    def rms(self):
+        return float(np.sqrt(np.mean(self.residuals[self.kept] ** 2)))
+
+    @property
+    def max(self):
+        return float(self.residuals[self.kept].max())
+
+    @property
+    def beyond_bound(self):
+        """Readings kept but farther from the curve than their bound (refinement ran out)."""
+        return int(np.count_nonzero(self.kept & (self.residuals > self.bounds)))
+
+    def record(self):
+        r = self.residuals
+        return {"rms": self.rms, "max": self.max,
+                "max_over_bound": float(np.max(r[self.kept] / self.bounds[self.kept])),
+                "bound_max": float(self.bounds[self.kept].max()),
+                "sigma_ref": self.sigma_ref, "n_poles": int(self.curve.NbPoles),
+                "n_beyond_bound": self.beyond_bound,
+                "n_rejected": int(self.rejected.sum()),
+                "rejected_mm": sorted(float(v) for v in r[self.rejected])}
+
+
+def noise_scale(snr, n):
+    """Each reading's noise relative to SNR_REF's, sqrt(SNR_REF / SNR) (1 without SNR)."""
+    if snr is None:
+        return np.ones(n)
+    snr = np.asarray(snr, dtype=float)
+    return np.sqrt(SNR_REF / np.maximum(np.where(np.isfinite(snr), snr, SNR_FLOOR), SNR_FLOOR))
+
+
+def pseudo_residuals(ordered, along, scale):
+    """Each interior reading's miss from the cubic through its two neighbours on each side
+    (Lagrange in arc length), across the chord, over that miss's noise in units of sigma_ref:
+    a noise sample that does not depend on any fitted curve (a cubic's own error over four
+    readings is far below the noise on a resolved pass, and the median ignores the few turns
+    onto an edge that are not resolved)."""
+    n = len(ordered)
+    if n < 5:
+        return np.zeros(0)
+    i = np.arange(2, n - 2)
+    nb = np.stack([i - 2, i - 1, i + 1, i + 2], axis=1)
+    x, x0 = along[nb], along[i]
+    w = np.ones_like(x)
+    for j in range(4):
+        for k in range(4):
+            if k != j:
+                w[:, j] *= (x0 - x[:, k]) / np.where(x[:, j] != x[:, k], x[:, j] - x[:, k], 1e-12)
+    miss = ordered[i] - np.einsum("ij,ijk->ik", w, ordered[nb])
+    chord = ordered[i + 1] - ordered[i - 1]
+    chord /= np.maximum(np.linalg.norm(chord, axis=1), 1e-15)[:, None]
+    across = np.linalg.norm(miss - np.einsum("ij,ij->i", miss, chord)[:, None] * chord, axis=1)
+    spread = np.sqrt(scale[i] ** 2 + np.einsum("ij,ij->i", w ** 2, scale[nb] ** 2))
+    return across / spread
+
+
+def noise_sigma_ref(z):
+    """sigma_ref from pseudo-residuals (robust: the median of |z|)."""
+    z = np.asarray(z, dtype=float)
+    return float(np.median(z) / HALF_NORMAL_MEDIAN) if len(z) else 0.0
+
+
+def _fit_on_knots(params, points, weights, knots, degree, corrections=PARAMETER_CORRECTIONS):
+    for _ in range(corrections):
+        spline = BSpline(knots, _least_squares_poles(params, points, knots, degree, weights),
+                         degree)
+        params = _closest_params(spline, points, params)
+    spline = BSpline(knots, _least_squares_poles(params, points, knots, degree, weights), degree)
+    params = _closest_params(spline, points, params)
+    return spline, params, np.linalg.norm(spline(params) - points, axis=1)
+
+
+def _runs(mask):
+    """(start, stop) of the runs of True in a boolean array."""
+    edges = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
+
+
+def _gross_readings(over, params, points, weights, knots, degree, residuals, bounds,
+                    rejected):
+    """Readings beyond their bound that the rule calls gross errors. Candidates are the peaks
+    of residual / bound above GROSS_BOUNDS in the runs of readings beyond their bounds, at
+    least END_READINGS from either end of the pass, each with its worse neighbour when that is
+    above GROSS_BOUNDS too (GROSS_RUN readings at most). A candidate is gross if the curve
+    fitted without the candidates misses it by more than GROSS_BOUNDS of its bound while
+    passing the nearest readings kept on both sides within theirs (a spike pulls its
+    neighbours off with it; a turn the knots do not resolve stays off)."""
+    n = len(points)
+    ratio = residuals / bounds
+    peaks = []
+    for a, b in _runs(over):
+        for k in range(max(a, END_READINGS), min(b, n - END_READINGS)):
+            if ratio[k] > GROSS_BOUNDS and ratio[k] >= ratio[k - 1] and ratio[k] > ratio[k + 1]:
+                pair = max((k - 1, k + 1), key=lambda j: ratio[j])
+                if GROSS_RUN > 1 and ratio[pair] > GROSS_BOUNDS and over[pair]:
+                    peaks.append((min(k, pair), max(k, pair) + 1))
+                else:
+                    peaks.append((k, k + 1))
+    gross = np.zeros(n, dtype=bool)
+    if not peaks:
+        return gross
+    out = rejected.copy()
+    for lo, hi in peaks:
+        out[lo:hi] = True
+    _, _, miss = _fit_on_knots(params, points, weights * ~out, knots, degree, corrections=1)
+    kept = np.flatnonzero(~out)
+    for lo, hi in peaks:
+        sides = kept[np.clip(np.searchsorted(kept, [lo, hi]) - [1, 0], 0, len(kept) - 1)]
+        if (np.all(miss[lo:hi] > GROSS_BOUNDS * bounds[lo:hi])
+                and np.all(miss[sides] <= bounds[sides])):
+            gross[lo:hi] = True
+    return gross
+
+
+def fit_section_pass(points, snr=None, sigma_ref=None, n_poles=None, degree=DEGREE):
+    """A cubic B-spline through one section pass that follows every reading it keeps within
+    FOLLOW_SIGMAS sigma_ref sqrt(SNR_REF / SNR) (at least FOLLOW_FLOOR_MM), as a SectionFit.
 
     ``points`` (K, 3), in any order, are ordered along the curve (see ``order_points``);
     parameters start as their normalised distance along it and are then corrected to the
-    closest curve points.
-    ``n_poles`` defaults to K/10 within [degree + 3, 100]: uniform knots need many spans to
-    follow a rounded edge, and ten points a span keep the noise averaged. Gross outliers
-    (beyond 4 robust sigmas, at most 10 % of the points) are left out and the curve refitted. Returns (Part.BSplineCurve, rms_fit_error, max_fit_error): distances from the
-    points kept to the curve, mm."""
+    closest curve points. Readings weigh 1 / their noise squared. ``sigma_ref``: the sensor's
+    noise at SNR_REF; by default measured from the pass's own pseudo-residuals.
+    ``n_poles``: the starting uniform knots, by default K/10 within [degree + 3, 100] (ten
+    readings a span keep the noise averaged). Where a reading is missed by more than its bound,
+    the knot span holding it is halved and the curve refitted, until every reading is followed
+    or the poles would outnumber the readings; isolated readings that a curve through their
+    neighbours misses by more than GROSS_BOUNDS bounds are left out as gross errors
+    (``_gross_readings``). The cause of a miss at a fixed knot count is the shape, not the
+    noise: a pass's ends turn onto a leading or trailing edge that uniform spans cannot
+    follow (0.1-0.5 mm at 1 mm point spacing)."""
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
         raise InputError("section points: expected finite (K, 3) coordinates, got shape %s"
@@ -144,62 +325,119 @@ def fit_section_curve(points, n_poles=None, degree=DEGREE):
     n_poles = int(min(n_poles, len(pts)))
     if n_poles < degree + 1:
         raise InputError("section curve: %d poles, at least %d needed" % (n_poles, degree + 1))
+    scale = noise_scale(snr, len(pts))
     # A fixed starting order: the same points in any row order give the same curve.
-    pts = pts[np.lexsort(pts.T[::-1])]
-    order, along = order_points(pts)
-    ordered = pts[order]
+    first = np.lexsort(pts.T[::-1])
+    order, along = order_points(pts[first])
     if along[-1] <= 1e-9:
         raise InputError("section points: all %d points coincide" % len(pts))
+    walk = first[order]
+    if sigma_ref is None:
+        sigma_ref = noise_sigma_ref(pseudo_residuals(pts[walk], along, scale[walk]))
+    fit = _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree)
+    if fit.beyond_bound:
+        # A pass folded round an edge thinner than its point spacing has no order that the
+        # points alone give (near neighbours lie across the edge): the order the readings
+        # were taken in, the rows', is tried then, and the better kept.
+        rows = np.arange(len(pts))
+        steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+        if not np.array_equal(rows, walk) and not np.array_equal(rows, walk[::-1]) \
+                and np.all(steps > 0):
+            again = _fit_walk(pts, scale, rows, np.concatenate([[0.0], np.cumsum(steps)]),
+                              sigma_ref, n_poles, degree)
+            if (again.beyond_bound, again.max) < (fit.beyond_bound, fit.max):
+                fit = again
+    return fit
+
+
+def _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree):
+    """fit_section_pass's refinement on the readings taken in the order ``walk`` (indices of
+    ``pts``), ``along`` their distances along the way."""
+    ordered, scale = pts[walk], scale[walk]
+    bounds = np.maximum(FOLLOW_SIGMAS * sigma_ref * scale, FOLLOW_FLOOR_MM)
+    weights = 1.0 / scale ** 2
     params = along / along[-1]
     knots = uniform_knots(n_poles, degree)
-    for _ in range(PARAMETER_CORRECTIONS):
-        spline = BSpline(knots, _least_squares_poles(params, ordered, knots, degree), degree)
-        params = _closest_params(spline, ordered, params)
-        params = (params - params.min()) / max(params.max() - params.min(), 1e-15)
-    spline = BSpline(knots, _least_squares_poles(params, ordered, knots, degree), degree)
-    params = _closest_params(spline, ordered, params)
-    dist = np.linalg.norm(spline(params) - ordered, axis=1)
-    # Gross-error rejection (a sensor's spikes): points beyond OUTLIER_SIGMAS robust sigmas of
-    # the current curve are left out and the curve refitted, a few rounds, since a curve
-    # pulled by spikes also flags good points next to them. Skipped when so many points are
-    # flagged that the curve, not the data, is at fault.
-    keep = np.ones(len(ordered), dtype=bool)
-    for _ in range(OUTLIER_ROUNDS):
-        sigma = 1.4826 * np.median(dist[keep])
-        flagged = dist > max(OUTLIER_SIGMAS * sigma, OUTLIER_FLOOR_MM)
-        if flagged.mean() > MAX_OUTLIER_FRACTION or np.array_equal(~flagged, keep):
+    rejected = np.zeros(len(ordered), dtype=bool)
+    for round_ in range(MAX_REFINE_ROUNDS):
+        spline, params, residuals = _fit_on_knots(params, ordered, weights * ~rejected, knots,
+                                                  degree)
+        if round_ == 0:
+            params = (params - params.min()) / max(params.max() - params.min(), 1e-15)
+        over = (residuals > bounds) & ~rejected
+        if not over.any():
             break
-        keep = ~flagged
-        for _ in range(2):
-            spline = BSpline(knots, _least_squares_poles(params[keep], ordered[keep], knots,
-                                                         degree), degree)
-            params = _closest_params(spline, ordered, params)
-        dist = np.linalg.norm(spline(params) - ordered, axis=1)
-    dist = dist[keep]
-    return (_to_part_curve(knots, spline.c, degree), float(np.sqrt(np.mean(dist ** 2))),
-            float(dist.max()))
+        gross = _gross_readings(over, params, ordered, weights, knots, degree, residuals,
+                                bounds, rejected)
+        if np.count_nonzero(rejected | gross) > MAX_GROSS_FRACTION * len(ordered):
+            gross[:] = False
+        if gross.any():
+            # The readings the gross ones pulled off come back once they are left out.
+            rejected |= gross
+            continue
+        shape = over
+        unique = np.unique(knots)
+        spans = np.unique(np.clip(np.searchsorted(unique, params[shape], side="right") - 1,
+                                  0, len(unique) - 2))
+        if len(knots) - degree - 1 + len(spans) > int(np.count_nonzero(~rejected)):
+            break
+        knots = np.sort(np.concatenate([knots, 0.5 * (unique[spans] + unique[spans + 1])]))
+    else:
+        spline, params, residuals = _fit_on_knots(params, ordered, weights * ~rejected, knots,
+                                                  degree)
+    back = np.empty(len(ordered), dtype=int)
+    back[walk] = np.arange(len(ordered))
+    return SectionFit(curve=_to_part_curve(knots, spline.c, degree),
+                      residuals=residuals[back], bounds=bounds[back], rejected=rejected[back],
+                      sigma_ref=float(sigma_ref), params=params[back])
 
 
-def make_compatible(curves, n_poles=None, samples=2000):
-    """The curves on one degree and one uniform knot vector, each reparametrised by normalised
-    arc length (refitted by least squares to dense samples of it). ``n_poles`` defaults to
-    the largest pole count among the curves. Curves must run the same way."""
+def fit_section_curve(points, n_poles=None, degree=DEGREE, snr=None, sigma_ref=None):
+    """``fit_section_pass``'s (Part.BSplineCurve, rms, max): distances from the readings kept
+    to the curve, mm."""
+    fit = fit_section_pass(points, snr=snr, sigma_ref=sigma_ref, n_poles=n_poles,
+                           degree=degree)
+    return fit.curve, fit.rms, fit.max
+
+
+def make_compatible(curves, n_poles=None, samples=2000, tolerance=COMPATIBLE_TOLERANCE_MM):
+    """``compatible_curves``' curves."""
+    return compatible_curves(curves, n_poles, samples, tolerance)[0]
+
+
+def compatible_curves(curves, n_poles=None, samples=2000, tolerance=COMPATIBLE_TOLERANCE_MM):
+    """The curves on one degree and one knot vector, each reparametrised by normalised arc
+    length (refitted by least squares to dense samples of it). The knots start uniform with
+    ``n_poles`` (default: the largest pole count among the curves) and the spans where any
+    refit strays more than ``tolerance`` mm from its curve's sample at the same arc length are
+    halved until none does: a curve that turns sharply onto an edge needs short spans there,
+    which uniform ones do not give. Curves must run the same way. Returns (curves, the largest
+    such stray, mm: a bound on how far the refit moved any curve)."""
     if not curves:
         raise InputError("make_compatible: no curves")
     degree = max(c.Degree for c in curves)
     n_poles = int(n_poles or max(c.NbPoles for c in curves))
     n_poles = max(n_poles, degree + 1)
     knots = uniform_knots(n_poles, degree)
-    out = []
+    t = np.linspace(0.0, 1.0, samples)
+    dense = []
     for curve in curves:
-        spline = _spline_of(curve)
-        t = np.linspace(0.0, 1.0, samples)
-        xyz = spline(t)
+        xyz = _spline_of(curve)(t)
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))])
-        s = arc / arc[-1]
-        poles = _least_squares_poles(s, xyz, knots, degree)
-        out.append(_to_part_curve(knots, poles, degree))
-    return out
+        dense.append((arc / arc[-1], xyz))
+    for _ in range(MAX_REFINE_ROUNDS):
+        poles = [_least_squares_poles(s, xyz, knots, degree) for s, xyz in dense]
+        gaps = np.array([np.linalg.norm(BSpline(knots, p, degree)(s) - xyz, axis=1)
+                         for (s, xyz), p in zip(dense, poles)])
+        stray = np.any(gaps > tolerance, axis=0)
+        if not stray.any() or len(knots) - degree - 1 >= samples // 4:
+            break
+        unique = np.unique(knots)
+        at = np.concatenate([s[g > tolerance] for (s, _), g in zip(dense, gaps)])
+        spans = np.unique(np.clip(np.searchsorted(unique, at, side="right") - 1, 0,
+                                  len(unique) - 2))
+        knots = np.sort(np.concatenate([knots, 0.5 * (unique[spans] + unique[spans + 1])]))
+    return [_to_part_curve(knots, p, degree) for p in poles], float(gaps.max())
 
 
 def _chord_v_params(pole_rows):
@@ -332,7 +570,11 @@ def reconstruct(pointset, n_poles=None):
                                "curve": None, "index": idx})
 
     span = _span_axis([xyz[g["index"]] for g in raw_groups if g["n_points"] >= 3])
-    curves, fit_errors, groups = [], [], []
+    snr = getattr(pointset, "snr", None)
+    snr = None if snr is None else np.asarray(snr, dtype=float)
+    sigma_ref = _pooled_sigma_ref(xyz, snr, [g["index"] for g in raw_groups
+                                             if g["n_points"] >= MIN_GROUP_POINTS])
+    curves, fits, fit_errors, groups = [], [], [], []
     for g in raw_groups:
         idx = g.pop("index")
         groups.append(g)
@@ -341,20 +583,31 @@ def reconstruct(pointset, n_poles=None):
                          % (g["section"], g["side"], len(idx), MIN_GROUP_POINTS))
             continue
         try:
-            curve, rms, worst = fit_section_curve(xyz[idx], n_poles=n_poles)
+            fit = fit_section_pass(xyz[idx], snr=None if snr is None else snr[idx],
+                                   sigma_ref=sigma_ref, n_poles=n_poles)
         except InputError as exc:
             notes.append("section %s side %d: skipped (%s)" % (g["section"], g["side"], exc))
             continue
         g["curve"] = len(curves)
         g["offset"] = float(np.mean(xyz[idx], axis=0) @ span)
-        curves.append(curve)
-        fit_errors.append({"section": g["section"], "side": g["side"],
-                           "n_points": int(len(idx)), "rms": rms, "max": worst})
+        curves.append(fit.curve)
+        fits.append(fit)
+        fit_errors.append(dict({"section": g["section"], "side": g["side"],
+                                "n_points": int(len(idx))}, **fit.record()))
+        if fit.rejected.any():
+            notes.append("section %s side %d: %d reading(s) left out as gross errors, %s mm "
+                         "off the curve" % (g["section"], g["side"], fit.rejected.sum(),
+                                            ", ".join("%.3f" % v for v in
+                                                      fit.record()["rejected_mm"])))
+        if fit.beyond_bound:
+            notes.append("section %s side %d: %d reading(s) beyond their bound (the poles "
+                         "would outnumber the readings), up to %.3f mm"
+                         % (g["section"], g["side"], fit.beyond_bound, fit.max))
     if not curves:
         raise InputError("%s: no section curve could be fitted (%s)"
                          % (source, "; ".join(notes) or "no groups"))
 
-    surfaces = []
+    surfaces, surface_errors = [], []
     for side in sorted({g["side"] for g in groups}):
         fitted = sorted((g for g in groups if g["side"] == side and g["curve"] is not None),
                         key=lambda g: g["offset"])
@@ -373,8 +626,13 @@ def reconstruct(pointset, n_poles=None):
             notes.append("side %d: section curves %.1f to %.1f mm long, no surface"
                          % (side, min(lengths), max(lengths)))
             continue
-        surfaces.append(loft(make_compatible(_oriented(side_curves, span)),
-                             v_params=offsets))
+        oriented = _oriented(side_curves, span)
+        compatible, stray = compatible_curves(oriented)
+        surfaces.append(loft(compatible, v_params=offsets))
+        surface_errors.append({
+            "side": side, "sections": [g["section"] for g in fitted],
+            "max_gap_mm": max(fits[g["curve"]].max for g in fitted) + stray,
+            "compatible_stray_mm": stray})
     for g in groups:
         g.pop("offset", None)
 
@@ -384,7 +642,22 @@ def reconstruct(pointset, n_poles=None):
     else:
         samples = np.vstack([[tuple(p) for p in c.discretize(SAMPLES_U)] for c in curves])
     return Reconstruction(curves=curves, surfaces=surfaces, samples=samples,
-                          fit_errors=fit_errors, groups=groups, notes=notes)
+                          fit_errors=fit_errors, groups=groups, notes=notes,
+                          sigma_ref=sigma_ref, surface_errors=surface_errors)
+
+
+def _pooled_sigma_ref(xyz, snr, groups):
+    """The sensor's noise at SNR_REF from the pseudo-residuals of every pass: one sensor read
+    them all, and a short edge view alone gives too few readings for a scale."""
+    z = []
+    for idx in groups:
+        pts = xyz[idx]
+        scale = noise_scale(None if snr is None else snr[idx], len(idx))
+        order, along = order_points(pts)
+        if along[-1] > 1e-9:
+            z.append(pseudo_residuals(pts[order], along, scale[order]))
+    z = np.concatenate(z) if z else np.zeros(0)
+    return noise_sigma_ref(z) if len(z) else None
 
 
 def _oriented(curves, span):
