@@ -227,6 +227,9 @@ class Plane:
     height_pct: float
     le_hint_3d: np.ndarray = None     # the CAD's LE when its faces name it
     point_index: np.ndarray = None
+    # the CAD's cut in this plane when the section table made it (cad.sections.cut at the
+    # airfoil spacing); None: the stage cuts the CAD itself
+    cut_polylines: list = None
 
 
 def planes_of_table(table):
@@ -234,7 +237,9 @@ def planes_of_table(table):
     for s in table.sections:
         hint = s.profile.le if (s.profile is not None
                                 and s.profile.le_rule == "CAD face roles") else None
-        out.append(Plane(s.label, s.origin, s.normal, s.height_pct, hint, s.point_index))
+        polylines = s.profile.polylines if s.profile is not None else None
+        out.append(Plane(s.label, s.origin, s.normal, s.height_pct, hint, s.point_index,
+                         polylines or None))
     return out
 
 
@@ -360,7 +365,8 @@ class SectionResult:
 def _section(nominal, plane, opts, result, rng, counted=None):
     from ..cad.airfoil_sections import airfoil_section
     try:
-        xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis)
+        xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis,
+                                    polylines=plane.cut_polylines)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
         upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
         nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
