@@ -45,7 +45,7 @@ def planned_case(nominal):
     from tests.test_airfoil_pipeline import _noisy, _result
     from BladeInspect.measurement.planning import nominal_section
     planes = stage_mod.nominal_planes(nominal, HEIGHTS)
-    sections = [nominal_section(nominal, p.origin, p.normal, 0.1)[:2] for p in planes]
+    sections = [nominal_section(nominal, p.origin, p.normal, float(os.environ.get("SPACING", "0.1")))[:2] for p in planes]
     xyz = np.vstack(_noisy(sections, 0.0035, 0))
     result = _result(nominal, xyz)
     return sections_mod.section_table(result, nominal, heights_pct=HEIGHTS, band=0.01), result
