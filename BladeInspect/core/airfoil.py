@@ -1304,3 +1304,18 @@ def lean_bow(heights_mm, shifts_mm):
             "lean_deg": float(np.degrees(np.arctan(np.linalg.norm(slope)))),
             "bow_mm": bow.tolist(), "bow_magnitude_mm": mag.tolist(),
             "largest_bow_section": int(np.argmax(mag))}
+
+
+# ---------------------------------------------------------------- propagation hooks
+# The kernel's own steps that core.airfoil_propagation re-measures a perturbed profile with:
+# a change to one of them reaches the uncertainty's draws too.
+ZONE_SAMPLES, ZONE_SETTLED_MM = _ZONE_SAMPLES, _ZONE_SETTLED_MM
+angle_deg, farthest_pair, feet, line_end, line_hit, ray_hit = (
+    _angle_deg, _farthest_pair, _feet, _line_end, _line_hit, _ray_hit)
+refine_centres, rotation_2d, support, zone_points, zone_range = (
+    _refine_centres, _rot, _support, _zone_points, _zone_range)
+
+
+def spline_of(profile):
+    """(knots, [x coefficients, y coefficients], degree) of a Profile's periodic spline."""
+    return profile._tck

@@ -50,6 +50,7 @@ _REPLAY_DEG = 1e-6
 # along the camber line is taken (the kernel's own zoom settles within a few hundredths of
 # a millimetre; the smooth fit's radius is a parabola over this).
 _MAX_STEP_MM = 0.05
+_ZONE_SEARCH_ROUNDS = 4
 
 
 def warm_remeasure(ch, points, nominal_chars, fit):
@@ -74,7 +75,8 @@ class SmoothFit:
 
     @classmethod
     def of(cls, profile):
-        t, c = profile._tck[0], np.asarray(profile._tck[1])
+        t, c = kernel.spline_of(profile)[:2]
+        c = np.asarray(c)
         n_free = len(t) - 2 * _DEGREE - 1
         if n_free < 2 * _DEGREE or c.shape[1] < n_free + _DEGREE:
             return None
@@ -112,7 +114,8 @@ class SmoothFit:
     def profile_of(self, points, dcoef):
         """The kernel's Profile of moved points (profile order) whose spline is the measured
         one moved by dcoef (n_free, 2): what this smoother makes of them."""
-        t, c = self.profile._tck[0], np.array(self.profile._tck[1], dtype=float)
+        t, c = kernel.spline_of(self.profile)[:2]
+        c = np.array(c, dtype=float)
         n_free = len(t) - 2 * _DEGREE - 1
         wrapped = np.vstack([dcoef, dcoef[:_DEGREE]]).T
         c[:, :n_free + _DEGREE] += wrapped
@@ -120,7 +123,7 @@ class SmoothFit:
 
     def rows(self, u, der=0):
         """Basis rows (len(u), n_free): the curve's change at u is rows @ coefficients."""
-        t = self.profile._tck[0]
+        t = kernel.spline_of(self.profile)[0]
         return _free_basis(t, len(t) - 2 * _DEGREE - 1,
                            np.mod(np.asarray(u, dtype=float), self.profile.length), der)
 
@@ -163,23 +166,31 @@ class _Zone:
 
     def __init__(self, smooth, circle, outward, edge_u):
         prof = smooth.profile
-        lo, hi = kernel._zone_range(prof, circle.center, outward, edge_u, circle.zone_deg)
-        xy, key = kernel._zone_points(prof, lo, hi)
+        # The zone whose own fit is the circle: the one seen from its centre, or -- when the
+        # kernel cycled between two point sets and kept the larger -- the one seen from the
+        # other set's fit (a round or two of the kernel's own iteration).
+        seen_from = circle.center
+        for _ in range(_ZONE_SEARCH_ROUNDS):
+            lo, hi = kernel.zone_range(prof, seen_from, outward, edge_u, circle.zone_deg)
+            xy, key = kernel.zone_points(prof, lo, hi)
+            centre, radius, _ = kernel.fit_circle_2d(xy)
+            # a resampled zone moves with its circle's centre and is settled to the kernel's
+            # own tolerance, not to the bit
+            tol = _REPLAY_MM if key is not None else 10.0 * kernel.ZONE_SETTLED_MM
+            self.reproduced = (np.linalg.norm(centre - circle.center) < tol
+                               and abs(radius - circle.radius) < tol)
+            if self.reproduced:
+                break
+            seen_from = centre
         self.circle = circle
         self.response = _circle_response(xy, circle.center, circle.radius)
-        centre, radius, _ = kernel.fit_circle_2d(xy)
-        # a resampled zone moves with its circle's centre and is settled to the kernel's
-        # own tolerance, not to the bit
-        tol = _REPLAY_MM if key is not None else 10.0 * kernel._ZONE_SETTLED_MM
-        self.reproduced = (np.linalg.norm(centre - circle.center) < tol
-                           and abs(radius - circle.radius) < tol)
         if key is not None:
             self.index = np.frombuffer(key, dtype=np.intp)
             return
         self.index = None
-        u = np.linspace(lo, hi, kernel._ZONE_SAMPLES)
+        u = np.linspace(lo, hi, kernel.ZONE_SAMPLES)
         self.rows = smooth.rows(u)
-        frac = np.linspace(0.0, 1.0, kernel._ZONE_SAMPLES)
+        frac = np.linspace(0.0, 1.0, kernel.ZONE_SAMPLES)
         tangent = prof.eval(u, 1)
         # each bound: g(u) = unit(S(u) - c) . outward - cos(zone) = 0
         self.bound_rows, self.bound_q, self.bound_e, pulls = [], [], [], []
@@ -222,7 +233,7 @@ class _Crossing:
     def __init__(self, smooth, origin, direction, u0):
         prof = smooth.profile
         self.direction = direction
-        u, xy = kernel._line_hit(prof, origin, direction, u0)
+        u, xy = kernel.line_hit(prof, origin, direction, u0)
         self.u, self.point = u, xy
         self.normal = prof.outward_normal(u)
         self.tau = np.einsum("ij,ij->i", xy - origin, direction)
@@ -275,13 +286,13 @@ class SectionPropagation:
     def _setup(self, pts, nominal_chars, fit):
         ch, smooth, prof, m = self.ch, self.smooth, self.ch.profile, self.ch.medial
         # inscribed circles: contacts and their normals
-        ua, ub, fa, fb = kernel._feet(prof, m.side_a, m.side_b, m.centres)
+        ua, ub, fa, fb = kernel.feet(prof, m.side_a, m.side_b, m.centres)
         self.contacts = _Contacts(smooth, m.centres, ua, ub, fa, fb)
         # first edge circles (about the unclosed ends) and their zones
         zones, self.first_outs = [], []
         for end, circle in ((0, m.circle_a), (-1, m.circle_b)):
-            out = kernel._line_end(m.centres, m.radii, end, window_pct=m.window_pct)[2]
-            u_hit = kernel._ray_hit(prof, m.centres[end], out)[0][0]
+            out = kernel.line_end(m.centres, m.radii, end, window_pct=m.window_pct)[2]
+            u_hit = kernel.ray_hit(prof, m.centres[end], out)[0][0]
             zones.append(_Zone(smooth, circle, out, u_hit))
             self.first_outs.append(out)
         self.first_zones = zones
@@ -292,7 +303,7 @@ class SectionPropagation:
         self.outs0 = (out_a, out_b)
         self.hits = []
         for tip, out in zip(self.tips0, self.outs0):
-            u_hit = kernel._ray_hit(prof, tip, out)[0]
+            u_hit = kernel.ray_hit(prof, tip, out)[0]
             self.hits.append(_Crossing(smooth, tip[None], out[None], u_hit))
         ends = [h.point[0] for h in self.hits]
         self.a_is_le = bool(np.linalg.norm(ends[0] - ch.le_point)
@@ -319,12 +330,12 @@ class SectionPropagation:
         self.mid0, self.nu0 = mid, nu
         # the largest inscribed circle and its neighbours along the line
         c_max = ch.max_thickness_center
-        ua, ub, fa, fb = kernel._feet(prof, m.side_a, m.side_b, c_max[None])
+        ua, ub, fa, fb = kernel.feet(prof, m.side_a, m.side_b, c_max[None])
         at_max = _Contacts(smooth, c_max[None], ua, ub, fa, fb)
         along = np.array([-at_max.normal_dir[0, 1], at_max.normal_dir[0, 0]])
         along = along if along @ ch.chord_dir >= 0 else -along
         seeds = c_max + np.outer([-_MAX_STEP_MM, _MAX_STEP_MM], along)
-        cs, ua, ub, fa, fb = kernel._refine_centres(prof, m.side_a, m.side_b, seeds)
+        cs, ua, ub, fa, fb = kernel.refine_centres(prof, m.side_a, m.side_b, seeds)
         self.max_contacts = at_max
         self.max_side = _Contacts(smooth, cs, ua, ub, fa, fb)
         s_side = (cs - c_max) @ along
@@ -336,10 +347,10 @@ class SectionPropagation:
         self.max_along, self.max_steps = along, s_side
         # chords along the axis and, for the caliper, the farthest pair
         axis = ch.engine_axis
-        ends_axis = [kernel._support(prof, axis, sign) for sign in (1, -1)]
+        ends_axis = [kernel.support(prof, axis, sign) for sign in (1, -1)]
         self.axial_rows = smooth.rows(prof.closest(np.array(ends_axis))[0])
         if ch.chord_method == "caliper":
-            u1, u2, p1, p2 = kernel._farthest_pair(prof)
+            u1, u2, p1, p2 = kernel.farthest_pair(prof)
             self.caliper_rows = smooth.rows([u2, u1])
             self.caliper_dir = (p2 - p1) / np.linalg.norm(p2 - p1)
         # area and centroid: Green's theorem on the displacement
@@ -351,7 +362,7 @@ class SectionPropagation:
         self.before, ub_nom = kernel.signed_deviation(pts, nom)
         self.before_normal = nom.outward_normal(ub_nom)
         theta = -np.radians(fit.twist_deg)
-        self.turn = kernel._rot(theta)
+        self.turn = kernel.rotation_2d(theta)
         t = -self.turn @ fit.shift_mm
         moved = (pts - fit.pivot) @ self.turn.T + fit.pivot + t
         self.after, u_after = kernel.signed_deviation(moved, nom)
@@ -366,8 +377,8 @@ class SectionPropagation:
     def _close(self, centres, radii, circle_a, circle_b):
         """The camber line's ends closed as the kernel closes them (end a, then end b)."""
         w = self.ch.medial.window_pct
-        c, r, out_a, _ = kernel._line_end(centres, radii, 0, circle_a, w)
-        c, r, out_b, _ = kernel._line_end(c, r, -1, circle_b, w)
+        c, r, out_a, _ = kernel.line_end(centres, radii, 0, circle_a, w)
+        c, r, out_b, _ = kernel.line_end(c, r, -1, circle_b, w)
         return c, r, out_a, out_b
 
     def _camber(self, centres, end_a, end_b, out_a, out_b):
@@ -393,7 +404,9 @@ class SectionPropagation:
                           < _REPLAY_MM))
         ok &= bool(np.linalg.norm(got["centroid_mm"] - ch.centroid_mm) < _REPLAY_MM)
         ok &= abs(got["max_thickness_pos_pct"] - ch.max_thickness_pos_pct) < 1e-6
-        ok &= all(z.reproduced for z in self.first_zones + self.final_zones)
+        # the reported radii's zones must be the kernel's; a first circle only places the
+        # line's end, and may be the larger of two zones the kernel cycled between
+        ok &= all(z.reproduced for z in self.final_zones)
         return bool(ok)
 
     # ------------------------------------------------------------ one draw
@@ -401,7 +414,7 @@ class SectionPropagation:
     def remeasure(self, dp_ordered):
         """The characteristics of the ordered points moved by dp_ordered (n, N, 2), one dict
         per draw: the kernel's fields (centroid in the plane) and the section fit's."""
-        ch, smooth = self.ch, self.smooth
+        smooth = self.smooth
         dp_ordered = np.asarray(dp_ordered, dtype=float)
         dp = dp_ordered[:, self.to_profile]
         dcoef = smooth.coefficients(dp)
@@ -422,7 +435,7 @@ class SectionPropagation:
         centres, radii = m.centres + dc, m.radii + dr
         first = []
         for end, zone, out0 in zip((0, -1), self.first_zones, self.first_outs):
-            out = kernel._line_end(centres, radii, end, window_pct=m.window_pct)[2]
+            out = kernel.line_end(centres, radii, end, window_pct=m.window_pct)[2]
             first.append(zone.moved(dp, dcoef, out - out0))
         c, r, out_a, out_b = self._close(centres, radii, *first)
         ends = []
@@ -473,14 +486,14 @@ class SectionPropagation:
         d_axis = self.axial_rows @ dcoef
         return {"chord_mm": chord,
                 "axial_chord_mm": ch.axial_chord_mm + float((d_axis[0] - d_axis[1]) @ axis),
-                "stagger_deg": kernel._angle_deg(chord_dir, axis),
+                "stagger_deg": kernel.angle_deg(chord_dir, axis),
                 "max_thickness_mm": max_thickness,
                 "max_thickness_pos_pct": 100.0 * float((c_max - le) @ chord_dir) / nose_tail,
                 "le_radius_mm": le_circle.radius, "te_radius_mm": te_circle.radius,
                 "le_thickness_mm": thickness[:half].tolist(),
                 "te_thickness_mm": thickness[half:].tolist(),
-                "inlet_angle_deg": kernel._angle_deg(mcl.le_tangent, axis),
-                "outlet_angle_deg": kernel._angle_deg(mcl.te_tangent, axis)}
+                "inlet_angle_deg": kernel.angle_deg(mcl.le_tangent, axis),
+                "outlet_angle_deg": kernel.angle_deg(mcl.te_tangent, axis)}
 
     def _area_centroid(self, dcoef):
         """Area and centroid of each draw's curve (Green's theorem, first order)."""
