@@ -51,6 +51,9 @@ _REPLAY_DEG = 1e-6
 # a millimetre; the smooth fit's radius is a parabola over this).
 _MAX_STEP_MM = 0.05
 _ZONE_SEARCH_ROUNDS = 4
+# The largest circle has jumped to another local maximum when the moved circles' largest lies
+# more than this many circles from the measured one.
+_MAX_JUMP_CIRCLES = 3
 
 
 def warm_remeasure(ch, points, nominal_chars, fit):
@@ -345,6 +348,7 @@ class SectionPropagation:
         h1, h2 = s_side
         self.max_curvature = 2.0 * ((r_side[1] - r0) / h2 - (r_side[0] - r0) / h1) / (h2 - h1)
         self.max_along, self.max_steps = along, s_side
+        self.max_index = int(np.argmin(np.linalg.norm(m.centres - c_max, axis=1)))
         # chords along the axis and, for the caliper, the farthest pair
         axis = ch.engine_axis
         ends_axis = [kernel.support(prof, axis, sign) for sign in (1, -1)]
@@ -478,6 +482,13 @@ class SectionPropagation:
         max_thickness += slope * ds
         dc_max = self.max_contacts.moves(dcoef)[0][0]
         c_max = ch.max_thickness_center + dc_max + ds * self.max_along
+        # On a flat maximum another local maximum of the radius along the line may become the
+        # larger one (the kernel's search then jumps there): taken from the moved circles.
+        k = int(np.clip(np.argmax(radii), 1, len(radii) - 2))
+        if abs(k - self.max_index) > _MAX_JUMP_CIRCLES:
+            r_jump, c_jump = _vertex(centres[k - 1:k + 2], radii[k - 1:k + 2])
+            if 2.0 * r_jump > max_thickness:
+                max_thickness, c_max = 2.0 * r_jump, c_jump
         if ch.chord_method == "caliper":
             d = self.caliper_rows @ dcoef
             chord = ch.caliper_chord_mm + float((d[0] - d[1]) @ self.caliper_dir)
@@ -528,6 +539,16 @@ class SectionPropagation:
         return {"twist_deg": np.degrees(twist), "shift_mm": shift,
                 "form_mm": after.max(axis=1) - after.min(axis=1),
                 "form_location_mm": 2.0 * np.abs(before).max(axis=1)}
+
+
+def _vertex(centres, radii):
+    """(radius, centre) at the top of the parabola of radius in arc length through three
+    circles along the line."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(centres, axis=0), axis=1))])
+    a2, a1, a0 = np.polyfit(s, radii, 2)
+    top = float(np.clip(-a1 / (2.0 * a2), s[0], s[-1])) if a2 < 0 else s[1]
+    along = np.array([np.polyval(np.polyfit(s, centres[:, j], 2), top) for j in range(2)])
+    return float(np.polyval([a2, a1, a0], top)), along
 
 
 class _Contacts:
