@@ -26,8 +26,15 @@ step the kernel takes, with every discrete choice the measurement made kept:
 - the section's 2D fit (twist, shift) by its Gauss-Newton step at the measured solution, and
   the contour's deviations moved with it (their maxima taken again per draw).
 
+What it leaves out, by construction: a fresh fit's own choices per draw -- FITPACK's knots
+(a re-fit of a 0.1 mm section's points takes 31 to 166 knots where the measurement took 34 to
+89), the points entering or leaving an edge zone, the camber line's resampled centres. Where
+those move a characteristic more than the points' noise does through the kept choices (edge
+radii and max-thickness position on sparse edges), the u stated is smaller than the draws'
+from scratch (docs/airfoil.md "Warm re-measure").
+
 Tests (tests/test_airfoil_fast_u.py) compare a draw's figures with the kernel measuring the
-same perturbed points from scratch. ``SectionPropagation.of`` returns None where it cannot
+same perturbed profile (this smoother's) from scratch. ``SectionPropagation.of`` returns None where it cannot
 stand in for the kernel (a tangent chord, a profile whose spline it cannot identify, a state
 that does not reproduce the measurement): the caller then re-measures from scratch.
 """

@@ -751,7 +751,10 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                       "normal (sigma_beam cos incidence, the sensor's "
                                       "distribution) on the measured profile's smooth fit and "
                                       "the sensor's bias, %d draws; form values add the bias of "
-                                      "a maximum" % opts.draws,
+                                      "a maximum" % opts.draws
+                                      + ("; each draw re-measured from the measured "
+                                         "section's state (core.airfoil_propagation)"
+                                         if opts.remeasure == "warm" else ""),
                 # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
                 "uncertainty_relative_accuracy": (None if opts.draws < 2 else
                                                   float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),
