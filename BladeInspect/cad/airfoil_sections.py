@@ -56,13 +56,17 @@ def plane_frame(origin, normal, engine_axis=(1.0, 0.0, 0.0)):
 
 
 def airfoil_section(shape, origin, normal, engine_axis=(1.0, 0.0, 0.0),
-                    spacing=AIRFOIL_SPACING):
+                    spacing=AIRFOIL_SPACING, polylines=None):
     """(ordered (N, 2) profile, PlaneFrame) of the CAD shape cut by the plane: the closed loop
     enclosing the largest area (the airfoil; other loops, e.g. of a fillet or a shroud, are
     left out), without its repeated closing point, counter-clockwise about the normal.
-    InputError when the plane misses the shape or cuts no closed loop."""
+    InputError when the plane misses the shape or cuts no closed loop. ``polylines``: this
+    plane's cut at ``spacing`` when already made (the section table's): OCC's slice, half the
+    airfoil stage's time without draws, is not run again."""
     frame = plane_frame(origin, normal, engine_axis)
-    loops = [p for p in sections.cut(shape, frame.origin, frame.normal, spacing)
+    if not polylines:
+        polylines = sections.cut(shape, frame.origin, frame.normal, spacing)
+    loops = [p for p in polylines
              if len(p) >= 4 and np.linalg.norm(p[-1] - p[0]) < 1e-9]
     if not loops:
         raise InputError("section plane through %s with normal %s cuts no closed profile"

@@ -84,7 +84,9 @@ _DENSE_MIN, _DENSE_MAX = 2000, 8000
 class Profile:
     """A closed section profile as a periodic cubic spline, counter-clockwise."""
 
-    def __init__(self, points, noise_mm=0.0):
+    def __init__(self, points, noise_mm=0.0, tck=None):
+        # tck (propagation hook): the periodic spline of these points when already fitted
+        # (core.airfoil_propagation: a perturbed fit with the measured fit's knots and weight)
         pts = np.asarray(points, dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 8:
             raise InputError("airfoil profile: need an (N, 2) array of at least 8 points, got "
@@ -101,10 +103,15 @@ class Profile:
         self.corners = _corners(pts) if noise_mm == 0 else np.zeros(0, int)
         closed = np.vstack([pts, pts[:1]])
         u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+        if tck is not None:     # the spline's own period; the points' parameters within it
+            period = tck[0][-4] - tck[0][3]
+            u = u * (period / u[-1])
+            u[-1] = period
         self.length = float(u[-1])
         self.point_params = u[:-1]
         smoothing = len(pts) * float(noise_mm) ** 2
-        self._tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)
+        self._tck = tck if tck is not None else splprep(
+            [closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)[0]
         pieces = [PPoly.from_spline((self._tck[0], cx, 3)) for cx in self._tck[1]]
         keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
         keep &= np.diff(pieces[0].x) > 0
@@ -882,6 +889,19 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
 # ---------------------------------------------------------------- the characteristics
 
 @dataclass
+class MedialState:
+    """The inscribed circles' locus before its ends are closed (ordered from side a's start),
+    the first edge circles fitted about its ends, and the two sides it lies between."""
+    centres: np.ndarray
+    radii: np.ndarray
+    circle_a: CircleFit2D
+    circle_b: CircleFit2D
+    side_a: _Side
+    side_b: _Side
+    window_pct: float
+
+
+@dataclass
 class Characteristics:
     """One section's characteristics (field names as result.json's ``airfoil`` block)."""
     chord_mm: float
@@ -919,6 +939,9 @@ class Characteristics:
     suction_range: tuple = ()     # unwrapped parameter ranges of the two sides
     pressure_range: tuple = ()
     warnings: list = field(default_factory=list)
+    # propagation hook: the state the ends were closed from (core.airfoil_propagation re-measures
+    # perturbed profiles from it rather than from scratch)
+    medial: Optional["MedialState"] = field(default=None, repr=False)
 
     def as_dict(self):
         return {
@@ -983,6 +1006,8 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     circle_b = _edge_circle(profile, centres[-1], out_b,
                             _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
     notes = []
+    medial = MedialState(centres, radii, circle_a, circle_b, side_a, side_b,  # propagation hook
+                         metal_angle_window_pct)
     centres, radii, out_a, ua_end, end_a = _closed_end(profile, centres, radii, 0, circle_a,
                                                        notes, metal_angle_window_pct)
     centres, radii, out_b, ub_end, end_b = _closed_end(profile, centres, radii, -1, circle_b,
@@ -1055,7 +1080,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         outlet_angle_deg=_angle_deg(mcl.te_tangent, axis), area_mm2=area,
         centroid_mm=centroid, le_point=le, te_point=te, chord_dir=chord_dir, engine_axis=axis,
         le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
-        profile=profile, suction_range=(suction.lo, suction.hi),
+        profile=profile, suction_range=(suction.lo, suction.hi), medial=medial,
         pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
 
 
@@ -1279,3 +1304,18 @@ def lean_bow(heights_mm, shifts_mm):
             "lean_deg": float(np.degrees(np.arctan(np.linalg.norm(slope)))),
             "bow_mm": bow.tolist(), "bow_magnitude_mm": mag.tolist(),
             "largest_bow_section": int(np.argmax(mag))}
+
+
+# ---------------------------------------------------------------- propagation hooks
+# The kernel's own steps that core.airfoil_propagation re-measures a perturbed profile with:
+# a change to one of them reaches the uncertainty's draws too.
+ZONE_SAMPLES, ZONE_SETTLED_MM = _ZONE_SAMPLES, _ZONE_SETTLED_MM
+angle_deg, farthest_pair, feet, line_end, line_hit, ray_hit = (
+    _angle_deg, _farthest_pair, _feet, _line_end, _line_hit, _ray_hit)
+refine_centres, rotation_2d, support, zone_points, zone_range = (
+    _refine_centres, _rot, _support, _zone_points, _zone_range)
+
+
+def spline_of(profile):
+    """(knots, [x coefficients, y coefficients], degree) of a Profile's periodic spline."""
+    return profile._tck
