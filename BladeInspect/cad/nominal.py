@@ -481,7 +481,9 @@ def _sample_face(surf, domain, reverse, spacing):
     if domain.index is not None:
         inside, _ = point_in_domain(domain, uv)
         uv = uv[inside]
-    S, Su, Sv = bspline.evaluate(surf, uv[:, 0], uv[:, 1], order=1)
+    # The power-basis patches (which Newton's projection builds anyway): cheaper than de
+    # Boor's recurrence.
+    S, Su, Sv = surf.power_patches().evaluate(uv[:, 0], uv[:, 1], order=1)
     nrm = np.cross(Su, Sv)
     area = np.linalg.norm(nrm, axis=1)
     keep = area > 0

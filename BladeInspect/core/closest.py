@@ -48,6 +48,8 @@ THREADS = 2
 # Points per chunk at least when a call is split over the threads (below, one chunk: the
 # threads' start-up and the per-face loops would cost more than the second core gives).
 MIN_THREAD_CHUNK = 4096
+# Points at least for nearest_sample to split its k-d query over the threads.
+MIN_QUERY_SPLIT = 256
 # Nearest samples searched for a Newton start on one given face.
 START_CANDIDATES = 8
 # Factor on the largest sample distance found at a face's check points (cell corners, boundary
@@ -194,7 +196,7 @@ def cover_radius(surf, domain, uv, tree, hull_size):
         along = np.cumsum(np.linalg.norm(b - a, axis=1)) / (0.25 * min(du, dv))
         check.append(a[np.diff(np.floor(along), prepend=-1.0) > 0])
     check = np.clip(np.concatenate(check), [u0, v0], [u1, v1])
-    (S,) = bspline.evaluate(surf, check[:, 0], check[:, 1], order=0)
+    (S,) = surf.power_patches().evaluate(check[:, 0], check[:, 1], order=0)
     return min(COVER_SAFETY * float(tree.query(S)[0].max()), hull_size)
 
 
@@ -337,7 +339,10 @@ class FaceSet:
 
     def nearest_sample(self, points):
         """Index of each point's nearest sample."""
-        return self.tree.query(points)[1]
+        # Hook (speed): the coarse stage's ICP asks this from one thread, about points that
+        # start far from the samples (slow k-d queries); scipy splits them over the threads.
+        return self.tree.query(points, workers=THREADS if len(points) >= MIN_QUERY_SPLIT
+                               else 1)[1]
 
     def faces_within_reach(self, points):
         """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
