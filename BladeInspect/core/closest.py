@@ -47,7 +47,7 @@ POINT_CHUNK = 32768
 THREADS = 2
 # Points per chunk at least when a call is split over the threads (below, one chunk: the
 # threads' start-up and the per-face loops would cost more than the second core gives).
-MIN_THREAD_CHUNK = 4096
+MIN_THREAD_CHUNK = 1024
 # Points at least for nearest_sample to split its k-d query over the threads.
 MIN_QUERY_SPLIT = 256
 # Nearest samples searched for a Newton start on one given face.
@@ -222,9 +222,9 @@ class SampleCover:
         order = np.argsort(samples.face, kind="stable")
         cuts = np.searchsorted(samples.face[order], np.arange(n_faces + 1))
         members = [order[cuts[f]:cuts[f + 1]] for f in range(n_faces)]
-        for f, surf in enumerate(surfaces):
-            if not len(members[f]):
-                continue
+
+        def face_cover(f):
+            surf = surfaces[f]
             xyz = samples.xyz[members[f]]
             self.trees[f], self.uv[f] = cKDTree(xyz), samples.uv[members[f]]
             self.lo[f], self.hi[f] = xyz.min(axis=0), xyz.max(axis=0)
@@ -234,14 +234,19 @@ class SampleCover:
                     if surf.weights is None or np.all(surf.weights > 0) else np.inf)
             self.radius[f] = cover_radius(surf, domains[f], self.uv[f], self.trees[f], hull)
         self.sampled = np.flatnonzero(cuts[1:] > cuts[:-1])
+        # Hook (speed): the faces' trees and radii, then each face's clearances (rows of its
+        # own samples only), on the threads: numpy and the k-d trees release the GIL.
+        with ThreadPoolExecutor(max_workers=THREADS) as pool:
+            list(pool.map(face_cover, self.sampled))
         # A face without samples is never a candidate: only its patch boxes bound it.
         self.unsampled = [(f, patch_boxes(surfaces[f])) for f in
                           np.flatnonzero(cuts[1:] == cuts[:-1])]
         self.radius_max = float(self.radius.max()) if n_faces else 0.0
         reach = CLEARANCE_REACH * self.radius_max
         self.clearance = np.full(len(samples.xyz), reach - self.radius_max)
-        for b in self.sampled:
-            for a in self.sampled:
+
+        def face_clearance(a):
+            for b in self.sampled:
                 boxes_apart = np.maximum(np.maximum(self.lo[a] - self.hi[b],
                                                     self.lo[b] - self.hi[a]), 0.0)
                 if a == b or np.linalg.norm(boxes_apart) > reach:
@@ -253,6 +258,8 @@ class SampleCover:
                 d, _ = self.trees[b].query(samples.xyz[mine], distance_upper_bound=reach)
                 self.clearance[mine] = np.minimum(self.clearance[mine],
                                                   np.minimum(d, reach) - self.radius[b])
+        with ThreadPoolExecutor(max_workers=THREADS) as pool:
+            list(pool.map(face_clearance, self.sampled))
 
     def patch_boxes(self, f):
         """patch_boxes of face f, kept from the first call."""
