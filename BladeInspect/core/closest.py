@@ -35,8 +35,10 @@ from scipy.spatial import cKDTree
 from . import bspline
 from .trim import TrimDomain
 
-# Number of nearest samples whose faces become Newton candidates for a point.
-K_CANDIDATES = 8
+# Number of nearest samples whose faces become Newton candidates for a point. SampleCover
+# tries any face they miss that can be nearer, so this only trades the k-d query's cost
+# against the cover's: 8 cost a cold evaluation 10-15 % more, for the same answers.
+K_CANDIDATES = 4
 # Relative cosine above which the gradient at a bound means "the minimum lies outside".
 CLAMP_COSINE = 1e-7
 # Newton results farther than this from the nearest sample's distance are distrusted (mm).
