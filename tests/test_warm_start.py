@@ -30,18 +30,15 @@ class WarmStartKernel(unittest.TestCase):
         rng = np.random.default_rng(14)
         p, x, y, h = points_off(rng, 3000, x_range, y_range, height=0.005)
         before, _ = fs.closest(p)
-        # Rows the cold path got, per closest() call (a call may split into chunks on threads).
-        calls, chunks = [], []
-        closest_call, cold_path = fs.closest, fs.closest_chunk
-        fs.closest = lambda *args: calls.append(len(calls)) or closest_call(*args)
-        fs.closest_chunk = lambda points, *args: chunks.append(
-            (calls[-1], len(points))) or cold_path(points, *args)
+        cold_rows = []
+        cold_path = fs.closest_chunk
+        fs.closest_chunk = lambda points, *args: cold_rows.append(len(points)) or cold_path(
+            points, *args)
         for size in (1e-7, 1e-4, 2e-3, 1e-2, 0.3):
             moved = tf.apply_transform(small_motion(rng, size, p.mean(axis=0)), p)
             start = closest.FootStart.of(p, before)
             warm, warm_hard = fs.closest(moved, start)
             cold, cold_hard = fs.closest(moved)
-            cold_rows = [sum(n for c, n in chunks if c == k) for k in calls]
             if size <= 1e-4:   # the warm path decided all but the undecided few
                 self.assertLess(cold_rows[-2], len(cold_hard) + 0.05 * len(p))
             np.testing.assert_array_equal(warm_hard, cold_hard)

@@ -49,9 +49,7 @@ POINT_CHUNK = 32768
 THREADS = 2
 # Points per chunk at least when a call is split over the threads (below, one chunk: the
 # threads' start-up and the per-face loops would cost more than the second core gives).
-MIN_THREAD_CHUNK = 1024
-# Points at least for nearest_sample to split its k-d query over the threads.
-MIN_QUERY_SPLIT = 256
+MIN_THREAD_CHUNK = 4096
 # Nearest samples searched for a Newton start on one given face.
 START_CANDIDATES = 8
 # Factor on the largest sample distance found at a face's check points (cell corners, boundary
@@ -348,10 +346,7 @@ class FaceSet:
 
     def nearest_sample(self, points):
         """Index of each point's nearest sample."""
-        # Hook (speed): the coarse stage's ICP asks this from one thread, about points that
-        # start far from the samples (slow k-d queries); scipy splits them over the threads.
-        return self.tree.query(points, workers=THREADS if len(points) >= MIN_QUERY_SPLIT
-                               else 1)[1]
+        return self.tree.query(points)[1]
 
     def faces_within_reach(self, points):
         """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
