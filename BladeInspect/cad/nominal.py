@@ -31,10 +31,10 @@ from .raycast import cast, face_meshes
 MIN_SAMPLES_PER_SIDE = 12
 # Total samples aimed at when no spacing is given.
 DEFAULT_SAMPLE_COUNT = 60000
-# Points per trimming edge when discretising its pcurve.
+# Points per trimming edge when discretising its pcurve, at first and at most.
 PCURVE_SAMPLES = 400
-MAX_PCURVE_SAMPLES = 25600
-# Aimed chord error of the discretised trimming curves, relative to the parameter range.
+MAX_PCURVE_SAMPLES = 102400
+# Aimed chord error of the discretised trimming curves, relative to the face's size in 3D.
 CHORD_TARGET = 1e-6
 
 
@@ -105,10 +105,61 @@ def _pcurve_values(curve):
     return lambda t: np.array([[q.x, q.y] for q in (curve.value(x) for x in t)])
 
 
+def _pcurve_polyline(values, a, b, chord_target):
+    """(points (K, 2), largest chord error) of a polyline on a pcurve ``values`` over [a, b]:
+    PCURVE_SAMPLES uniform segments, each one whose midpoint is farther than ``chord_target``
+    from its chord split in four, until none is or the edge has MAX_PCURVE_SAMPLES segments
+    (refined where the curve bends only: a uniform refinement that meets the target at the
+    sharpest bend costs the whole curve that density)."""
+    t = np.linspace(a, b, PCURVE_SAMPLES + 1)
+    pts = values(t)
+    mids = values(0.5 * (t[1:] + t[:-1]))
+    while True:
+        chord = np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1)
+        bad = np.flatnonzero(chord > chord_target)
+        if not len(bad) or len(t) - 1 + 3 * len(bad) > MAX_PCURVE_SAMPLES:
+            return pts, float(chord.max())
+        # Each bad segment [t0, t1] gets nodes at its quarters (its midpoint already known)
+        # and midpoints at its eighths.
+        t0, h = t[bad], t[bad + 1] - t[bad]
+        new_t = t0[:, None] + h[:, None] * np.array([0.25, 0.75])
+        new_mid = t0[:, None] + h[:, None] * np.array([0.125, 0.375, 0.625, 0.875])
+        vals = values(np.concatenate([new_t.ravel(), new_mid.ravel()]))
+        q = vals[:2 * len(bad)].reshape(-1, 2, 2)
+        m = vals[2 * len(bad):].reshape(-1, 4, 2)
+        # Every segment becomes 1 (good) or 4 (bad) segments; rebuild nodes and midpoints.
+        per = np.ones(len(t) - 1, int)
+        per[bad] = 4
+        seg_start = np.concatenate([[0], np.cumsum(per)])
+        n_seg = seg_start[-1]
+        t_new = np.empty(n_seg + 1)
+        p_new = np.empty((n_seg + 1, 2))
+        m_new = np.empty((n_seg, 2))
+        good = np.flatnonzero(per == 1)
+        t_new[seg_start[good]], p_new[seg_start[good]] = t[good], pts[good]
+        m_new[seg_start[good]] = mids[good]
+        k = seg_start[bad]
+        t_new[k], p_new[k] = t0, pts[bad]
+        t_new[k + 1], p_new[k + 1] = new_t[:, 0], q[:, 0]
+        t_new[k + 2], p_new[k + 2] = t0 + 0.5 * h, mids[bad]
+        t_new[k + 3], p_new[k + 3] = new_t[:, 1], q[:, 1]
+        for j in range(4):
+            m_new[k + j] = m[:, j]
+        t_new[-1], p_new[-1] = t[-1], pts[-1]
+        t, pts, mids = t_new, p_new, m_new
+
+
 def _face_domain(nface, surf, planar):
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
     su, sv = u1 - u0, v1 - v0
     tol_u, tol_v = 1e-9 * max(1.0, su), 1e-9 * max(1.0, sv)
+    # The margin is a uv distance in every direction, so the chord error is aimed at in uv,
+    # scaled by the faster parameter's length per unit: in 3D it is then at most
+    # CHORD_TARGET of the face's size across the boundary (an error aimed at relative to the
+    # larger parameter range alone is ~100x that along a cylinder's angle in radians).
+    lu, lv = _extent(surf)
+    speed = max(lu / max(su, 1e-300), lv / max(sv, 1e-300))
+    chord_target = CHORD_TARGET * (max(lu, lv) / speed if speed > 0 else max(su, sv))
     polylines = []
     max_chord = 0.0
     on_box = True
@@ -118,17 +169,7 @@ def _face_domain(nface, surf, planar):
             if pc is None:
                 raise InputError("CAD face has an edge without a curve on its surface")
             curve, a, b = pc
-            values = _pcurve_values(curve)
-            count = PCURVE_SAMPLES
-            while True:
-                t = np.linspace(a, b, count + 1)
-                pts = values(t)
-                mids = values(0.5 * (t[1:] + t[:-1]))
-                chord = float(np.linalg.norm(mids - 0.5 * (pts[1:] + pts[:-1]), axis=1).max())
-                # The margin of undecided points grows with the chord error: refine until small.
-                if chord <= CHORD_TARGET * max(su, sv) or count >= MAX_PCURVE_SAMPLES:
-                    break
-                count *= 4
+            pts, chord = _pcurve_polyline(_pcurve_values(curve), a, b, chord_target)
             max_chord = max(max_chord, chord)
             on_u = (np.all(np.abs(pts[:, 0] - u0) <= tol_u) or np.all(np.abs(pts[:, 0] - u1) <= tol_u))
             on_v = (np.all(np.abs(pts[:, 1] - v0) <= tol_v) or np.all(np.abs(pts[:, 1] - v1) <= tol_v))
@@ -440,7 +481,9 @@ def _sample_face(surf, domain, reverse, spacing):
     if domain.index is not None:
         inside, _ = point_in_domain(domain, uv)
         uv = uv[inside]
-    S, Su, Sv = bspline.evaluate(surf, uv[:, 0], uv[:, 1], order=1)
+    # The power-basis patches (which Newton's projection builds anyway): cheaper than de
+    # Boor's recurrence.
+    S, Su, Sv = surf.power_patches().evaluate(uv[:, 0], uv[:, 1], order=1)
     nrm = np.cross(Su, Sv)
     area = np.linalg.norm(nrm, axis=1)
     keep = area > 0

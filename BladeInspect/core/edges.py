@@ -22,6 +22,11 @@ MIN_SAMPLES_PER_EDGE = 256
 # Newton iterations at most, and the step (mm along the curve) below which it has converged.
 MAX_ITER = 30
 STEP_TOL = 1e-12
+# Another edge within this of the nearest one, elsewhere, leaves the point undecided (mm).
+RIVAL_MM = 1e-9
+# Polyline vertices between two of an edge's, for its vertex_reach, and a factor on it.
+ARC_SUBDIVISIONS = 8
+ARC_SAFETY = 1.25
 
 
 @dataclass
@@ -90,6 +95,18 @@ def curve_polyline(curve):
     return np.append(t, b)
 
 
+def vertex_reach(curve, t):
+    """How far a point of the curve can be from the nearest of its polyline's vertices (at
+    parameters t): half the longest arc between two vertices, the arcs measured as the length
+    of a polyline ARC_SUBDIVISIONS times as dense (an arc is longer than any polyline inscribed
+    in it; ARC_SAFETY covers the difference, which is of order (segment x curvature)^2)."""
+    s = np.linspace(0.0, 1.0, ARC_SUBDIVISIONS + 1)
+    dense = (t[:-1, None] + s[None] * np.diff(t)[:, None]).ravel()
+    x = evaluate_curve(curve, dense, order=0)[0].reshape(len(t) - 1, ARC_SUBDIVISIONS + 1, -1)
+    arcs = np.linalg.norm(np.diff(x, axis=1), axis=2).sum(axis=1)
+    return 0.5 * ARC_SAFETY * float(arcs.max()) if len(arcs) else 0.0
+
+
 class FaceEdges:
     """A face's boundary edges: their curves and a k-d tree over each one's polyline."""
 
@@ -98,24 +115,44 @@ class FaceEdges:
         self.vertex_t = [curve_polyline(c) for c in self.curves]
         self.trees = [cKDTree(evaluate_curve(c, t, order=0)[0])
                       for c, t in zip(self.curves, self.vertex_t)]
+        self.reach = np.array([vertex_reach(c, t) for c, t in zip(self.curves, self.vertex_t)])
 
     def closest(self, points):
         """(distance (N,), closest point (N, 3), exact (N,) bool) of each point to the
         boundary: Newton on every edge from its polyline's nearest vertex, the nearest edge
         wins; exact is False where Newton did not converge, the winner is at an edge's end
         (a vertex) or another edge comes within a hair of it elsewhere."""
-        n = len(points)
-        dist = np.empty((len(self.curves), n))
-        closest = np.empty((len(self.curves), n, 3))
-        exact = np.empty((len(self.curves), n), bool)
-        for e, (curve, tree, ts) in enumerate(zip(self.curves, self.trees, self.vertex_t)):
-            _, i = tree.query(points)
-            _, c, conv, at_end = project_on_curve(curve, points, ts[i])
-            closest[e] = c
-            dist[e] = np.linalg.norm(c - points, axis=1)
-            exact[e] = conv & ~at_end
+        n, n_edges = len(points), len(self.curves)
+        # Edges that cannot come within RIVAL_MM of the nearest are not projected on (their
+        # closest points are neither the winner nor its rival): an edge is at least its
+        # nearest vertex's distance less its vertex_reach away, and at most that distance.
+        dist = np.full((n_edges, n), np.inf)
+        closest = np.zeros((n_edges, n, 3))
+        exact = np.zeros((n_edges, n), bool)
+        vertex_d, vertex_i = np.empty((n_edges, n)), np.empty((n_edges, n), int)
+        for e, tree in enumerate(self.trees):
+            vertex_d[e], vertex_i[e] = tree.query(points)
+        lower = vertex_d - self.reach[:, None]
+        done = np.zeros((n_edges, n), bool)
+        bound = vertex_d.min(axis=0)
+        while True:
+            todo = ~done & (lower <= bound + RIVAL_MM)
+            if not todo.any():
+                break
+            for e in np.flatnonzero(todo.any(axis=1)):
+                rows = np.flatnonzero(todo[e])
+                p = points[rows]
+                _, c, conv, at_end = project_on_curve(self.curves[e], p,
+                                                      self.vertex_t[e][vertex_i[e, rows]])
+                closest[e, rows] = c
+                dist[e, rows] = np.linalg.norm(c - p, axis=1)
+                exact[e, rows] = conv & ~at_end
+            done |= todo
+            # Newton need not descend: an edge above its vertex bound may still be the winner.
+            bound = dist.min(axis=0)
         win = np.argmin(dist, axis=0)
         cols = np.arange(n)
         best, c = dist[win, cols], closest[win, cols]
-        rival = ((dist < best + 1e-9) & (np.linalg.norm(closest - c, axis=2) > 1e-7)).any(axis=0)
+        rival = ((dist < best + RIVAL_MM)
+                 & (np.linalg.norm(closest - c, axis=2) > 1e-7)).any(axis=0)
         return best, c, exact[win, cols] & ~rival
