@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PPoly, splprep
+from scipy.interpolate import CubicSpline, PPoly, splev, splprep
 from scipy.spatial import ConvexHull, cKDTree
 
 from .errors import InputError
@@ -76,6 +76,9 @@ _MCL_SPACING_MM = 0.05        # least spacing of the camber line's centres
 # camber line thus stops within 1e-4 r of an exact circular edge's centre.
 _EDGE_GAP = 1e-4
 _DENSE_SPACING_MM = 0.02
+# Noisy points' feet on their first fit (_refit_in_arc_length): a table of that curve this
+# fine (at most this many samples), then Newton steps.
+_FOOT_TABLE_MM, _FOOT_TABLE_MAX, _FOOT_NEWTON = 1e-3, 400000, 3
 _DENSE_MIN, _DENSE_MAX = 2000, 8000
 
 
@@ -105,6 +108,11 @@ class Profile:
         self.point_params = u[:-1]
         smoothing = len(pts) * float(noise_mm) ** 2
         self._tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)
+        if noise_mm > 0:
+            # metal-angle hook: noisy points fitted again in the first fit's arc length
+            self.points, self.point_params, self._tck = _refit_in_arc_length(pts, self._tck,
+                                                                             u[-1], noise_mm)
+            self.length = float(self._tck[0][len(self._tck[0]) - 4])
         pieces = [PPoly.from_spline((self._tck[0], cx, 3)) for cx in self._tck[1]]
         keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
         keep &= np.diff(pieces[0].x) > 0
@@ -189,6 +197,49 @@ class Profile:
         x, w = np.polynomial.legendre.leggauss(order)
         a, b = knots[:-1, None], knots[1:, None]
         return ((a + b) / 2 + (b - a) / 2 * x).ravel(), ((b - a) / 2 * w).ravel()
+
+
+def _refit_in_arc_length(pts, first, first_length, noise_mm):
+    """Noisy points' smoothing spline in a parameter that is the curve's arc length: each
+    point's foot on the first fit ``first`` (a smoothing spline in the chord length between
+    consecutive points), measured as that fit's arc length; the points re-ordered along it.
+    Returns the points, their parameters and the spline.
+
+    Why (docs/airfoil.md, "Input and representation"): where points lie closer than their noise
+    (the planned edges: 2 um apart, 3.9 um noise) the chord length between consecutive points
+    is mostly noise -- a parameter running at up to 3x the arc length, as a random walk -- and
+    a parametric fit in it reads the curve biased round the edges: Rotor 67's 10 % section
+    planned, a perfect part, metal angles +19 / +5 mdeg over 24 scans (one outlet 0.33 deg
+    off), against +0.1 / -4.0 mdeg in this parameter."""
+    n_table = int(np.clip(first_length / _FOOT_TABLE_MM, 4 * len(pts), _FOOT_TABLE_MAX))
+    table_u = np.linspace(0.0, first_length, n_table + 1)
+    table = np.column_stack(splev(table_u, first))
+    arc = np.concatenate([[0.0], np.cumsum(_norms(np.diff(table, axis=0)))])
+    foot = table_u[cKDTree(table[:-1]).query(pts)[1]]
+    for _ in range(_FOOT_NEWTON):
+        p, d1, d2 = (np.column_stack(splev(foot, first, der=k)) for k in range(3))
+        g = np.einsum("ij,ij->i", p - pts, d1)
+        h = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", p - pts, d2)
+        h = np.where(h > 0, h, np.einsum("ij,ij->i", d1, d1))
+        foot = np.mod(foot - g / h, first_length)
+    s = np.interp(foot, table_u, arc)
+    order = np.argsort(s, kind="stable")
+    s, pts = s[order], pts[order]
+    # the parameter must increase strictly: of points with one foot, the first is kept
+    keep = np.concatenate([[True], np.diff(s) > 1e-12 * arc[-1]])
+    s, pts = s[keep], pts[keep]
+    foot = foot[order][keep]
+    # The budget: the points' own noise about the first fit (their normal residuals'
+    # consecutive differences, in which the first fit's smooth error cancels; RMS, unbiased
+    # for any noise distribution), never more than the noise given.
+    p, d1 = (np.column_stack(splev(foot, first, der=k)) for k in range(2))
+    residual = _cross2(d1, pts - p) / _norms(d1)
+    sigma = min(float(noise_mm), float(np.sqrt(np.mean(np.diff(residual) ** 2) / 2.0)))
+    closed = np.vstack([pts, pts[:1]])
+    s = s - s[0]           # the loop's parameter starts at its first point, as the first fit's
+    tck, _ = splprep([closed[:, 0], closed[:, 1]], u=np.concatenate([s, [arc[-1]]]),
+                     s=len(pts) * sigma ** 2, per=1, k=3, quiet=1)
+    return pts, s, tck
 
 
 def _corners(pts):
