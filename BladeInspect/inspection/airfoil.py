@@ -315,6 +315,7 @@ def _measure(pts2d, nominal_chars, opts, noise, le_hint):
     ch = kernel.characteristics(ordered, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
                                 edge_offsets_mm=opts.edge_offsets_mm, le_hint=le_hint,
                                 noise_mm=noise)
+    ch = kernel.withhold_corner_edges(ch, nominal_chars)      # metal-angle hook: sharp edges
     # the twist's pivot, the nominal's centroid, is known: not integrated again for each draw
     fit = kernel.fit_section(ordered, nominal_chars.profile, pivot=nominal_chars.centroid_mm)
     cont = kernel.contour(ordered, nominal_chars, fit)
