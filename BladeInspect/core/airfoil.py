@@ -209,7 +209,7 @@ def _refit_in_arc_length(pts, first, first_length, noise_mm):
     is mostly noise -- a parameter running at up to 3x the arc length, as a random walk -- and
     a parametric fit in it reads the curve biased round the edges: Rotor 67's 10 % section
     planned, a perfect part, metal angles +19 / +5 mdeg over 24 scans (one outlet 0.33 deg
-    off), against +0.1 / -4.0 mdeg in this parameter."""
+    off), -2.1 / -1.7 mdeg in this parameter with the budget below (bound ~6 mdeg)."""
     n_table = int(np.clip(first_length / _FOOT_TABLE_MM, 4 * len(pts), _FOOT_TABLE_MAX))
     table_u = np.linspace(0.0, first_length, n_table + 1)
     table = np.column_stack(splev(table_u, first))
@@ -1203,7 +1203,7 @@ def withhold_corner_edges(measured, nominal):
     why. A corner has no edge circle and no camber-line end for a tangent; the nominal's
     value is its cut's, read at the corner's exact vertex, while a measured profile's smooth
     fit rounds the corner off over the points' spacing and noise, and the same rule then
-    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.05-0.9 deg off,
+    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.03-0.45 deg off,
     1 sigma 0.2 deg). docs/airfoil.md, "Sharp edges"."""
     for name, point, angle, radius in (("LE", nominal.le_point, "inlet_angle_deg",
                                         "le_radius_mm"),
