@@ -78,6 +78,7 @@ _DENSE_SPACING_MM = 0.02
 # Noisy points' feet on their first fit (_refit_in_arc_length): a table of that curve this
 # fine (at most this many samples), then Newton steps.
 _FOOT_TABLE_MM, _FOOT_TABLE_MAX, _FOOT_NEWTON = 1e-3, 400000, 3
+_FREE_SHARE = 0.75            # of the spline's free coefficients taken off its budget
 _DENSE_MIN, _DENSE_MAX = 2000, 8000
 
 
@@ -209,7 +210,7 @@ def _refit_in_arc_length(pts, first, first_length, noise_mm):
     is mostly noise -- a parameter running at up to 3x the arc length, as a random walk -- and
     a parametric fit in it reads the curve biased round the edges: Rotor 67's 10 % section
     planned, a perfect part, metal angles +19 / +5 mdeg over 24 scans (one outlet 0.33 deg
-    off), -2.1 / -1.7 mdeg in this parameter with the budget below (bound ~6 mdeg)."""
+    off), -2.4 / -1.3 mdeg in this parameter with the budget below (bound ~6 mdeg)."""
     n_table = int(np.clip(first_length / _FOOT_TABLE_MM, 4 * len(pts), _FOOT_TABLE_MAX))
     table_u = np.linspace(0.0, first_length, n_table + 1)
     table = np.column_stack(splev(table_u, first))
@@ -241,13 +242,13 @@ def _refit_in_arc_length(pts, first, first_length, noise_mm):
                      quiet=1)
     # Of pure noise a least-squares spline with `free` coefficients leaves (N - free) sigma^2
     # and a smoothing one more (its penalty keeps part of them stiff): the budget is taken
-    # between, (N - free / 2) sigma^2. The excess of a budget of N sigma^2 is what the fit
-    # spends on the edges (double-circular-arc section at 2 um, 40 scans: inlet +5.1 mdeg at
-    # N, +4.5 here, +3.4 at N - free, where a rigidly moved demo section's max thickness moved
-    # by 0.17 um: too little smoothing lets the fit follow the points' small changes).
+    # between, (N - _FREE_SHARE free) sigma^2. The excess of a budget of N sigma^2 is what
+    # the fit spends on the edges (double-circular-arc section at 2 um, 40 scans: inlet +5.1
+    # mdeg at N, +4.1 here, +3.4 at N - free, where a rigidly moved demo section's max
+    # thickness moved by 0.17 um: too little smoothing follows the points' small changes).
     free = len(tck[0]) - 7
-    tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=(len(pts) - free / 2) * sigma ** 2,
-                     per=1, k=3, quiet=1)
+    tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u,
+                     s=(len(pts) - _FREE_SHARE * free) * sigma ** 2, per=1, k=3, quiet=1)
     return pts, s, tck
 
 
@@ -633,12 +634,11 @@ def _ray_hit(profile, origin, direction):
         lam = _cross2(p - origin, direction) / den
     ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau > 0)
     if not np.any(ok):
-        # metal-angle hook: an origin just outside the dense samples' polygon (a camber line's
-        # last centre in a sharp corner of a noisy profile, which the chords between samples
-        # cut off) crosses the profile just behind it: that crossing, within two samples'
-        # spacing (Rotor 67's 90 % TE, planned: 5 scans in 24 lost the whole section).
-        behind = ((np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau <= 0)
-                  & (tau >= -2.0 * profile.length / len(profile.dense)))
+        # metal-angle hook: an origin outside the profile (a camber line's last centre or
+        # its end in a sharp corner of a noisy profile, which the smooth fit rounds off)
+        # crosses it first just behind itself: that crossing (Rotor 67's 90 % TE, planned:
+        # 5 to 7 scans in 24 lost the whole section, the end 25-60 um outside the fit).
+        behind = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau <= 0)
         ok = behind
         tau = np.where(behind, -tau, tau)
     if not np.any(ok):
@@ -1203,8 +1203,8 @@ def withhold_corner_edges(measured, nominal):
     why. A corner has no edge circle and no camber-line end for a tangent; the nominal's
     value is its cut's, read at the corner's exact vertex, while a measured profile's smooth
     fit rounds the corner off over the points' spacing and noise, and the same rule then
-    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.03-0.45 deg off,
-    1 sigma 0.2 deg). docs/airfoil.md, "Sharp edges"."""
+    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.003-12 deg off,
+    1 sigma 3 deg over 22 scans). docs/airfoil.md, "Sharp edges"."""
     for name, point, angle, radius in (("LE", nominal.le_point, "inlet_angle_deg",
                                         "le_radius_mm"),
                                        ("TE", nominal.te_point, "outlet_angle_deg",
