@@ -612,7 +612,7 @@ def _closed_end(profile, centres, radii, end, circle, notes, window_pct):
         u, point = _ray_hit(profile, c[end], out)
     except InputError:
         c, r, out, bend = _line_end(centres, radii, end, window_pct=window_pct)
-        u, point = _ray_hit(profile, c[end], out)
+        u, point = _ray_hit(profile, c[end], out, behind=True)
         notes.append("the camber line's end at (%.4f, %.4f) mm could not be brought abreast "
                      "of its edge circle; it ends at its last inscribed circle"
                      % tuple(c[end]))
@@ -624,8 +624,9 @@ def _closed_end(profile, centres, radii, end, circle, notes, window_pct):
     return c, r, out, u, point
 
 
-def _ray_hit(profile, origin, direction):
-    """First crossing of the ray origin + tau * direction (tau > 0) with the profile."""
+def _ray_hit(profile, origin, direction, behind=False):
+    """First crossing of the ray origin + tau * direction (tau > 0) with the profile; with
+    ``behind``, when there is none, the line's nearest crossing behind the origin."""
     p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
     e = q - p
     den = _cross2(direction, e)
@@ -634,13 +635,13 @@ def _ray_hit(profile, origin, direction):
         lam = _cross2(p - origin, direction) / den
     ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau > 0)
     if not np.any(ok):
-        # metal-angle hook: an origin outside the profile (a camber line's last centre or
-        # its end in a sharp corner of a noisy profile, which the smooth fit rounds off)
-        # crosses it first just behind itself: that crossing (Rotor 67's 90 % TE, planned:
-        # 5 to 7 scans in 24 lost the whole section, the end 25-60 um outside the fit).
-        behind = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau <= 0)
-        ok = behind
-        tau = np.where(behind, -tau, tau)
+        # metal-angle hook: an origin outside the profile (the camber locus's last centre in
+        # a sharp corner of a noisy profile, which the smooth fit rounds off) crosses it
+        # first just behind itself: that crossing, for the edge the circle is fitted about
+        # (Rotor 67's 90 % TE, planned: 2-7 scans in 24 lost the whole section, the centre
+        # 25-60 um outside the fit).
+        ok = behind & (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau <= 0)
+        tau = np.where(ok, -tau, tau)
     if not np.any(ok):
         raise InputError("airfoil profile: the camber line's end tangent leaves the profile "
                          "without crossing it; the profile is not closed around it")
@@ -1049,10 +1050,12 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     # First the edge circles about the locus's ends, then the ends closed onto circular edges.
     out_a = _line_end(centres, radii, 0, window_pct=metal_angle_window_pct)[2]
     out_b = _line_end(centres, radii, -1, window_pct=metal_angle_window_pct)[2]
-    circle_a = _edge_circle(profile, centres[0], out_a, _ray_hit(profile, centres[0], out_a)[0][0],
+    circle_a = _edge_circle(profile, centres[0], out_a,
+                            _ray_hit(profile, centres[0], out_a, behind=True)[0][0],
                             edge_zone_deg)
     circle_b = _edge_circle(profile, centres[-1], out_b,
-                            _ray_hit(profile, centres[-1], out_b)[0][0], edge_zone_deg)
+                            _ray_hit(profile, centres[-1], out_b, behind=True)[0][0],
+                            edge_zone_deg)
     notes = []
     centres, radii, out_a, ua_end, end_a = _closed_end(profile, centres, radii, 0, circle_a,
                                                        notes, metal_angle_window_pct)
