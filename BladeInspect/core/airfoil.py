@@ -1206,8 +1206,8 @@ def withhold_corner_edges(measured, nominal):
     why. A corner has no edge circle and no camber-line end for a tangent; the nominal's
     value is its cut's, read at the corner's exact vertex, while a measured profile's smooth
     fit rounds the corner off over the points' spacing and noise, and the same rule then
-    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.003-12 deg off,
-    1 sigma 3 deg over 22 scans). docs/airfoil.md, "Sharp edges"."""
+    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.006-12 deg off,
+    1 sigma 2.6 deg over 22 scans). docs/airfoil.md, "Sharp edges"."""
     for name, point, angle, radius in (("LE", nominal.le_point, "inlet_angle_deg",
                                         "le_radius_mm"),
                                        ("TE", nominal.te_point, "outlet_angle_deg",
