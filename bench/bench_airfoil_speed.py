@@ -7,9 +7,7 @@ uncertainty re-fits, on the demo blade:
 
     scripts/fcpython bench/bench_airfoil_speed.py [POINTS.csv]
 
-Prints the CPU seconds of run_stage for draws 0 and the default draws (re-measured from scratch,
-"cold", and from the measured section's state, "warm": core.airfoil_propagation), the ratio of
-the two's stated u on the same draws, the CPU seconds of the kernel alone
+Prints the CPU seconds of run_stage for draws 0 and the default draws, of the kernel alone
 (core.airfoil.characteristics on the five nominal cuts), and of one kernel run a measured
 section (what every uncertainty re-fit repeats). BLAS is held to one thread (its
 spinning threads double a CPU figure on a shared machine).
@@ -31,11 +29,10 @@ from BladeInspect.inspection.pipeline import load_nominal, load_points, register
 HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 
 
-def stage_cpu(nominal, table, result, draws, remeasure="cold"):
+def stage_cpu(nominal, table, result, draws):
     t = time.process_time()
     stage = stage_mod.run_stage(nominal, stage_mod.planes_of_table(table),
-                                stage_mod.Options(draws=draws, remeasure=remeasure, seed=0),
-                                result, table.span_axis)
+                                stage_mod.Options(draws=draws), result, table.span_axis)
     return time.process_time() - t, stage
 
 
@@ -68,24 +65,11 @@ def main():
     if len(sys.argv) > 1:
         cases.insert(0, ("report on %s" % sys.argv[1], report_case(nominal, sys.argv[1])))
     for name, (table, result) in cases:
-        stated = {}
-        for draws, remeasure in ((0, "cold"), (stage_mod.DEFAULT_DRAWS, "cold"),
-                                 (stage_mod.DEFAULT_DRAWS, "warm")):
-            cpu, stage = stage_cpu(nominal, table, result, draws, remeasure)
+        for draws in (0, stage_mod.DEFAULT_DRAWS):
+            cpu, stage = stage_cpu(nominal, table, result, draws)
             n = [b["measured"]["n_points"] if b.get("measured") else 0 for b in stage.blocks]
-            print("%s: draws %2d (%s): %.2f s CPU for %d sections (points %s)"
-                  % (name, draws, remeasure, cpu, len(n), "/".join(map(str, n))))
-            if draws:
-                stated[remeasure] = [stage_mod._flat(b["uncertainty"] or {})
-                                     for b in stage.blocks]
-        # the same draws (seed) re-measured warm and from scratch: u warm / u cold
-        print("%s: u warm / u cold, the same %d draws, per section:" % (name,
-                                                                        stage_mod.DEFAULT_DRAWS))
-        for key in stated["cold"][0]:
-            ratios = [w[key] / c[key] for w, c in zip(stated["warm"], stated["cold"])
-                      if c.get(key) and key in w]
-            if ratios:
-                print("    %-24s %s" % (key, " ".join("%.2f" % x for x in ratios)))
+            print("%s: draws %2d: %.2f s CPU for %d sections (points %s)"
+                  % (name, draws, cpu, len(n), "/".join(map(str, n))))
         # one kernel run on each measured section (what each of the 12 re-fits repeats)
         measured = [r for r in stage.sections if r.measured is not None]
         t = time.process_time()

@@ -125,8 +125,10 @@ class CamberLine(_SectionGeometry):
         obj.Shape = Part.makePolygon([_vector(p) for p in xyz])
         obj.LengthMm = float(ch.mcl.length)
         obj.ChordMm = float(ch.chord_mm)
-        obj.InletAngleDeg = float(ch.inlet_angle_deg)
-        obj.OutletAngleDeg = float(ch.outlet_angle_deg)
+        # a measured sharp edge's metal angle is not measured (None): NaN, as the table's "-"
+        obj.InletAngleDeg = np.nan if ch.inlet_angle_deg is None else float(ch.inlet_angle_deg)
+        obj.OutletAngleDeg = (np.nan if ch.outlet_angle_deg is None
+                              else float(ch.outlet_angle_deg))
         obj.MaxThicknessMm = float(ch.max_thickness_mm)
         obj.LePoint = _vector(frame.to_3d(ch.le_point)[0])
         obj.TePoint = _vector(frame.to_3d(ch.te_point)[0])

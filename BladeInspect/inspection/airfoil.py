@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import airfoil as kernel
-from ..core import airfoil_propagation as propagation
 from ..core import contracts
 from ..core import decision as decision_mod
 from ..core import transforms as tf
@@ -64,11 +63,6 @@ class Options:
     tolerances: list = field(default_factory=list)     # of Tolerance
     characteristics_file: str = None
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
-    # how each draw is re-measured: "cold" from scratch (the kernel), "warm" from the measured
-    # section's state (core.airfoil_propagation; from scratch where that cannot stand in):
-    # seven times faster, but its edge radii's u is smaller than the draws' from scratch
-    # (docs/airfoil.md "Uncertainty, warm re-measure"), so not the default
-    remeasure: str = "cold"
     # the sensor's stated accuracy, a reading bias of unknown sign (half-width, mm); None: the
     # sensor model's, as inspection.uncertainty takes it for the deviations
     accuracy_mm: float = None
@@ -326,6 +320,7 @@ def _measure(pts2d, nominal_chars, opts, noise, le_hint):
     ch = kernel.characteristics(ordered, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
                                 edge_offsets_mm=opts.edge_offsets_mm, le_hint=le_hint,
                                 noise_mm=noise)
+    ch = kernel.withhold_corner_edges(ch, nominal_chars)      # metal-angle hook: sharp edges
     # the twist's pivot, the nominal's centroid, is known: not integrated again for each draw
     fit = kernel.fit_section(ordered, nominal_chars.profile, pivot=nominal_chars.centroid_mm)
     cont = kernel.contour(ordered, nominal_chars, fit)
@@ -479,12 +474,6 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     response = np.ones(len(idx)) if response is None else np.asarray(response)[idx]
     sigma, unit = _point_noise_model(result, idx, sensor, noise)
     draws = []
-    # propagation hook: the draws re-measured from the measured section's state
-    # (core.airfoil_propagation) where it stands in for the kernel, else from scratch
-    warm = propagation.warm_remeasure(ch, pts, nom, fit) if opts.remeasure == "warm" else None
-    if warm is not None:
-        smooth2 = frame.to_2d(_into_plane(smooth3, n0, frame.origin, frame.normal))
-        moves = []
     for _ in range(max(int(opts.draws), 2)):
         d = chol @ rng.standard_normal(6)
         R = tf.rotation_from_vector(d[3:])
@@ -492,18 +481,11 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
         moved = moved + out_normal * (sigma * unit(rng, len(moved)))[:, None]
         moved = moved + n0 * (rng.uniform(-accuracy, accuracy) * response)[:, None]
         p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
-        if warm is not None:
-            moves.append(p2 - smooth2)
-            continue
         try:
             c, f, k, _ = _measure(p2, nom, opts, noise, nom.le_point)
         except InputError:
             continue
         draws.append(_flat(_char_values(c, frame, f, k)))
-    if warm is not None:
-        for v in warm(np.array(moves)):
-            v["centroid_mm"] = frame.to_3d(v["centroid_mm"])[0].tolist()
-            draws.append(_flat(v))
     if len(draws) < 2:
         return None
     keys = _flat(measured_values).keys()
@@ -751,10 +733,7 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                       "normal (sigma_beam cos incidence, the sensor's "
                                       "distribution) on the measured profile's smooth fit and "
                                       "the sensor's bias, %d draws; form values add the bias of "
-                                      "a maximum" % opts.draws
-                                      + ("; each draw re-measured from the measured "
-                                         "section's state (core.airfoil_propagation)"
-                                         if opts.remeasure == "warm" else ""),
+                                      "a maximum" % opts.draws,
                 # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
                 "uncertainty_relative_accuracy": (None if opts.draws < 2 else
                                                   float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),
