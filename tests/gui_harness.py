@@ -92,9 +92,12 @@ def start_workbench(combo_width):
     sys.path.insert(0, REPO)
     window = Gui.getMainWindow()
     window.resize(1280, 1000)
-    combo = [d for d in window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"]
-    if combo:
-        window.resizeDocks(combo, [combo_width], QtCore.Qt.Horizontal)
+    # FreeCAD 0.20 has one "Combo View" dock; 1.0 splits it into tabbed "Model" and "Tasks"
+    # docks of other names: size every visible dock on the left
+    left = [d for d in window.findChildren(QtGui.QDockWidget)
+            if d.isVisible() and window.dockWidgetArea(d) == QtCore.Qt.LeftDockWidgetArea]
+    if left:
+        window.resizeDocks(left, [combo_width] * len(left), QtCore.Qt.Horizontal)
     Gui.activateWorkbench("BladeInspectWorkbench")
     from BladeInspect.gui import progress
     progress.SHOW_DIALOGS = False
