@@ -250,3 +250,31 @@ def suction_bump_at(nominal, height_pct, radius_mm, height_mm):
     pts = s.xyz[near]
     centre = pts[np.argmin(np.linalg.norm(pts - pts.mean(axis=0), axis=1))]
     return axis, make_bump(centre, radius_mm, height_mm)
+
+
+def cli_process(wrapper_pid):
+    """The pid of the CLI's Python process that the ``./bladeinspect`` wrapper ``wrapper_pid``
+    runs as its child (None while it has not started)."""
+    try:
+        with open("/proc/%d/task/%d/children" % (wrapper_pid, wrapper_pid)) as fh:
+            children = [int(pid) for pid in fh.read().split()]
+    except OSError:
+        return None
+    for pid in children:
+        try:
+            with open("/proc/%d/cmdline" % pid, "rb") as fh:
+                if b"BladeInspect.cli" in fh.read():
+                    return pid
+        except OSError:
+            continue
+    return None
+
+
+def process_state(pid):
+    """The kernel's one-letter state of ``pid`` ('T' stopped, 'Z' dead but not reaped), or
+    None once it is gone."""
+    try:
+        with open("/proc/%d/stat" % pid) as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return None

@@ -11,39 +11,15 @@ import tempfile
 import time
 import unittest
 
-from tests.helpers import REPO
+from tests.helpers import REPO, cli_process, process_state
 
 BLADEINSPECT = os.path.join(REPO, "bladeinspect")
 RESULT_FILES = ("result.json", "deviations.csv", "report.html", "report.pdf", "inspection.FCStd")
 
 
-def _children(pid):
-    try:
-        with open("/proc/%d/task/%d/children" % (pid, pid)) as fh:
-            return [int(p) for p in fh.read().split()]
-    except OSError:
-        return []
-
-
-def _python_child(wrapper_pid):
-    """The wrapper's Python process (its direct child running BladeInspect.cli)."""
-    for pid in _children(wrapper_pid):
-        try:
-            with open("/proc/%d/cmdline" % pid, "rb") as fh:
-                if b"BladeInspect.cli" in fh.read():
-                    return pid
-        except OSError:
-            pass
-    return None
-
-
 def _alive(pid):
     """True while ``pid`` runs (a zombie waiting to be reaped counts as ended)."""
-    try:
-        with open("/proc/%d/stat" % pid) as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
+    return process_state(pid) not in (None, "Z")
 
 
 class CrashIsNeverSilent(unittest.TestCase):
@@ -64,7 +40,7 @@ class CrashIsNeverSilent(unittest.TestCase):
                 lines.append(line)
                 # A progress line: FreeCAD is up and the run is inside a stage.
                 if killed is None and re.match(r"\[\s*\d+%\]", line):
-                    killed = _python_child(wrapper.pid)
+                    killed = cli_process(wrapper.pid)
                     self.assertIsNotNone(killed, "no Python child under the wrapper")
                     os.kill(killed, sig)
             rc = wrapper.wait(timeout=120)
@@ -102,7 +78,7 @@ class CrashIsNeverSilent(unittest.TestCase):
             try:
                 for line in wrapper.stderr:
                     if re.match(r"\[\s*\d+%\]", line):
-                        child = _python_child(wrapper.pid)
+                        child = cli_process(wrapper.pid)
                         wrapper.send_signal(sig)
                         break
                 rest = wrapper.stderr.read()

@@ -22,7 +22,8 @@ import numpy as np
 from BladeInspect.core.errors import InputError
 from BladeInspect.core.pointio import read_points
 from BladeInspect.measurement.journal import JOURNAL_FILE, read_journal
-from tests.helpers import demo_nominal, first_difference, read_json, read_lines
+from tests.helpers import (cli_process, demo_nominal, first_difference, process_state,
+                           read_json, read_lines)
 from tests.serial_support import FakeSimulatedRig, section_path
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -91,34 +92,6 @@ def start_simrig(procs, log):
     raise AssertionError("simrig printed no port within %d s" % START_TIMEOUT_S)
 
 
-def cli_process(wrapper):
-    """The pid of the CLI's Python process that the ``./bladeinspect`` wrapper runs as its
-    child (None while it has not started): the process that writes the checkpoint."""
-    try:
-        with open("/proc/%d/task/%d/children" % (wrapper.pid, wrapper.pid)) as fh:
-            children = [int(pid) for pid in fh.read().split()]
-    except OSError:
-        return None
-    for pid in children:
-        try:
-            with open("/proc/%d/cmdline" % pid, "rb") as fh:
-                if b"BladeInspect.cli" in fh.read():
-                    return pid
-        except OSError:
-            continue
-    return None
-
-
-def process_state(pid):
-    """The kernel's one-letter state of ``pid`` ('T' stopped, 'Z' dead but not reaped), or
-    None once it is gone."""
-    try:
-        with open("/proc/%d/stat" % pid) as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0]
-    except (OSError, IndexError):
-        return None
-
-
 def wait_for_state(pid, done):
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline:
@@ -139,7 +112,7 @@ def kill_when(proc, ready, what, log):
     deadline = time.monotonic() + RUN_TIMEOUT_S
     while time.monotonic() < deadline:
         if ready():
-            cli = cli_process(proc)
+            cli = cli_process(proc.pid)
             if cli is None:   # ready() reads what the CLI wrote, so it has been running
                 raise AssertionError("no CLI process under the wrapper %d" % proc.pid)
             os.kill(cli, signal.SIGSTOP)
