@@ -19,7 +19,9 @@ class BladeInspectWorkbench(FreeCADGui.Workbench):
         FreeCADGui.updateLocale()
 
     def Initialize(self):
+        from BladeInspect.core.blas_threads import limit_blas_threads
         from BladeInspect.gui import commands, loop_commands
+        limit_blas_threads()
         self.appendToolbar("BladeInspect", commands.TOOLBAR)
         self.appendToolbar("BladeInspect loop", loop_commands.NAMES)
         self.appendMenu("BladeInspect", commands.MENU + ["Separator"] + loop_commands.NAMES)

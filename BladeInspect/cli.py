@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from .core import contracts
+from .core.blas_threads import limit_blas_threads
 from .core.errors import Cancelled, DeviceError, InputError
 
 EXIT_BAD_INPUT = 2
@@ -461,6 +462,7 @@ OUT_FOLDER_COMMANDS = ("demo", "register", "simulate", "scan", "report", "batch"
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
+    limit_blas_threads()
     try:
         args = build_parser().parse_args(argv)
         if args.command in OUT_FOLDER_COMMANDS:

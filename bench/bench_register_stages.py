@@ -8,6 +8,7 @@ write) at the paper's 269,158 points on three blades in one run (issue 14's spee
   cylinder about the same engine axis, written to STEP and read back (built here, not kept).
 
     scripts/fcpython bench/bench_register_stages.py [--points 269158] [--seed 14]
+        [--only demo rotor67 step] [--repeat N]
         [--save FILE.npz] [--compare FILE.npz]
 
 After the stage times: how many point evaluations the exact distance handed to OpenCASCADE
@@ -32,6 +33,7 @@ import time
 import numpy as np
 
 from BladeInspect.core import transforms as tf
+from BladeInspect.core.blas_threads import limit_blas_threads
 from BladeInspect.core.pointio import write_points_csv
 from BladeInspect.cad.nominal import Nominal
 from BladeInspect.inspection import pipeline
@@ -150,13 +152,19 @@ def report_convergence(name, nominal, points_path, result, other_pose=None):
           % float(np.max(np.abs(exact - result.deviation))), flush=True)
 
 
-def blades(tmp):
-    out = [("demo blade", None)]
-    if os.path.exists(ROTOR67):
-        out.append(("Rotor 67", ROTOR67))
-    else:
-        print("Rotor 67 skipped: %s not found" % ROTOR67)
-    out.append(("third-party STEP", write_revolved_cap_step(os.path.join(tmp, "blade.step"))))
+def blades(tmp, only=None):
+    """(name, CAD path or None) of the blades to time; ``only``: a subset of demo, rotor67,
+    step."""
+    only = set(only or ("demo", "rotor67", "step"))
+    out = [("demo blade", None)] if "demo" in only else []
+    if "rotor67" in only:
+        if os.path.exists(ROTOR67):
+            out.append(("Rotor 67", ROTOR67))
+        else:
+            print("Rotor 67 skipped: %s not found" % ROTOR67)
+    if "step" in only:
+        out.append(("third-party STEP",
+                    write_revolved_cap_step(os.path.join(tmp, "blade.step"))))
     return out
 
 
@@ -167,12 +175,18 @@ def main(argv=None):
     ap.add_argument("--save")
     ap.add_argument("--compare")
     ap.add_argument("--converged", action="store_true")
+    ap.add_argument("--only", nargs="+", choices=("demo", "rotor67", "step"),
+                    help="time these blades only (default: all three)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="register each blade this many times (the stage times of each run)")
     args = ap.parse_args(argv)
+    limited = limit_blas_threads()   # as the CLI does (core.blas_threads)
+    print("BLAS threads limited to 1 in %s" % (", ".join(limited) or "no library"))
     print("load average %.2f %.2f %.2f on %d cores" % (os.getloadavg() + (os.cpu_count(),)))
     tmp = tempfile.mkdtemp(prefix="bench-stages-")
     saved, reference = {}, (dict(np.load(args.compare)) if args.compare else None)
     try:
-        for k, (name, cad) in enumerate(blades(tmp)):
+        for k, (name, cad) in enumerate(blades(tmp, args.only)):
             nominal = pipeline.load_nominal(cad)
             if cad is not None and cad.endswith(".step"):
                 kinds = sorted({type(f.Surface).__name__ for f in
@@ -182,22 +196,23 @@ def main(argv=None):
                                                outlier_fraction=0.02, seed=args.seed)
             points = os.path.join(tmp, "points%d.csv" % k)
             write_points_csv(points, ps.xyz, {"snr": ps.snr})
-            out = os.path.join(tmp, "out%d" % k)
-            clock = StageClock()
-            pipeline.time = clock
-            try:
-                with FallbackCount() as fallback:
-                    t0, c0 = time.perf_counter(), time.process_time()
-                    result = pipeline.run_register(cad, points, out, seed=args.seed)
-                    total, total_cpu = time.perf_counter() - t0, time.process_time() - c0
-            finally:
-                pipeline.time = time
-            print("%-17s %d points: register %.2f s [cpu %.2f] (%s); OCC fallback %d points "
-                  "in %d calls"
-                  % (name, len(ps.xyz), total, total_cpu,
-                     ", ".join("%s %.2f [%.2f]" % (k, v, clock.cpu_seconds(v))
-                               for k, v in result.timing_s.items()),
-                     fallback.points, fallback.calls), flush=True)
+            for run in range(args.repeat):
+                out = os.path.join(tmp, "out%d-%d" % (k, run))
+                clock = StageClock()
+                pipeline.time = clock
+                try:
+                    with FallbackCount() as fallback:
+                        t0, c0 = time.perf_counter(), time.process_time()
+                        result = pipeline.run_register(cad, points, out, seed=args.seed)
+                        total, total_cpu = time.perf_counter() - t0, time.process_time() - c0
+                finally:
+                    pipeline.time = time
+                print("%-17s %d points: register %.2f s [cpu %.2f] (%s); OCC fallback %d "
+                      "points in %d calls"
+                      % (name, len(ps.xyz), total, total_cpu,
+                         ", ".join("%s %.2f [%.2f]" % (k, v, clock.cpu_seconds(v))
+                                   for k, v in result.timing_s.items()),
+                         fallback.points, fallback.calls), flush=True)
             key = "b%d" % k
             saved[key + "_pose"] = result.measured_to_cad
             saved[key + "_dev"] = result.deviation

@@ -61,6 +61,9 @@ def claim(claims, module):
 
 def run_worker(index, claims, modules):
     """Runs every module this worker claims; writes its counts and failures to claims/."""
+    # Two workers on two cores: BLAS threads of their own would only contend (core.blas_threads).
+    from BladeInspect.core.blas_threads import limit_blas_threads
+    limit_blas_threads()
     stream = unittest.runner._WritelnDecorator(sys.stdout)
     result = CountingResult(stream, True, 2)
     loader = unittest.TestLoader()

@@ -43,8 +43,13 @@ K_CANDIDATES = 4
 CLAMP_COSINE = 1e-7
 # Newton results farther than this from the nearest sample's distance are distrusted (mm).
 SAMPLE_SLACK = 1e-9
-# Points per chunk (bounds the (chunk, K) candidate arrays).
-POINT_CHUNK = 32768
+# Points per chunk at most (bounds the (chunk, K) candidate arrays, a few MB). Every chunk pays
+# per-face costs that do not shrink with it (the Newton loops on each face, the boundary edges'
+# curve evaluations for the few points near a trim): on the third-party STEP blade at 269,158
+# points the fine stage took 2.81 s (mean of 6 runs) in 10 chunks of 32,768 at most, 2.45 s in
+# 6 and 2.37 s in 4 (bench/bench_register_stages.py --only step --repeat 3), with identical
+# results.
+POINT_CHUNK = 131072
 # Threads for the fast path.
 THREADS = 2
 # Points per chunk at least when a call is split over the threads (below, one chunk: the
@@ -345,8 +350,11 @@ class FaceSet:
         self.cover = SampleCover(surfaces, domains, samples)
 
     def nearest_sample(self, points):
-        """Index of each point's nearest sample."""
-        return self.tree.query(points)[1]
+        """Index of each point's nearest sample. The query runs on THREADS threads: it is
+        called from the caller's thread (the coarse stage's short ICP on the samples, whose
+        early iterations on far-off candidate poses make it slow), never from the fast path's
+        chunk workers."""
+        return self.tree.query(points, workers=THREADS)[1]
 
     def faces_within_reach(self, points):
         """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
@@ -368,8 +376,8 @@ class FaceSet:
                              np.full(n, -np.inf), np.zeros(n), np.zeros(n))
 
         # Hook (speed): equal chunks, as many as a multiple of the threads, so that neither
-        # thread waits for the other's last chunk (269,158 points in 9 chunks of 32,768 left
-        # one thread a chunk alone; the fine fit's 30,000 ran on one thread).
+        # thread waits for the other's last chunk (an odd number of chunks leaves one thread a
+        # chunk alone; the fine fit's 30,000 points would run on one thread).
         n_chunks = -(-n // POINT_CHUNK)
         if n >= THREADS * MIN_THREAD_CHUNK:
             n_chunks = THREADS * -(-n_chunks // THREADS)
