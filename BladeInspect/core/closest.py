@@ -350,11 +350,8 @@ class FaceSet:
         self.cover = SampleCover(surfaces, domains, samples)
 
     def nearest_sample(self, points):
-        """Index of each point's nearest sample. The query runs on THREADS threads: it is
-        called from the caller's thread (the coarse stage's short ICP on the samples, whose
-        early iterations on far-off candidate poses make it slow), never from the fast path's
-        chunk workers."""
-        return self.tree.query(points, workers=THREADS)[1]
+        """Index of each point's nearest sample."""
+        return self.tree.query(points)[1]
 
     def faces_within_reach(self, points):
         """(N, F) bool: the faces that may hold a point's closest point. The samples lie on
