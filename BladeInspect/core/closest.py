@@ -372,6 +372,25 @@ class FaceSet:
                              np.empty((n, 3)), np.empty(n), np.zeros(n, bool),
                              np.full(n, -np.inf), np.zeros(n), np.zeros(n))
 
+        def cold(rows):
+            return self.closest_chunk(points[rows], out, rows, start)
+        rows = np.arange(n)
+        if start is not None:
+            # The warm pass first, then what it leaves (near trims and edges: a few hundred
+            # points of a tracked fit's 269,158) in one cold pass, so that the cold path's
+            # per-face costs are paid once, not once per chunk. Every point's answer is its
+            # own: the batching changes none.
+            rows = np.concatenate(self._on_threads(
+                lambda r: self.warm_chunk(points, r, out, start), rows) or [rows[:0]])
+        hard = self._on_threads(cold, rows)
+        return out, (np.concatenate(hard) if hard else np.zeros(0, int))
+
+    @staticmethod
+    def _on_threads(work, rows):
+        """[work(chunk) for each chunk of ``rows``], the chunks on THREADS threads."""
+        n = len(rows)
+        if n == 0:
+            return []
         # Hook (speed): equal chunks, as many as a multiple of the threads, so that neither
         # thread waits for the other's last chunk (an odd number of chunks leaves one thread a
         # chunk alone; the fine fit's 30,000 points would run on one thread).
@@ -379,20 +398,12 @@ class FaceSet:
         if n >= THREADS * MIN_THREAD_CHUNK:
             n_chunks = THREADS * -(-n_chunks // THREADS)
         size = max(-(-n // max(n_chunks, 1)), 1)
-
-        def work(s):
-            rows = np.arange(s, min(s + size, n))
-            if start is not None:
-                rows = self.warm_chunk(points, rows, out, start)
-            return self.closest_chunk(points[rows], out, rows, start)
-        starts = range(0, n, size)
+        chunks = [rows[s:s + size] for s in range(0, n, size)]
         # numpy releases the GIL in its array loops: chunks on two threads use both cores.
-        if len(starts) > 1:
+        if len(chunks) > 1:
             with ThreadPoolExecutor(max_workers=THREADS) as pool:
-                hard = list(pool.map(work, starts))
-        else:
-            hard = [work(s) for s in starts]
-        return out, (np.concatenate(hard) if hard else np.zeros(0, int))
+                return list(pool.map(work, chunks))
+        return [work(c) for c in chunks]
 
     def warm_chunk(self, points, rows, out, start):
         """The warm path (module docstring) on ``points[rows]``: fills ``out``'s rows it
