@@ -18,7 +18,8 @@ w_i = a_i * rho_i:
   floored at 1 / max_noise_ratio^2 inside z (a low SNR lowers the weight, it does not excuse
   a gross error), and rho_i is multiplied by the same taper applied to the mean of the
   (clipped) z over the point's measured neighbourhood (a defect's low flanks are coherent,
-  noise is not).
+  noise is not), less the most the sensor's own systematic error (ICPOptions.systematic_mm,
+  its stated accuracy) can put in that mean, which is just as coherent.
   A point is an inlier when rho_i > 0.
 
 Iterations: Horn's closed form against the exact closest points first (robust from a coarse
@@ -51,6 +52,10 @@ class ICPOptions:
     min_scale: float = 1e-6     # mm: residuals below this are exact data, not noise to scale by
     max_noise_ratio: float = 1.0   # largest noise, in typical points' noise, granted a low SNR
     defect_neighbours: int = 16    # neighbourhood size of the defect test; 0 switches it off
+    # mm: the sensor's stated accuracy, the bound of its systematic reading error. The defect
+    # test grants every neighbourhood mean this much before judging it (robust_weights): a
+    # smooth field the sensor's own bias can leave is not a defect. 0: no sensor known.
+    systematic_mm: float = 0.0
     # A last Gauss-Newton step below both is applied to the residuals linearly, without a new
     # closest-point evaluation: their error is curvature * step^2.
     linear_update_mm: float = 1e-4
@@ -147,11 +152,25 @@ def robust_weights(distances, a, options, neighbourhoods=None):
     """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point).
 
     `neighbourhoods` (of the measured points) switches on the defect test: the mean of the
-    standardised residuals, clipped at +-k_full s, over a point's neighbourhood is judged
-    against the robust spread of those means. Noise averages out in a neighbourhood, a
-    defect's flank (a real deviation of a few sigma, too small for the per-point test) does
-    not, so flanks are rejected with the defect instead of tilting the fit; the clipping keeps
-    a gross outlier from rejecting its neighbours.
+    standardised residuals over a point's neighbourhood, its departure from the median of
+    those means judged against their robust spread (1.4826 MAD). Noise averages out in a
+    neighbourhood, a defect's flank (a real deviation of a few sigma, too small for the
+    per-point test) does not, so flanks are rejected with the defect instead of tilting the
+    fit; each residual enters the mean clipped at +-(k_full s + its allowance below), which
+    keeps a gross outlier from rejecting its neighbours.
+
+    The spread is that of the noise, sigma / sqrt(size) (0.9 um for the default sensor). But
+    a reading bias b (|b| <= the sensor's stated accuracy, options.systematic_mm) moves every
+    point by b beta_i along its normal (beta_i = beam . normal, 0..1), and the rigid fit
+    leaves a smooth field of that: a level common to the cloud (the median takes it out; a
+    defect departs from its surroundings, not from zero) and a variation of up to the
+    accuracy about it, 5-7 spreads, which the test alone would reject as a flank (docs/fits.md,
+    "The defect test and the sensor's bias"). So a departure counts only by what exceeds the
+    most that variation can be, systematic_mm times the neighbourhood's mean of sqrt(a_i)
+    (z's scaling): a point is down-weighted from accuracy + k_full spreads, rejected from
+    accuracy + k_zero spreads (with the default sensor 6 + 2.6 and 6 + 3.9 um at a typical
+    point). A departure within the stated accuracy cannot be told from the sensor's own
+    error, and is fitted as the sensor's error is.
     """
     usable = (a > 0) & np.isfinite(distances)
     if not usable.any():
@@ -160,16 +179,22 @@ def robust_weights(distances, a, options, neighbourhoods=None):
     # but gross errors are what low SNRs bring (docs/contracts.md), so when judging outliers no
     # point is granted more than max_noise_ratio times a typical point's noise (by default none: the
     # SNR lowers a point's weight, it does not excuse its residual).
-    z = np.where(usable, distances * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2)),
-                 np.inf)
+    root = np.sqrt(np.maximum(a, options.max_noise_ratio ** -2))
+    z = np.where(usable, distances * root, np.inf)
     u, scale = _robust_deviation(z, usable, options)
     rho = _taper(u, options)
     if neighbourhoods is not None:
-        limit = options.k_full * scale
+        granted = options.systematic_mm * root
+        limit = options.k_full * scale + granted
         local = neighbourhoods.means(np.clip(z, -limit, limit), usable)
         finite = np.isfinite(local)
         if finite.any():
-            rho = rho * _taper(_robust_deviation(local, finite, options)[0], options)
+            level = np.median(local[finite])
+            departure = np.abs(local - level)
+            spread = max(MAD_TO_SIGMA * np.median(departure[finite]), options.min_scale)
+            allowance = neighbourhoods.means(granted, usable)
+            excess = np.where(finite, np.maximum(departure - allowance, 0.0), np.inf)
+            rho = rho * _taper(excess / spread, options)
     return rho, scale
 
 
