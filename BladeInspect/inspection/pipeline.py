@@ -381,10 +381,10 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     ``time_limit_s``; an InputError says so when it is spent. ``weight_model``: core.icp's
     (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
     all the points to use (so that the caller can start its deviations from the fit's last
-    foot points), or None. ``systematic_mm``: the sensor's stated accuracy, which core.icp's
-    defect test grants every neighbourhood (a smooth field of that size is the sensor's own
-    bias, not a defect's flank: docs/fits.md); the default sensor's, as the uncertainty
-    model's systematic term."""
+    foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
+    sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
+    core.icp's defect test grants each neighbourhood the field a bias of that size leaves
+    after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
     rng = np.random.default_rng(1) if rng is None else rng
     full_distance = full_distance or TrackedDistance(nominal)
     deadline = time.monotonic() + time_limit_s
