@@ -10,10 +10,12 @@ weights and with core.icp's neighbourhood defect test switched off (defect_neigh
 It prints the pose's error against the true pose (translation um, rotation mdeg, in the CAD
 frame), the inliers, and the model's linear prediction (b times the response at b = 0).
 
-Defect test "bias out" is a prototype of a fix, here only: the neighbourhood means are judged
-after removing the best-fitting multiple b^ of the bias's own signature (the means of s_i
-sqrt(a_i), s_i at the true pose), |b^| <= the sensor's accuracy: a smooth field the stated
-accuracy can leave is not a defect's flank (docs/fits.md, "What is still outside").
+Defect test "on" is core.icp's as the loop runs it: since the beams' allowance (docs/fits.md,
+"The defect test and the sensor's bias") each neighbourhood is granted the field a bias of the
+stated accuracy leaves there, accuracy |s_i| sqrt(a_i). "bias out" is an earlier prototype, kept
+for comparison, here only: core.icp's rule as it was before that allowance, its neighbourhood
+means judged after removing the best-fitting multiple b^ of the bias's own signature (the means
+of s_i sqrt(a_i), s_i at the true pose), |b^| <= the sensor's accuracy.
 
     scripts/fcpython bench/bench_bias_take_up.py [--blade rotor67|demo] [--noise-seed 5]
 """
@@ -74,7 +76,8 @@ def signature_removed_weights(signature, accuracy):
     """core.icp.robust_weights with the defect test's neighbourhood means judged after the
     best-fitting b^ signature (|b^| <= accuracy) is taken out; the whole cloud's fits only
     (the subsample levels keep the test as it is)."""
-    def robust_weights(distances, a, options, neighbourhoods=None):
+    def robust_weights(distances, a, options, neighbourhoods=None, bias_response=None):
+        # bias_response (core.icp's allowance) left unused: the prototype is the rule before it
         if neighbourhoods is None or len(distances) != len(signature):
             return original_robust_weights(distances, a, options, neighbourhoods)
         usable = (a > 0) & np.isfinite(distances)

@@ -18,7 +18,9 @@ w_i = a_i * rho_i:
   floored at 1 / max_noise_ratio^2 inside z (a low SNR lowers the weight, it does not excuse
   a gross error), and rho_i is multiplied by the same taper applied to the mean of the
   (clipped) z over the point's measured neighbourhood (a defect's low flanks are coherent,
-  noise is not).
+  noise is not), less, where the beams are known, the most the sensor's own systematic error
+  (ICPOptions.systematic_mm, its stated accuracy) can leave in that mean after the fit, which
+  is just as coherent.
   A point is an inlier when rho_i > 0.
 
 Iterations: Horn's closed form against the exact closest points first (robust from a coarse
@@ -51,6 +53,11 @@ class ICPOptions:
     min_scale: float = 1e-6     # mm: residuals below this are exact data, not noise to scale by
     max_noise_ratio: float = 1.0   # largest noise, in typical points' noise, granted a low SNR
     defect_neighbours: int = 16    # neighbourhood size of the defect test; 0 switches it off
+    # mm: the sensor's stated accuracy, the bound of its systematic reading error. Where the
+    # beams are known the defect test grants each neighbourhood's mean the field a bias of
+    # this size can leave after the fit (robust_weights): that is the sensor's error, not a
+    # defect. 0: no sensor known.
+    systematic_mm: float = 0.0
     # A last Gauss-Newton step below both is applied to the residuals linearly, without a new
     # closest-point evaluation: their error is curvature * step^2.
     linear_update_mm: float = 1e-4
@@ -143,15 +150,28 @@ def _robust_deviation(values, usable, options):
     return np.where(usable, np.abs(values) / scale, np.inf), scale
 
 
-def robust_weights(distances, a, options, neighbourhoods=None):
+def robust_weights(distances, a, options, neighbourhoods=None, bias_response=None):
     """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point).
 
     `neighbourhoods` (of the measured points) switches on the defect test: the mean of the
-    standardised residuals, clipped at +-k_full s, over a point's neighbourhood is judged
-    against the robust spread of those means. Noise averages out in a neighbourhood, a
-    defect's flank (a real deviation of a few sigma, too small for the per-point test) does
-    not, so flanks are rejected with the defect instead of tilting the fit; the clipping keeps
-    a gross outlier from rejecting its neighbours.
+    standardised residuals, clipped, over a point's neighbourhood is judged against the robust
+    spread of those means. Noise averages out in a neighbourhood, a defect's flank (a real
+    deviation of a few sigma, too small for the per-point test) does not, so flanks are
+    rejected with the defect instead of tilting the fit; the clipping (at +-k_full s, plus the
+    allowance below) keeps a gross outlier from rejecting its neighbours.
+
+    That spread is the noise's, sigma / sqrt(size) (0.9 um for the default sensor). A reading
+    bias b, |b| <= the sensor's stated accuracy (options.systematic_mm), moves each point's
+    residual by b s_i after the rigid fit has taken up what it can (`bias_response`, s_i =
+    beta_i - J_i (J^T W J)^-1 J^T W beta, beta_i = beam . normal; see _bias_response): a smooth
+    field reaching several um where the beams meet the surface unlike the rest (edges, grazing
+    views), 5-7 spreads, which the test alone would reject as a flank, and reject or keep
+    depending on the draw (docs/fits.md, "The defect test and the sensor's bias"). So with
+    `bias_response` a neighbourhood's mean counts only by what exceeds the most that field can
+    put in it, systematic_mm times the mean of |s_i| sqrt(a_i) (z's scaling): a point is
+    down-weighted from that + k_full spreads, rejected from that + k_zero spreads. Where the
+    sensor's bias cannot move a residual (s_i = 0) nothing is granted; without beams
+    (`bias_response` None) nothing either, the test as it was.
     """
     usable = (a > 0) & np.isfinite(distances)
     if not usable.any():
@@ -160,17 +180,39 @@ def robust_weights(distances, a, options, neighbourhoods=None):
     # but gross errors are what low SNRs bring (docs/contracts.md), so when judging outliers no
     # point is granted more than max_noise_ratio times a typical point's noise (by default none: the
     # SNR lowers a point's weight, it does not excuse its residual).
-    z = np.where(usable, distances * np.sqrt(np.maximum(a, options.max_noise_ratio ** -2)),
-                 np.inf)
+    root = np.sqrt(np.maximum(a, options.max_noise_ratio ** -2))
+    z = np.where(usable, distances * root, np.inf)
     u, scale = _robust_deviation(z, usable, options)
     rho = _taper(u, options)
     if neighbourhoods is not None:
-        limit = options.k_full * scale
+        granted = (0.0 if bias_response is None or options.systematic_mm <= 0 else
+                   options.systematic_mm * np.abs(np.nan_to_num(bias_response)) * root)
+        limit = options.k_full * scale + granted
         local = neighbourhoods.means(np.clip(z, -limit, limit), usable)
         finite = np.isfinite(local)
         if finite.any():
-            rho = rho * _taper(_robust_deviation(local, finite, options)[0], options)
+            spread = _robust_deviation(local, finite, options)[1]
+            allowance = (0.0 if np.isscalar(granted)
+                         else neighbourhoods.means(np.where(usable, granted, 0.0), usable))
+            excess = np.where(finite, np.maximum(np.abs(local) - allowance, 0.0), np.inf)
+            rho = rho * _taper(excess / spread, options)
     return rho, scale
+
+
+def _bias_response(moved, normals, beams_cad, a):
+    """(N,) s_i: each residual's change per unit reading bias once a weighted (``a``) rigid
+    fit has taken up what it can, beta_i - J_i (J^T W J)^-1 J^T W beta with beta_i = beam_i .
+    n_i (uncertainty.systematic_coefficients' model, at this pose; 0 where unusable)."""
+    beta = np.einsum("ij,ij->i", beams_cad, normals)
+    keep = (a > 0) & np.isfinite(beta)
+    s = np.zeros(len(beta))
+    if np.count_nonzero(keep) < 7:
+        return s
+    w = a[keep]
+    J = _jacobian(moved[keep], normals[keep], w @ moved[keep] / w.sum())
+    JW = J.T * w
+    s[keep] = beta[keep] - J @ np.linalg.lstsq(JW @ J, JW @ beta[keep], rcond=1e-12)[0]
+    return s
 
 
 class Neighbourhoods:
@@ -353,11 +395,13 @@ def _gauss_newton_step(points_cad, normals, distances, w, center):
     return x[:3], x[3:]
 
 
-def icp(points, snr, closest_fn, init, options=None, weight_model=None):
+def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=None):
     """Register `points` (measured frame) to the surface behind `closest_fn`, starting at `init`
     (measured -> CAD). See the module docstring for the objective and the weights;
     ``weight_model(T, normals) -> (N,)`` (core.weights.SensorWeights), when given, replaces the
-    SNR weights a_i and is re-evaluated at every closest-point evaluation."""
+    SNR weights a_i and is re-evaluated at every closest-point evaluation. ``beams`` (N,3):
+    each reading's beam in the measured frame (default: the weight model's, if it has them),
+    from which the defect test grants the field the sensor's bias can leave (robust_weights)."""
     options = options or ICPOptions()
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 7:
@@ -366,6 +410,18 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
     a = snr_weights(snr, len(points))
     neighbourhoods = (Neighbourhoods(points, options.defect_neighbours)
                       if 0 < options.defect_neighbours < len(points) else None)
+    if beams is None:
+        beams = getattr(weight_model, "beam", None)
+    if beams is not None:
+        beams = np.asarray(beams, dtype=float)
+        if beams.shape != points.shape:
+            raise InputError("icp: beams have shape %s, expected %s"
+                             % (beams.shape, points.shape))
+
+    def bias_response(T, moved, normals):
+        if beams is None or neighbourhoods is None or options.systematic_mm <= 0:
+            return None
+        return _bias_response(moved, normals, beams @ T[:3, :3].T, a)
     T = np.array(init, dtype=float)
     converged = False
     iterations = 0
@@ -383,7 +439,8 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
         iterations += 1
         if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
             a = normalised_weights(weight_model, T, normals, len(points))
-        rho, _ = robust_weights(distances, a, options, neighbourhoods)
+        rho, _ = robust_weights(distances, a, options, neighbourhoods,
+                                bias_response(T, moved, normals))
         w = a * rho
         if np.count_nonzero(w) < 7:
             last_step = None
@@ -430,7 +487,8 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None):
         closest, normals, distances = closest_fn(moved)
     if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
         a = normalised_weights(weight_model, T, normals, len(points))
-    rho, _ = robust_weights(distances, a, options, neighbourhoods)
+    rho, _ = robust_weights(distances, a, options, neighbourhoods,
+                            bias_response(T, moved, normals))
     w = a * rho
     inlier = rho > 0
     center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)

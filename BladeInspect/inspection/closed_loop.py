@@ -548,7 +548,8 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
             register_options["weights"], kinematics, phase.source)
         fit = pipeline.fine_register(xyz, snr, nominal, pose,
                                      progress=lambda f, m: progress(phase.fit_progress, m),
-                                     weight_model=weight_model)
+                                     weight_model=weight_model,
+                                     systematic_mm=rig.sensor.accuracy)
         timing[phase.fit_timing[attempt]] = time.perf_counter() - t0
         if not phase.again(state, plan, pose, fit, n_measured, attempt, checkpoint):
             break

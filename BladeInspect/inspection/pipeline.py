@@ -373,14 +373,18 @@ def final_distances(fit, tracked):
 
 
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
-                  time_limit_s=FINE_TIME_LIMIT_S, weight_model=None, full_distance=None):
+                  time_limit_s=FINE_TIME_LIMIT_S, weight_model=None, full_distance=None,
+                  systematic_mm=checks.SENSOR_ACCURACY_MM):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
     information (and its covariance is the whole cloud's). Both runs together get
     ``time_limit_s``; an InputError says so when it is spent. ``weight_model``: core.icp's
     (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
     all the points to use (so that the caller can start its deviations from the fit's last
-    foot points), or None."""
+    foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
+    sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
+    core.icp's defect test grants each neighbourhood the field a bias of that size leaves
+    after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
     rng = np.random.default_rng(1) if rng is None else rng
     full_distance = full_distance or TrackedDistance(nominal)
     deadline = time.monotonic() + time_limit_s
@@ -405,18 +409,22 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         first = sub[_subsample(len(sub), FINE_FIRST_SUBSAMPLE, rng)]
         full_distance.start = FootStart.none(n)
         progress(0.1, "fine registration on %d of %d points" % (len(first), n))
-        T = fit_level(first, icp_mod.ICPOptions(time_limit_s=remaining()))
+        T = fit_level(first, icp_mod.ICPOptions(systematic_mm=systematic_mm,
+                                                time_limit_s=remaining()))
         progress(0.3, "fine registration on %d of %d points" % (len(sub), n))
         T = fit_level(sub, icp_mod.ICPOptions(horn_iters=0, max_iter=SUBSAMPLE_STEPS,
+                                              systematic_mm=systematic_mm,
                                               linear_update_mm=np.inf, linear_update_rad=np.inf,
                                               time_limit_s=remaining()))
         options = icp_mod.ICPOptions(max_iter=FULL_CLOUD_STEPS, horn_iters=0,
+                                     systematic_mm=systematic_mm,
                                      uncertainty_fraction=FULL_CLOUD_UNCERTAINTY_FRACTION,
                                      linear_update_mm=LINEAR_UPDATE_MM,
                                      linear_update_rad=LINEAR_UPDATE_RAD,
                                      time_limit_s=remaining())
     else:
         options = icp_mod.ICPOptions(linear_update_mm=LINEAR_UPDATE_MM,
+                                     systematic_mm=systematic_mm,
                                      linear_update_rad=LINEAR_UPDATE_RAD,
                                      time_limit_s=remaining())
     progress(0.6, "fine registration on all %d points" % n)
