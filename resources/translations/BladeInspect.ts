@@ -9,6 +9,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>%s (not measured)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>%s. Pose uncertainty %.2f µm after the planned scan (%.2f µm after the blind scan); ICP weights: %s. Files in %s</source>
         <translation type="unfinished"></translation>
@@ -63,6 +68,26 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Airfoil characteristics...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: FAIL, %d of %d characteristics: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: NOT PROVEN, %d of %d characteristics: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: PASS (%d characteristics)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: no characteristic toleranced</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
