@@ -48,8 +48,16 @@ VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
 # Sensitivity columns before and after the objectives'
 SENSITIVITY_LEADING = (AIRFOIL_COLUMNS[0], AIRFOIL_COLUMNS[1])
 SENSITIVITY_CHANGE = (QT_TRANSLATE_NOOP("BladeInspect", "Change"),
-                      QT_TRANSLATE_NOOP("BladeInspect", "Largest minus smallest value over "
-                                                        "the objectives"))
+                      QT_TRANSLATE_NOOP("BladeInspect", "Largest minus smallest over the "
+                                                        "objectives: of a worst deviation's "
+                                                        "size |value| (what the verdict "
+                                                        "judges against \u00b1T), of an "
+                                                        "airfoil characteristic's value"))
+# A worst deviation's change marked when it is + under one objective and - under another
+SIDE_MARK = " *"
+SIDE_NOTE = QT_TRANSLATE_NOOP("BladeInspect", "*: the worst deviation is + under one objective "
+                                              "and - under another; the change is of its "
+                                              "size, which the verdict judges")
 
 
 def tr(text):
@@ -320,8 +328,10 @@ def sensitivity_table(sensitivity):
                     tip += ", U = %.4f %s" % (U, unit)
                 table.setItem(r, c, colour_verdict(
                     _item(_number(value, True), tip, NUMBER), cell.get("verdict")))
+            side = bool(row.get("side_changes"))
             table.setItem(r, len(columns) - 1, _item(
-                "%.4f" % row.get("change_mm", row.get("change")), align=NUMBER))
+                "%.4f%s" % (row.get("change_mm", row.get("change")), SIDE_MARK if side else ""),
+                tr(SIDE_NOTE) if side else None, NUMBER))
             r += 1
     table.setItem(r, 0, _item(tr(names.PART_VERDICT)))
     for c, objective in enumerate(objectives, 2):

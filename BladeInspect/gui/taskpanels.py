@@ -361,6 +361,8 @@ def sensitivity_widget(sensitivity):
                         translate("BladeInspect", "changes")
                         if sensitivity["verdict_changes"]
                         else translate("BladeInspect", "does not change")))
+    if any(row.get("side_changes") for row in sensitivity["rows"]):
+        lines.append(tables.tr(tables.SIDE_NOTE))
     label = QtGui.QLabel("\n".join(lines))
     label.setWordWrap(True)
     layout.addWidget(label)

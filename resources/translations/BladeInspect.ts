@@ -29,6 +29,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>*: the worst deviation is + under one objective and - under another; the change is of its size, which the verdict judges</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>2 turns the part over to scan the other side</source>
         <translation type="unfinished"></translation>
@@ -494,7 +499,7 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
-        <source>Largest minus smallest value over the objectives</source>
+        <source>Largest minus smallest over the objectives: of a worst deviation's size |value| (what the verdict judges against ±T), of an airfoil characteristic's value</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
