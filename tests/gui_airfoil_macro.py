@@ -71,6 +71,21 @@ def run():
                   (table.width(), table.horizontalScrollBar().maximum()))
             check("the fit-sensitivity table's headers read whole at 560 px",
                   not clipped_headers(table), clipped_headers(table))
+            # a worst deviation's change is of its size; "*" when it changes side
+            wrong, last = [], table.columnCount() - 1
+            for r in range(table.rowCount()):
+                name = table.item(r, 0)
+                if name is None or "Worst deviation" not in name.text():
+                    continue
+                values = [float(table.item(r, c).text()) for c in range(2, last)]
+                sizes = [abs(v) for v in values]
+                shown = table.item(r, last).text()
+                side = min(values) < 0 < max(values)
+                if abs(float(shown.rstrip(" *")) - (max(sizes) - min(sizes))) > 1.5e-4 or \
+                        shown.endswith("*") != side:
+                    wrong.append((name.text(), values, shown))
+            check("the worst deviations' change is of their size, * on a change of side",
+                  not wrong, wrong)
         Gui.Control.closeDialog()
         state.update(blade=blade, reg=regs[0])
 
