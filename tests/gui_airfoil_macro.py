@@ -10,8 +10,9 @@ import FreeCADGui as Gui
 from PySide import QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
-from tests.gui_harness import (OUT, active_panel, check, run_scenario,  # noqa: E402
-                               settle, start_workbench, step, view_shot, window_shot)
+from tests.gui_harness import (OUT, active_panel, check, clipped_headers,  # noqa: E402
+                               run_scenario, settle, start_workbench, step, view_shot,
+                               window_shot)
 
 
 class ConsoleLines:
@@ -68,6 +69,23 @@ def run():
             check("the fit-sensitivity table does not scroll sideways",
                   table.horizontalScrollBar().maximum() == 0,
                   (table.width(), table.horizontalScrollBar().maximum()))
+            check("the fit-sensitivity table's headers read whole at 560 px",
+                  not clipped_headers(table), clipped_headers(table))
+            # a worst deviation's change is of its size; "*" when it changes side
+            wrong, last = [], table.columnCount() - 1
+            for r in range(table.rowCount()):
+                name = table.item(r, 0)
+                if name is None or "Worst deviation" not in name.text():
+                    continue
+                values = [float(table.item(r, c).text()) for c in range(2, last)]
+                sizes = [abs(v) for v in values]
+                shown = table.item(r, last).text()
+                side = min(values) < 0 < max(values)
+                if abs(float(shown.rstrip(" *")) - (max(sizes) - min(sizes))) > 1.5e-4 or \
+                        shown.endswith("*") != side:
+                    wrong.append((name.text(), values, shown))
+            check("the worst deviations' change is of their size, * on a change of side",
+                  not wrong, wrong)
         Gui.Control.closeDialog()
         state.update(blade=blade, reg=regs[0])
 
@@ -118,6 +136,18 @@ def run():
             check("the characteristics table does not scroll sideways",
                   table.horizontalScrollBar().maximum() == 0,
                   (table.width(), table.horizontalScrollBar().maximum()))
+            check("the characteristics table's headers read whole at 560 px",
+                  not clipped_headers(table),
+                  (clipped_headers(table), table.viewport().width(),
+                   [table.horizontalHeader().sectionSize(c)
+                    for c in range(table.columnCount())]))
+            verdict = airfoil_objects.analysis_of(group)["airfoil_verdict"]
+            line = panel.verdict_label.text()
+            check("the verdict line names the characteristics as the table does",
+                  "Airfoil: " in line and "Stagger angle" in line and "LE radius" in line
+                  and not any(k in line for k in ("stagger_deg", "le_radius_mm", "chord_mm"))
+                  and panel.verdict_label.toolTip() == verdict["summary"]
+                  and "stagger_deg" in verdict["summary"], (line, verdict["summary"]))
         window_shot("airfoil_task_panel_characteristics")
         Gui.Control.closeDialog()
         kinds = [objects.proxy_type(o) for o in group.Group]

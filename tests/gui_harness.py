@@ -77,6 +77,24 @@ def window_shot(name):
     return path
 
 
+def clipped_headers(table):
+    """[(column, header text, width its longest line needs, the section's width)] of the
+    header labels narrower than their text: the text's advance in the header's font plus the
+    style's header margin on both sides (what QHeaderView's own size hint adds), line by
+    line. Empty when every header reads whole."""
+    header = table.horizontalHeader()
+    metrics = header.fontMetrics()
+    margin = header.style().pixelMetric(QtGui.QStyle.PM_HeaderMargin, None, header)
+    clipped = []
+    for c in range(table.columnCount()):
+        item = table.horizontalHeaderItem(c)
+        text = item.text() if item is not None else ""
+        need = max(metrics.horizontalAdvance(line) for line in text.split("\n")) + 2 * margin
+        if header.sectionSize(c) < need:
+            clipped.append((c, text, need, header.sectionSize(c)))
+    return clipped
+
+
 def active_panel(kinds):
     """The visible task panel of one of these classes, or None."""
     for obj in gc.get_objects():

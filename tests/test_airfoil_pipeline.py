@@ -3,6 +3,7 @@ truths made independently of the kernel: readings simulated on the CAD's own sec
 (OCC's cut, exact on the CAD and the plane), a part made as the CAD offset outward, one section
 turned or shifted by a known amount, and OCC's centre of mass of a section face."""
 import csv
+import html
 import json
 import os
 import shutil
@@ -354,6 +355,10 @@ class ReportAndBatch(unittest.TestCase):
         self.assertIn("Airfoil characteristics", text)
         self.assertIn("section 3 airfoil", text)
         self.assertIn("shift and twist", text)
+        # the report names the failure as the tables do; result.json keeps the field name
+        text = html.unescape(text)
+        self.assertIn("Airfoil: FAIL, 1 of 4 characteristics: Section 2: Section area", text)
+        self.assertNotIn("section 2: area_mm2", text)
         with open(os.path.join(self.out, "summary_airfoil.csv")) as fh:
             rows = list(csv.DictReader(fh))
         self.assertEqual({r["file"] for r in rows}, {"blade1.csv"})

@@ -93,6 +93,59 @@ class SensitivityRows(unittest.TestCase):
                          "Part: Worst deviation")
 
 
+class VerdictLines(unittest.TestCase):
+    """The airfoil verdict's line names the failed and not-proven characteristics as the
+    tables do; result.json's summary (field names) is left as the stage wrote it."""
+    DEFINITIONS = {"chord_method": "caliper", "edge_offsets_mm": [0.5, 1.0, 2.0]}
+    BLOCKS = [{"label": "2", "nominal": DEFINITIONS}, {"label": "root 1", "nominal": {}}]
+
+    def test_entries(self):
+        for entry, text in (("section 2: le_thickness_mm[1]", "Section 2: LE thickness at 1 mm"),
+                            ("section 2: chord_mm", "Section 2: Chord (caliper)"),
+                            ("section root 1: te_radius_mm (not measured)",
+                             "Section root 1: TE radius (not measured)"),
+                            ("section 2: stagger_deg", "Section 2: Stagger angle"),
+                            ("something else", "something else")):
+            values = {b["label"]: b["nominal"] for b in self.BLOCKS}
+            self.assertEqual(names.verdict_entry_name(entry, values), text)
+
+    def test_lines(self):
+        fail = {"n_judged": 7, "failed": ["section 2: le_thickness_mm[1]",
+                                          "section root 1: te_radius_mm (not measured)"],
+                "not_proven": ["section 2: stagger_deg"],
+                "summary": "airfoil: FAIL 2 of 7: section 2: le_thickness_mm[1]; section root 1: "
+                           "te_radius_mm (not measured)"}
+        self.assertEqual(names.airfoil_verdict_text(fail, self.BLOCKS),
+                         "Airfoil: FAIL, 2 of 7 characteristics: Section 2: LE thickness at 1 mm; "
+                         "Section root 1: TE radius (not measured)")
+        unproven = {"n_judged": 3, "failed": [], "not_proven": ["section 2: stagger_deg"]}
+        self.assertEqual(names.airfoil_verdict_text(unproven, self.BLOCKS),
+                         "Airfoil: NOT PROVEN, 1 of 3 characteristics: Section 2: Stagger angle")
+        self.assertEqual(names.airfoil_verdict_text({"n_judged": 3, "failed": [],
+                                                     "not_proven": []}),
+                         "Airfoil: PASS (3 characteristics)")
+        self.assertEqual(names.airfoil_verdict_text({"n_judged": 0, "failed": [],
+                                                     "not_proven": []}),
+                         "Airfoil: no characteristic toleranced")
+        part = "FAIL: %s; profile PASS: within +-0.040 mm" % fail["summary"]
+        self.assertEqual(names.part_summary_text(part, fail, self.BLOCKS),
+                         "FAIL: Airfoil: FAIL, 2 of 7 characteristics: Section 2: LE thickness "
+                         "at 1 mm; Section root 1: TE radius (not measured); profile PASS: "
+                         "within +-0.040 mm")
+        self.assertEqual(names.part_summary_text("PASS: within +-0.040 mm", None),
+                         "PASS: within +-0.040 mm")
+
+    def test_the_stage_writes_what_the_line_reads(self):
+        """inspection.airfoil.stage_verdict's entries and summary, as the stage writes
+        them, read back in display names."""
+        verdict = stage_mod.stage_verdict(
+            [types.SimpleNamespace(block={"verdicts": {"a": "fail", "b": "pass"}})],
+            ["section 2: area_mm2"], [])
+        self.assertEqual(verdict["summary"], "airfoil: FAIL 1 of 2: section 2: area_mm2")
+        self.assertEqual(names.airfoil_verdict_text(verdict),
+                         "Airfoil: FAIL, 1 of 2 characteristics: Section 2: Section area")
+
+
 class SectionTableColumns(unittest.TestCase):
     def test_every_table_2_column_has_a_short_header_and_a_meaning(self):
         for cmm in (None, "cmm.csv"):

@@ -149,9 +149,17 @@ class EdgeCircles(_SectionGeometry):
     def store(self, obj, ch, frame):
         import Part
         normal = _vector(frame.normal)
+        drawn = dict(ch.edge_circles())
         circles = []
-        for circle, radius_prop, centre_prop in ((ch.le_circle, "LeRadiusMm", "LeCenter"),
-                                                 (ch.te_circle, "TeRadiusMm", "TeCenter")):
+        for name, radius_prop, centre_prop in (("LE", "LeRadiusMm", "LeCenter"),
+                                               ("TE", "TeRadiusMm", "TeCenter")):
+            if name not in drawn:
+                # a withheld edge (a corner of the nominal): no circle, its radius NaN as the
+                # table's "-", no centre to show
+                setattr(obj, radius_prop, np.nan)
+                setattr(obj, centre_prop, FreeCAD.Vector(np.nan, np.nan, np.nan))
+                continue
+            circle = drawn[name]
             centre = _vector(frame.to_3d(circle.center)[0])
             circles.append(Part.makeCircle(float(circle.radius), centre, normal))
             setattr(obj, radius_prop, float(circle.radius))

@@ -992,6 +992,14 @@ class Characteristics:
     pressure_range: tuple = ()
     warnings: list = field(default_factory=list)
 
+    def edge_circles(self):
+        """[("LE" or "TE", CircleFit2D)] of the edges whose radius is reported: an edge
+        withheld by withhold_corner_edges (radius None) keeps its fit on the record, but a
+        circle drawn for it would show a radius the result says is not measurable."""
+        return [(name, circle) for name, circle, radius in
+                (("LE", self.le_circle, self.le_radius_mm),
+                 ("TE", self.te_circle, self.te_radius_mm)) if radius is not None]
+
     def as_dict(self):
         return {
             "chord_mm": self.chord_mm, "chord_method": self.chord_method,

@@ -18,9 +18,10 @@ from PySide import QtGui
 from ..app import actions, loop, objects, settings
 from ..core import contracts
 from ..core.errors import InputError
+from ..inspection import characteristic_names as names
 from ..inspection.report import section_rows
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
-from . import commands, progress, taskpanels
+from . import commands, progress, tables, taskpanels
 from .i18n import QT_TRANSLATE_NOOP, translate
 from .session import RIG
 
@@ -285,7 +286,10 @@ class Inspect(commands._Command):
     def show(summary):
         note = (translate("BladeInspect", "%s. Pose uncertainty %.2f \u00b5m after the planned "
                           "scan (%.2f \u00b5m after the blind scan); ICP weights: %s. Files in %s")
-                % (summary["verdict"]["summary"], 1e3 * summary["pose_uncertainty_mm"],
+                % (names.part_summary_text(
+                    summary["verdict"]["summary"], summary["verdict"].get("airfoil"),
+                    getattr(getattr(summary["sections"], "airfoil", None), "blocks", ()),
+                    tables.tr), 1e3 * summary["pose_uncertainty_mm"],
                    1e3 * summary["uncertainty_after_blind_mm"],
                    summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
         return _show_table(

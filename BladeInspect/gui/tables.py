@@ -4,7 +4,9 @@ names (inspection.characteristic_names) with their unit, short headers over two 
 full meaning as a tooltip, the names' column takes the width left (wrapped over two lines when
 the panel is narrow, whole with the field name in the tooltip), rows grouped under a line per
 section, verdicts coloured. A characteristics table fits a 640 px panel without scrolling
-sideways (tests/gui_loop_macro.py checks it; 560 px in tests/gui_airfoil_macro.py)."""
+sideways, its headers whole (tests/gui_loop_macro.py checks it; 560 px in
+tests/gui_airfoil_macro.py, where the unit and verdict columns wrap to leave the names'
+header its width: NamedRowsTable)."""
 from PySide import QtCore, QtGui
 
 from ..inspection import airfoil as airfoil_mod
@@ -46,8 +48,16 @@ VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
 # Sensitivity columns before and after the objectives'
 SENSITIVITY_LEADING = (AIRFOIL_COLUMNS[0], AIRFOIL_COLUMNS[1])
 SENSITIVITY_CHANGE = (QT_TRANSLATE_NOOP("BladeInspect", "Change"),
-                      QT_TRANSLATE_NOOP("BladeInspect", "Largest minus smallest value over "
-                                                        "the objectives"))
+                      QT_TRANSLATE_NOOP("BladeInspect", "Largest minus smallest over the "
+                                                        "objectives: of a worst deviation's "
+                                                        "size |value| (what the verdict "
+                                                        "judges against \u00b1T), of an "
+                                                        "airfoil characteristic's value"))
+# A worst deviation's change marked when it is + under one objective and - under another
+SIDE_MARK = " *"
+SIDE_NOTE = QT_TRANSLATE_NOOP("BladeInspect", "*: the worst deviation is + under one objective "
+                                              "and - under another; the change is of its "
+                                              "size, which the verdict judges")
 
 
 def tr(text):
@@ -101,6 +111,79 @@ def _group_row(table, r, text, verdict=None):
                                                                      GROUP_COLOUR))))
     table.setItem(r, 0, item)
     table.setSpan(r, 0, 1, table.columnCount())
+
+
+class NamedRowsTable(QtGui.QTableWidget):
+    """A table whose names' column (the stretched one) is never narrower than its header
+    while other columns can give way: when the panel is too narrow for every column at its
+    contents' width, the ``wrap_columns`` are narrowed in turn to their longest word (their
+    cells wrap, "% chord" over two lines) until the names' header reads whole. FreeCAD 1.0's
+    task panel at 560 px left "Characteristic" 9 px short ("Characterist"); a wider panel
+    keeps every column whole."""
+    wrap_columns = ()
+    name_column = NAME_COLUMN
+
+    def __init__(self, *args):
+        super().__init__(*args)
+        self._sharing = False
+
+    def resizeEvent(self, event):   # noqa: N802 (Qt's name)
+        super().resizeEvent(event)
+        self.share_width()
+
+    def _full_width(self, c):
+        # what ResizeToContents gives the column
+        return max(self.sizeHintForColumn(c), self.horizontalHeader().sectionSizeHint(c))
+
+    def _header_need(self, c):
+        """The header's longest line with the style's header margin on both sides, as the
+        header draws its label (its size hint adds more: a sort indicator's room)."""
+        header = self.horizontalHeader()
+        item = self.horizontalHeaderItem(c)
+        lines = (item.text() if item is not None else "").split("\n")
+        margin = header.style().pixelMetric(QtGui.QStyle.PM_HeaderMargin, None, header)
+        return max(header.fontMetrics().horizontalAdvance(x) for x in lines) + 2 * margin + 2
+
+    def _texts(self, c):
+        items = (self.item(r, c) for r in range(self.rowCount()) if self.columnSpan(r, c) == 1)
+        return [item.text() for item in items if item is not None and item.text()]
+
+    def _word_width(self, c):
+        """The column as wide as its header and its longest word (its cells' padding as
+        the delegate's size hint has it: the full width less the widest line)."""
+        metrics = self.fontMetrics()
+        lines = [line for text in self._texts(c) for line in text.split("\n")]
+        if not lines:
+            return self._full_width(c)
+        pad = self.sizeHintForColumn(c) - max(metrics.horizontalAdvance(x) for x in lines)
+        word = max(metrics.horizontalAdvance(w) for x in lines for w in x.split())
+        return max(word + pad, self._header_need(c))
+
+    def share_width(self):
+        header = self.horizontalHeader()
+        if self._sharing or header.sectionResizeMode(self.name_column) != \
+                QtGui.QHeaderView.Stretch:
+            return
+        self._sharing = True
+        try:
+            need = self._header_need(self.name_column)
+            spare = self.viewport().width() - sum(self._full_width(c)
+                                                  for c in range(self.columnCount())
+                                                  if c != self.name_column)
+            for c in self.wrap_columns:
+                if spare >= need:
+                    header.setSectionResizeMode(c, QtGui.QHeaderView.ResizeToContents)
+                    continue
+                narrow = self._word_width(c)
+                header.setSectionResizeMode(c, QtGui.QHeaderView.Fixed)
+                header.resizeSection(c, narrow)
+                spare += self._full_width(c) - narrow
+            # the wrapped cells' rows as tall as their lines
+            for r in range(self.rowCount()):
+                if self.columnSpan(r, 0) == 1:
+                    self.resizeRowToContents(r)
+        finally:
+            self._sharing = False
 
 
 def fit_columns(table, stretch_column=NAME_COLUMN):
@@ -171,7 +254,8 @@ def airfoil_rows(blocks):
 
 def airfoil_table(rows):
     """The table of airfoil_rows (group lines spanning it)."""
-    table = QtGui.QTableWidget(len(rows), len(AIRFOIL_COLUMNS))
+    table = NamedRowsTable(len(rows), len(AIRFOIL_COLUMNS))
+    table.wrap_columns = (1, VERDICT_COLUMN)   # unit, then verdict ("not / judged")
     _header(table, AIRFOIL_COLUMNS)
     for r, row in enumerate(rows):
         if len(row) == 2:
@@ -218,7 +302,8 @@ def sensitivity_table(sensitivity):
     # a line per section only when it heads several rows (the airfoil characteristics')
     grouped = any(len(rows) > 1 for label, rows in groups if label is not None)
     n_rows = sum(grouped + len(rows) for _, rows in groups) + 1
-    table = QtGui.QTableWidget(n_rows, len(columns))
+    table = NamedRowsTable(n_rows, len(columns))
+    table.wrap_columns = (1,)   # the unit
     _header(table, columns)
     r = 0
     for label, rows in groups:
@@ -243,8 +328,10 @@ def sensitivity_table(sensitivity):
                     tip += ", U = %.4f %s" % (U, unit)
                 table.setItem(r, c, colour_verdict(
                     _item(_number(value, True), tip, NUMBER), cell.get("verdict")))
+            side = bool(row.get("side_changes"))
             table.setItem(r, len(columns) - 1, _item(
-                "%.4f" % row.get("change_mm", row.get("change")), align=NUMBER))
+                "%.4f%s" % (row.get("change_mm", row.get("change")), SIDE_MARK if side else ""),
+                tr(SIDE_NOTE) if side else None, NUMBER))
             r += 1
     table.setItem(r, 0, _item(tr(names.PART_VERDICT)))
     for c, objective in enumerate(objectives, 2):

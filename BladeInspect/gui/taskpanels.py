@@ -11,6 +11,7 @@ from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
 from ..core import decision
 from ..core.airfoil import CHORD_METHODS
+from ..inspection import characteristic_names as names
 from ..inspection import fitting
 from ..inspection.result import rival_lines
 from . import tables
@@ -360,6 +361,8 @@ def sensitivity_widget(sensitivity):
                         translate("BladeInspect", "changes")
                         if sensitivity["verdict_changes"]
                         else translate("BladeInspect", "does not change")))
+    if any(row.get("side_changes") for row in sensitivity["rows"]):
+        lines.append(tables.tr(tables.SIDE_NOTE))
     label = QtGui.QLabel("\n".join(lines))
     label.setWordWrap(True)
     layout.addWidget(label)
@@ -463,7 +466,10 @@ class AirfoilPanel(_ResultPanel):
         self.table = tables.airfoil_table(self.rows)
         self.table.setMinimumHeight(420)
         layout.addWidget(self.table)
-        lines = [analysis.get("airfoil_verdict", {}).get("summary", "")]
+        # the failed characteristics by the names the table shows (result.json's summary,
+        # with the field names, in the tooltip)
+        verdict_ = analysis.get("airfoil_verdict") or {}
+        lines = [names.airfoil_verdict_text(verdict_, analysis.get("airfoil", []), tables.tr)]
         lean_bow = analysis.get("lean_bow")
         if lean_bow:
             lines.append(translate("BladeInspect", "Lean and bow: largest bow at section %s.")
@@ -476,7 +482,9 @@ class AirfoilPanel(_ResultPanel):
                             settings_.get("uncertainty_method")))
         label = QtGui.QLabel("\n".join(line for line in lines if line))
         label.setWordWrap(True)
+        label.setToolTip(verdict_.get("summary", ""))
         layout.addWidget(label)
+        self.verdict_label = label
         # What the stage says it could not do well (sparse edges, non-circular ends): a
         # number shown without its caveat would be trusted where it should not be.
         notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"], note)

@@ -76,7 +76,7 @@ def figure_profile(section):
                 linewidth=0.6)
     _circle(ax, ch.max_thickness_center, ch.max_thickness_mm / 2.0, color="#ff7f0e",
             linewidth=1.1, linestyle="--")
-    for circle, name in ((ch.le_circle, "LE"), (ch.te_circle, "TE")):
+    for name, circle in ch.edge_circles():   # none for a withheld (corner) edge
         _circle(ax, circle.center, circle.radius, color="#2ca02c", linewidth=1.1)
         ax.annotate("%s r = %.4f" % (name, circle.radius), circle.center, fontsize=7,
                     xytext=(4, 8), textcoords="offset points")
@@ -133,7 +133,8 @@ def add_pages(pdf, parts, table):
     plt, _, _ = _mpl()
     pages = 0
     parts += ["<h2>Airfoil characteristics</h2>",
-              "<p>%s</p>" % html.escape(stage.verdict["summary"]),
+              "<p>%s</p>" % html.escape(characteristic_names.airfoil_verdict_text(
+                  stage.verdict, stage.blocks)),
               "<p class='note'>Definitions: docs/airfoil.md; chord %s; angles from the engine "
               "axis %s; LE: %s; uncertainty: %s, %s. Tolerances limit the deviation; "
               "decision rule: %s (%s).</p>"

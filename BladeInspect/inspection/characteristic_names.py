@@ -109,6 +109,18 @@ PART = QT_TRANSLATE_NOOP("BladeInspect", "Part")
 SECTION = QT_TRANSLATE_NOOP("BladeInspect", "Section %s")
 PART_VERDICT = QT_TRANSLATE_NOOP("BladeInspect", "Part verdict")
 
+# The airfoil verdict's line (inspection.airfoil.stage_verdict's summary) in display names;
+# result.json's ``summary`` keeps the field names, which files, scripts and tests match.
+AIRFOIL_VERDICT_LINES = {
+    None: QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: no characteristic toleranced"),
+    "fail": QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: FAIL, %d of %d characteristics: %s"),
+    "not proven": QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: NOT PROVEN, %d of %d "
+                                                    "characteristics: %s"),
+    "pass": QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: PASS (%d characteristics)"),
+}
+NOT_MEASURED = " (not measured)"   # inspection.airfoil._judge's suffix of an unmeasured key
+NOT_MEASURED_NAME = QT_TRANSLATE_NOOP("BladeInspect", "%s (not measured)")
+
 # Verdicts as core.decision and inspection.airfoil write them, marked so that they are
 # translated where they are shown.
 VERDICTS = (QT_TRANSLATE_NOOP("BladeInspect", "pass"),
@@ -188,6 +200,50 @@ def sensitivity_row_name(row, tr=_same, values=None):
     what = tr(WORST_DEVIATION) if key is None else display_name(key, values, tr)
     where = tr(PART) if label is None else tr(SECTION) % label
     return "%s: %s" % (where, what)
+
+
+def verdict_entry_name(entry, values_by_section=None, tr=_same):
+    """"Section 2: LE thickness at 1 mm" for an airfoil_verdict ``failed`` / ``not_proven``
+    entry "section 2: le_thickness_mm[1]" (its " (not measured)" kept). ``values_by_section``:
+    each section label's nominal block (what completes the names); an entry of another form
+    is returned as it is."""
+    if not entry.startswith("section ") or ": " not in entry:
+        return entry
+    label, _, key = entry[len("section "):].rpartition(": ")
+    missing = key.endswith(NOT_MEASURED)
+    if missing:
+        key = key[:-len(NOT_MEASURED)]
+    name = display_name(key, (values_by_section or {}).get(label), tr)
+    if missing:
+        name = tr(NOT_MEASURED_NAME) % name
+    return "%s: %s" % (tr(SECTION) % label, name)
+
+
+def airfoil_verdict_text(verdict, blocks=(), tr=_same):
+    """The airfoil verdict's line (result.json's airfoil_verdict) with the failed or not
+    proven characteristics by their display names; ``blocks``: result.json's ``airfoil``."""
+    if not verdict:
+        return ""
+    values = {str(b["label"]): b.get("nominal") for b in blocks or ()}
+    n_judged = verdict.get("n_judged", 0)
+    if not n_judged:
+        return tr(AIRFOIL_VERDICT_LINES[None])
+    for word, entries in (("fail", verdict.get("failed")),
+                          ("not proven", verdict.get("not_proven"))):
+        if entries:
+            return tr(AIRFOIL_VERDICT_LINES[word]) % (
+                len(entries), n_judged,
+                "; ".join(verdict_entry_name(e, values, tr) for e in entries))
+    return tr(AIRFOIL_VERDICT_LINES["pass"]) % n_judged
+
+
+def part_summary_text(summary, airfoil_verdict, blocks=(), tr=_same):
+    """The part verdict's summary with the airfoil clause inspection.airfoil.attach appended
+    (the stage's summary, field names) in display names; as it is without that clause."""
+    clause = (airfoil_verdict or {}).get("summary")
+    if not clause or clause not in summary:
+        return summary
+    return summary.replace(clause, airfoil_verdict_text(airfoil_verdict, blocks, tr))
 
 
 # Table 2's columns (inspection.report.section_rows' header) as a narrow panel shows them: a

@@ -97,6 +97,8 @@ def html_parts(result, verdict, table_html):
                       largest["change_mm"],
                       " The verdict depends on the fit." if s["verdict_changes"] else "")
                   if largest else ""]
+        if any(r.get("side_changes") for r in s["rows"]):
+            parts.append("<p class='note'>%s</p>" % html.escape(fitting.SIDE_NOTE))
     return parts
 
 
@@ -127,6 +129,10 @@ def pdf_pages(plt, result, verdict):
         # on the first page when it all fits there, else on pages of its own
         first = (pages[-1], lower) if len(pages) == 1 and \
             len(rows) <= rows_that_fit(fig, lower) else None
-        pages += pdf_table_pages(plt, header, rows, 6.5, "Fit sensitivity", first=first,
-                                 **options)
+        if any(r[-1].endswith(fitting.SIDE_MARK) for r in rows):
+            title = ("Fit sensitivity (*: the worst deviation changes side; the change is of "
+                     "its size)")
+        else:
+            title = "Fit sensitivity"
+        pages += pdf_table_pages(plt, header, rows, 6.5, title, first=first, **options)
     return pages

@@ -353,6 +353,14 @@ def section_worst_characteristics(verdict):
 
 
 CHARACTERISTICS = (section_worst_characteristics,)
+# After a change whose worst deviation changes side between the objectives.
+SIDE_MARK = " *"
+SIDE_NOTE = ("* the worst deviation is + under one objective and - under another; the change "
+             "is of its size, which the verdict judges against +-T")
+CHANGE_RULE = ("worst deviation rows: largest minus smallest |worst deviation| over the "
+               "objectives (its size is what the verdict judges against +-T); side_changes: "
+               "it is + under one objective and - under another. Airfoil rows: largest minus "
+               "smallest deviation (the characteristic itself changed)")
 
 
 def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
@@ -381,8 +389,14 @@ def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
         cells = {o: {"value_mm": columns[o]["values"][i][1], "U_mm": columns[o]["values"][i][2],
                      "verdict": columns[o]["values"][i][3]} for o in objectives}
         values = [c["value_mm"] for c in cells.values()]
-        change = float(max(values) - min(values))
-        rows.append({"characteristic": name, "by_fit": cells, "change_mm": change})
+        # A worst deviation is judged by its size against +-T: +6 um under one fit and -6 um
+        # under another leave the same margin, a change of 0, not 12 um. That the worst
+        # point changes side (excess material under one fit, missing under another) is said
+        # apart.
+        sizes = [abs(v) for v in values]
+        change = float(max(sizes) - min(sizes))
+        rows.append({"characteristic": name, "by_fit": cells, "change_mm": change,
+                     "side_changes": bool(min(values) < 0.0 < max(values))})
         if largest is None or change > largest["change_mm"]:
             largest = {"characteristic": name, "change_mm": change}
     verdicts = {o: columns[o]["verdict"] for o in objectives}
@@ -395,6 +409,7 @@ def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
             "cad_motion_by_fit": motion, "chosen": choice.objective,
             "verdict_changes": len(set(verdicts.values())) > 1,
             "largest_change": largest,
+            "change_rule": CHANGE_RULE,
             "free": choice.free or "all",
             "timing_s": dict(runs.seconds, judge=time.perf_counter() - t0)}
 
@@ -417,7 +432,8 @@ def report_rows(sensitivity_doc):
         rows.append([names.sensitivity_row_name(row, values=definitions), unit] + [
             ("-" if v is None else "%+.4f %s" % (v, row["by_fit"][o]["verdict"] or ""))
             for v, o in zip(value, objectives)]
-            + ["%.4f" % row.get("change_mm", row.get("change"))])
+            + ["%.4f%s" % (row.get("change_mm", row.get("change")),
+                           SIDE_MARK if row.get("side_changes") else "")])
     rows.append([names.PART_VERDICT, ""] + [sensitivity_doc["verdict_by_fit"][o] or ""
                                             for o in objectives] + [""])
     return header, rows

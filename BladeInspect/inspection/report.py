@@ -23,6 +23,7 @@ from ..core import colourmap, contracts
 from ..core import stats as stats_mod
 from . import airfoil as airfoil_mod
 from . import airfoil_report
+from . import characteristic_names
 from . import pipeline
 from . import sections as sections_mod
 from . import fit_report
@@ -401,7 +402,10 @@ def _img(png, alt):
 
 
 def _verdict_lines(verdict, table):
-    lines = [verdict["summary"],
+    stage = getattr(table, "airfoil", None)
+    lines = [characteristic_names.part_summary_text(   # the airfoil clause in display names
+                 verdict["summary"], verdict.get("airfoil"),
+                 stage.blocks if stage is not None else ()),
              "Points outside +-%.3f mm: %d (%.3f %%), in %d spot(s); %d isolated point(s)"
              % (verdict["tolerance_mm"], verdict["n_points_out"], verdict["pct_points_out"],
                 verdict["n_spots"], verdict["n_isolated_out"])]

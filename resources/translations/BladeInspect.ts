@@ -9,6 +9,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>%s (not measured)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>%s. Pose uncertainty %.2f µm after the planned scan (%.2f µm after the blind scan); ICP weights: %s. Files in %s</source>
         <translation type="unfinished"></translation>
@@ -21,6 +26,11 @@
     <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>%s: done</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>*: the worst deviation is + under one objective and - under another; the change is of its size, which the verdict judges</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -63,6 +73,26 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Airfoil characteristics...</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: FAIL, %d of %d characteristics: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: NOT PROVEN, %d of %d characteristics: %s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: PASS (%d characteristics)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Airfoil: no characteristic toleranced</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -469,7 +499,7 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
-        <source>Largest minus smallest value over the objectives</source>
+        <source>Largest minus smallest over the objectives: of a worst deviation's size |value| (what the verdict judges against ±T), of an airfoil characteristic's value</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
