@@ -470,7 +470,7 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     sensor = (SensorModel() if opts.accuracy_mm is None
               else SensorModel(accuracy=float(opts.accuracy_mm)))
     accuracy = sensor.accuracy
-    response = uncertainty_mod.systematic_coefficients(result)
+    response = uncertainty_mod.systematic_coefficients(result, sensor)
     response = np.ones(len(idx)) if response is None else np.asarray(response)[idx]
     sigma, unit = _point_noise_model(result, idx, sensor, noise)
     draws = []
