@@ -103,6 +103,13 @@ class SystematicThroughTheFitTest(unittest.TestCase):
         # The fit takes up part of the bias: the coefficients are not simply beam . n.
         beta = np.einsum("ij,ij->i", beams[pick], result.normal)
         self.assertGreater(np.max(np.abs(s - beta)), 0.1)
+        # ... by the rigid motion bias_take_up states (the airfoil draws move the points by
+        # it, along the surface too): each point where the re-fit put it.
+        b, r = U.bias_take_up(dataclasses.replace(result, icp_weights=fit.weights))
+        np.testing.assert_allclose(b, beams[pick], atol=1e-12)
+        model = moved - bias * (r[:3] + np.cross(r[3:], on - result.center))
+        where = tf.apply_transform(fit.transform, moved)
+        self.assertLess(np.max(np.linalg.norm(where - model, axis=1)), 0.05 * bias)
 
     def test_a_reading_past_the_end_takes_up_nothing(self):
         """A reading just past the blade's end has its foot on the face's edge and the normal

@@ -164,6 +164,21 @@ def systematic_coefficients(result, sensor=None):
     taken up what a rigid motion can (module notes), or None when the beams are not known.
     ``sensor``: the rig.sensor.SensorModel whose largest incidence tells a reading's normal
     from an edge's (None: the default sensor)."""
+    take_up = bias_take_up(result, sensor)
+    if take_up is None:
+        return None
+    beams, response = take_up
+    normal = np.asarray(result.normal, dtype=float)
+    arm = np.asarray(result.points_cad, dtype=float) - np.asarray(result.center)
+    J = np.hstack([normal, np.cross(arm, normal)])
+    return np.einsum("ij,ij->i", beams, normal) - J @ response
+
+
+def bias_take_up(result, sensor=None):
+    """(beams (N, 3) in the CAD frame, r (6,)) of a unit reading bias: each point moves by its
+    beam and the registration takes that up by the rigid motion -r ([t mm, w rad] about
+    result.center), systematic_coefficients' s_i = beta_i - J_i r being its normal part; None
+    when the beams are not known."""
     beams = beam_directions(result)
     if beams is None:
         return None
@@ -187,8 +202,7 @@ def systematic_coefficients(result, sensor=None):
     J = np.hstack([normal, np.cross(arm, normal)])
     JW = J.T * weights
     # lstsq: a pose direction the points do not measure takes up nothing of the bias
-    response = np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0]
-    return beta - J @ response
+    return beams, np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0]
 
 
 def expanded_uncertainty(result, index, model=None):
