@@ -103,6 +103,51 @@ class SystematicThroughTheFitTest(unittest.TestCase):
         # The fit takes up part of the bias: the coefficients are not simply beam . n.
         beta = np.einsum("ij,ij->i", beams[pick], result.normal)
         self.assertGreater(np.max(np.abs(s - beta)), 0.1)
+        # ... by the rigid motion bias_take_up states (the airfoil draws move the points by
+        # it, along the surface too): each point where the re-fit put it.
+        b, r = U.bias_take_up(dataclasses.replace(result, icp_weights=fit.weights))
+        np.testing.assert_allclose(b, beams[pick], atol=1e-12)
+        model = moved - bias * (r[:3] + np.cross(r[3:], on - result.center))
+        where = tf.apply_transform(fit.transform, moved)
+        self.assertLess(np.max(np.linalg.norm(where - model, axis=1)), 0.05 * bias)
+
+    def test_a_reading_past_the_end_takes_up_nothing(self):
+        """A reading just past the blade's end has its foot on the face's edge and the normal
+        p - c, square to a beam that read the side: its weight in the loop's fit sits at the
+        sensor weights' grazing floor (41 against a median of 0.6 on the demo loop). The
+        coefficients of the surface's points must still be those of a re-fit of the surface's
+        readings, not a linearised fit held along the span by that one point."""
+        from BladeInspect.core import transforms as tf
+        from BladeInspect.inspection import pipeline
+        from BladeInspect.rig.kinematics import RigKinematics
+        nominal = fx.demo_nominal()
+        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
+        normal = nominal.signed_distance(on).normal
+        angles = np.arange(0.0, 360.0, 10.0)
+        k = RigKinematics()
+        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
+        pick = np.argmin(normal @ beams.T, axis=1)
+        seen = (normal @ beams.T)[np.arange(len(on)), pick] < -0.3
+        on, pick, normal = on[seen], pick[seen], normal[seen]
+        low = int(np.argmin(on[:, 2]))
+        past = on[low].copy()
+        past[2] = -0.002                   # the demo blade's hub end is at z = 0
+        # read by the beam square to the span that meets the side there most head-on
+        level = np.flatnonzero(np.abs(beams[:, 2]) < 0.05)
+        angle_past = level[np.argmin(beams[level] @ normal[low])]
+        points = np.vstack([on, past])
+        result = fx.make_result(nominal, points,
+                                columns={"angle_deg": angles[np.append(pick, angle_past)]})
+        self.assertLess(abs(beams[angle_past] @ result.normal[-1]),
+                        np.cos(SensorModel().max_incidence_rad))
+        bias = 0.005
+        moved = on + bias * beams[pick]
+        fit = pipeline.fine_register(moved, None, nominal, np.eye(4))
+        weights = np.append(fit.weights, 70.0 * np.median(fit.weights))
+        s = U.systematic_coefficients(dataclasses.replace(result, icp_weights=weights))
+        after = nominal.signed_distance(tf.apply_transform(fit.transform, moved)).distance
+        change = after - result.deviation[:-1]
+        self.assertLess(np.max(np.abs(change - s[:-1] * bias)), 0.05 * bias)
 
 
 if __name__ == "__main__":
