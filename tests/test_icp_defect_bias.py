@@ -224,3 +224,36 @@ class NearestMeans:
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestTakeUpWithoutEdgeFeet(unittest.TestCase):
+    """core.icp._bias_response leaves out of the take-up a point whose beam meets its normal
+    more obliquely than the sensor reads (an edge foot, normal p - c): the others' s_i are
+    those of the weighted least-squares take-up over them alone, solved here directly."""
+
+    def test_an_edge_foot_takes_up_nothing(self):
+        rng = np.random.default_rng(7)
+        n = 400
+        pts = rng.uniform(-20.0, 20.0, (n, 3))
+        normals = rng.normal(size=(n, 3))
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        beams = normals + 0.3 * rng.normal(size=(n, 3))
+        beams /= np.linalg.norm(beams, axis=1)[:, None]
+        a = rng.uniform(0.5, 1.5, n)
+        # the edge foot: its beam square to its "normal", and a grazing-floor weight
+        side = np.cross(normals[0], [0.0, 0.0, 1.0])
+        beams[0] = side / np.linalg.norm(side)
+        a[0] = 1000.0
+        max_incidence = np.radians(85.0)
+        s = icp._bias_response(pts, normals, beams, a, max_incidence)
+
+        fit = np.arange(1, n)
+        beta = np.einsum("ij,ij->i", beams, normals)
+        c = a[fit] @ pts[fit] / a[fit].sum()
+        J = np.hstack([normals, np.cross(pts - c, normals)])
+        Jw = J[fit] * np.sqrt(a[fit])[:, None]
+        r = np.linalg.lstsq(Jw, beta[fit] * np.sqrt(a[fit]), rcond=None)[0]
+        np.testing.assert_allclose(s, beta - J @ r, rtol=0, atol=1e-9)
+        # with the edge foot in the take-up (no incidence limit) the answer is another
+        s_all = icp._bias_response(pts, normals, beams, a)
+        self.assertGreater(np.max(np.abs(s_all[fit] - s[fit])), 1e-3)

@@ -199,19 +199,27 @@ def robust_weights(distances, a, options, neighbourhoods=None, bias_response=Non
     return rho, scale
 
 
-def _bias_response(moved, normals, beams_cad, a):
+def _bias_response(moved, normals, beams_cad, a, max_incidence_rad=None):
     """(N,) s_i: each residual's change per unit reading bias once a weighted (``a``) rigid
     fit has taken up what it can, beta_i - J_i (J^T W J)^-1 J^T W beta with beta_i = beam_i .
-    n_i (uncertainty.systematic_coefficients' model, at this pose; 0 where unusable)."""
+    n_i (uncertainty.systematic_coefficients' model, at this pose; 0 where unusable). A point
+    whose beam meets its normal more obliquely than ``max_incidence_rad`` (the sensor reads
+    nothing there) has its foot on a face's edge, its normal p - c: it takes up nothing, as in
+    uncertainty.bias_take_up (one such point past the demo blade's hub end held two thirds of
+    the take-up's weakest direction there)."""
     beta = np.einsum("ij,ij->i", beams_cad, normals)
     keep = (a > 0) & np.isfinite(beta)
     s = np.zeros(len(beta))
-    if np.count_nonzero(keep) < 7:
+    fit = keep if max_incidence_rad is None else \
+        keep & (np.abs(beta) >= np.cos(max_incidence_rad))
+    if np.count_nonzero(fit) < 7:
         return s
-    w = a[keep]
-    J = _jacobian(moved[keep], normals[keep], w @ moved[keep] / w.sum())
-    JW = J.T * w
-    s[keep] = beta[keep] - J @ np.linalg.lstsq(JW @ J, JW @ beta[keep], rcond=1e-12)[0]
+    w = a[fit]
+    center = w @ moved[fit] / w.sum()
+    J_fit = _jacobian(moved[fit], normals[fit], center)
+    JW = J_fit.T * w
+    response = np.linalg.lstsq(JW @ J_fit, JW @ beta[fit], rcond=1e-12)[0]
+    s[keep] = beta[keep] - _jacobian(moved[keep], normals[keep], center) @ response
     return s
 
 
@@ -421,7 +429,8 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
     def bias_response(T, moved, normals):
         if beams is None or neighbourhoods is None or options.systematic_mm <= 0:
             return None
-        return _bias_response(moved, normals, beams @ T[:3, :3].T, a)
+        return _bias_response(moved, normals, beams @ T[:3, :3].T, a,
+                              getattr(weight_model, "max_incidence_rad", None))
     T = np.array(init, dtype=float)
     converged = False
     iterations = 0
