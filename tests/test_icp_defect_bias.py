@@ -222,9 +222,6 @@ class NearestMeans:
             return v.sum(axis=1) / c
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 class TestTakeUpWithoutEdgeFeet(unittest.TestCase):
     """core.icp._bias_response leaves out of the take-up a point whose beam meets its normal
@@ -257,3 +254,7 @@ class TestTakeUpWithoutEdgeFeet(unittest.TestCase):
         # with the edge foot in the take-up (no incidence limit) the answer is another
         s_all = icp._bias_response(pts, normals, beams, a)
         self.assertGreater(np.max(np.abs(s_all[fit] - s[fit])), 1e-3)
+
+
+if __name__ == "__main__":
+    unittest.main()
