@@ -7,11 +7,9 @@ import unittest
 import numpy as np
 
 from BladeInspect.inspection import airfoil
-from BladeInspect.inspection import uncertainty as U
-from BladeInspect.rig.kinematics import RigKinematics
 from BladeInspect.rig.sensor import SensorModel
 from tests import inspection_fixtures as fx
-from tests.test_fit_pipeline import demo_cloud
+from tests.test_worst_uncertainty import head_on_readings
 
 READINGS = 4000
 
@@ -19,15 +17,7 @@ READINGS = 4000
 class DrawNoiseAlongTheBeam(unittest.TestCase):
     def test_against_the_sensors_readings(self):
         nominal = fx.demo_nominal()
-        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
-        normal = nominal.signed_distance(on).normal
-        angles = np.arange(0.0, 360.0, 10.0)
-        k = RigKinematics()
-        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
-        pick = np.argmin(normal @ beams.T, axis=1)
-        cos = -(normal @ beams.T)[np.arange(len(on)), pick]
-        seen = cos > 0.3
-        on, pick, normal, cos = on[seen], pick[seen], normal[seen], cos[seen]
+        on, normal, angles, beams, pick, cos = head_on_readings(nominal)
         sensor = SensorModel()
         incidence = np.arccos(np.clip(cos, -1.0, 1.0))
         snr = sensor.snr(np.full(len(on), sensor.standoff), incidence)

@@ -15,6 +15,22 @@ from tests.test_fit_pipeline import demo_cloud
 DRAWS = 40000
 
 
+def head_on_readings(nominal, min_cos=0.3):
+    """The demo cloud on the nominal, each point read from the rotary angle (10 deg steps) that
+    sees it most head-on, those seen at a cosine above ``min_cos``: (points, CAD normals, the
+    angles, their beams in the table frame, each point's angle index, its cosine)."""
+    from BladeInspect.rig.kinematics import RigKinematics
+    on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
+    normal = nominal.signed_distance(on).normal
+    angles = np.arange(0.0, 360.0, 10.0)
+    k = RigKinematics()
+    beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
+    pick = np.argmin(normal @ beams.T, axis=1)
+    cos = -(normal @ beams.T)[np.arange(len(on)), pick]
+    seen = cos > min_cos
+    return on[seen], normal[seen], angles, beams, pick[seen], cos[seen]
+
+
 class MaxOfDrawsTest(unittest.TestCase):
     def test_against_sampled_order_statistics(self):
         rng = np.random.default_rng(11)
@@ -78,17 +94,8 @@ class SystematicThroughTheFitTest(unittest.TestCase):
     def test_against_a_refit_with_a_known_bias(self):
         from BladeInspect.core import transforms as tf
         from BladeInspect.inspection import pipeline
-        from BladeInspect.rig.kinematics import RigKinematics
         nominal = fx.demo_nominal()
-        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
-        normal = nominal.signed_distance(on).normal
-        # Each point read from the rotary angle (10 deg steps) that sees it most head-on.
-        angles = np.arange(0.0, 360.0, 10.0)
-        k = RigKinematics()
-        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
-        pick = np.argmin(normal @ beams.T, axis=1)
-        seen = (normal @ beams.T)[np.arange(len(on)), pick] < -0.3
-        on, pick = on[seen], pick[seen]
+        on, _, angles, beams, pick, _ = head_on_readings(nominal)
         result = fx.make_result(nominal, on, columns={"angle_deg": angles[pick]})
         np.testing.assert_allclose(U.beam_directions(result), beams[pick], atol=1e-12)
         bias = 0.005
@@ -119,16 +126,8 @@ class SystematicThroughTheFitTest(unittest.TestCase):
         readings, not a linearised fit held along the span by that one point."""
         from BladeInspect.core import transforms as tf
         from BladeInspect.inspection import pipeline
-        from BladeInspect.rig.kinematics import RigKinematics
         nominal = fx.demo_nominal()
-        on = demo_cloud(nominal, lambda p: np.zeros(len(p)))
-        normal = nominal.signed_distance(on).normal
-        angles = np.arange(0.0, 360.0, 10.0)
-        k = RigKinematics()
-        beams = np.array([k.rotation(a).T @ U.BEAM_MACHINE for a in angles])
-        pick = np.argmin(normal @ beams.T, axis=1)
-        seen = (normal @ beams.T)[np.arange(len(on)), pick] < -0.3
-        on, pick, normal = on[seen], pick[seen], normal[seen]
+        on, normal, angles, beams, pick, _ = head_on_readings(nominal)
         low = int(np.argmin(on[:, 2]))
         past = on[low].copy()
         past[2] = -0.002                   # the demo blade's hub end is at z = 0
