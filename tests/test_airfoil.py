@@ -266,8 +266,12 @@ class Corners(unittest.TestCase):
         upper[-1] = lower[-1] = [50.0, 0.0]
         pts = np.vstack([lower, upper[::-1][1:-1]])
         ch = airfoil.characteristics(pts)
-        self.assertEqual(len(ch.warnings), 1)
+        self.assertEqual(len(ch.warnings), 2)
         self.assertIn("corner at the TE", ch.warnings[0])
+        # a corner's radius is zero, not the circle fitted about the camber line's end
+        self.assertIsNone(ch.te_radius_mm)
+        self.assertIn("TE is a corner", ch.warnings[1])
+        self.assertIsNotNone(ch.le_radius_mm)
 
     def test_round_edges_raise_no_warning(self):
         for pts in (ArcSection().points(), NacaSection("0012", x0=0.97).points()):

@@ -1,7 +1,9 @@
-"""A withheld edge (core.airfoil.withhold_corner_edges: the nominal's TE is a corner, the
-measured TE radius and metal angle null) gets no edge circle: not in the document's
-EdgeCircles object, not in the report's profile figure; the rounded LE keeps its circle, of the
-radius the characteristics report (issue 15 item 5).
+"""A withheld edge (the nominal's TE is a corner: core.airfoil.withhold_corner_edges makes the
+measured TE radius and metal angle null, and the nominal's own radius is null too -- a
+corner's radius is zero, not the circle fitted about its camber line's end) gets no edge
+circle: not in the document's EdgeCircles object, not in the report's profile figure; the
+rounded LE keeps its circle, of the radius the characteristics report (issue 15 item 5). A TE
+radius toleranced on that section cannot be signed off unless the drawing gives its nominal.
 
 The section is the one of tests/test_airfoil_sharp_edge.py: a double-circular-arc section
 whose TE circle is replaced by the corner where its two side arcs cross, built from its
@@ -40,7 +42,10 @@ class WithheldEdgeHasNoCircle(unittest.TestCase):
         self.assertIsNone(self.measured.te_radius_mm)
         self.assertIsNotNone(self.measured.le_radius_mm)
         self.assertEqual([name for name, _ in self.measured.edge_circles()], ["LE"])
-        self.assertEqual([name for name, _ in self.nominal.edge_circles()], ["LE", "TE"])
+        self.assertEqual([name for name, _ in self.nominal.edge_circles()], ["LE"])
+        self.assertIsNone(self.nominal.te_radius_mm)
+        # the fitted circle stays on record (a scan plan spaces its points by it)
+        self.assertIsNotNone(self.nominal.te_circle)
 
     def test_document_object_has_the_le_circle_only(self):
         import FreeCAD
@@ -65,13 +70,13 @@ class WithheldEdgeHasNoCircle(unittest.TestCase):
             self.assertGreater(np.linalg.norm(np.array(circle.Center) - corner_xyz), 10.0)
             self.assertAlmostEqual(obj.LeRadiusMm, self.measured.le_radius_mm, places=12)
             self.assertTrue(np.isnan(obj.TeRadiusMm))
-            # the nominal's TE (its radius reported) keeps both circles
+            # the nominal's corner gets no circle either
             nom = doc.addObject("Part::FeaturePython", "EdgeCircles_nominal")
             airfoil_objects.EdgeCircles(nom)
             airfoil_objects.EdgeCircles.store(nom.Proxy, nom, self.nominal, frame)
-            self.assertEqual(sorted(round(e.Curve.Radius, 9) for e in nom.Shape.Edges),
-                             sorted(round(r, 9) for r in (self.nominal.le_radius_mm,
-                                                          self.nominal.te_radius_mm)))
+            self.assertEqual([round(e.Curve.Radius, 9) for e in nom.Shape.Edges],
+                             [round(self.nominal.le_radius_mm, 9)])
+            self.assertTrue(np.isnan(nom.TeRadiusMm))
         finally:
             FreeCAD.closeDocument(doc.Name)
 
@@ -108,11 +113,62 @@ class WithheldEdgeHasNoCircle(unittest.TestCase):
         self.assertTrue(any(t.startswith("LE r =") for t in labels), labels)
         self.assertFalse(any(t.startswith("TE") for t in labels), labels)
 
-    def test_report_figure_of_the_nominal_draws_both(self):
+    def test_report_figure_of_the_nominal_draws_the_le_only(self):
         circles, labels = self._edge_lines(self.nominal)
-        self.assertEqual(sorted(round(r, 6) for _, r in circles),
-                         sorted(round(r, 6) for r in (self.nominal.le_radius_mm,
-                                                      self.nominal.te_radius_mm)))
+        self.assertEqual(len(circles), 1, circles)
+        self.assertAlmostEqual(circles[0][1], self.sec.r_le, delta=1e-3)
+        self.assertFalse(any(t.startswith("TE") for t in labels), labels)
+
+
+class WithheldEdgeJudged(unittest.TestCase):
+    """A drawing's TE radius tolerance on a section whose CAD TE is a corner."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.nominal, cls.measured, _, _ = _measured_sharp_section()
+        frame = types.SimpleNamespace(to_3d=lambda p: np.column_stack(
+            [np.atleast_2d(p), np.zeros((len(np.atleast_2d(p)), 1))]))
+        cls.values = (stage_mod._char_values(cls.nominal, frame),
+                      stage_mod._char_values(cls.measured, frame))
+
+    def _judge(self, drawing_nominal):
+        block = {"label": "sharp", "nominal": dict(self.values[0]),
+                 "measured": dict(self.values[1]), "uncertainty": None}
+        row = stage_mod.Tolerance("te_radius_mm", "all", -0.01, 0.01, drawing_nominal, 2)
+        failed, _ = stage_mod._judge(block, [row], True, "simple")
+        return block, failed
+
+    def test_without_a_drawing_nominal_it_is_not_measured(self):
+        block, failed = self._judge(None)
+        self.assertEqual(block["verdicts"]["te_radius_mm"], "not measured")
+        self.assertEqual(len(failed), 1)
+        self.assertTrue(failed[0].startswith("te_radius_mm"))
+        self.assertEqual(block["verdict"], "fail")
+        # the verdict keeps its row in airfoil.csv, the nominal cell empty
+        rows = [r for r in stage_mod.csv_rows([block]) if r[1] == "te_radius_mm"]
+        self.assertEqual(len(rows), 1)
+        self.assertIsNone(rows[0][2])
+        self.assertEqual(rows[0][-1], "not measured")
+        from BladeInspect.inspection import airfoil_report
+        shown = [r for r in airfoil_report.characteristics_rows(block) if r[0] == "TE radius"]
+        self.assertEqual(len(shown), 1, shown)
+        self.assertEqual(shown[0][2], "-")
+        self.assertEqual(shown[0][-1], "not measured")
+
+    def test_with_a_drawing_nominal_the_unmeasurable_radius_fails_too(self):
+        # the measured TE radius is withheld (not measurable at this sampling): not signed off
+        block, failed = self._judge(0.05)
+        self.assertEqual(block["verdicts"]["te_radius_mm"], "not measured")
+        self.assertEqual(block["nominal"]["te_radius_mm"], 0.05)
+        self.assertEqual(block["verdict"], "fail")
+
+    def test_a_nominal_only_check_does_not_judge_it(self):
+        block = {"label": "sharp", "nominal": dict(self.values[0]), "measured": None,
+                 "uncertainty": None}
+        row = stage_mod.Tolerance("te_radius_mm", "all", -0.01, 0.01, None, 2)
+        failed, _ = stage_mod._judge(block, [row], False, "simple")
+        self.assertEqual(block["verdicts"]["te_radius_mm"], "not judged")
+        self.assertEqual(failed, [])
 
 
 if __name__ == "__main__":

@@ -1125,13 +1125,24 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
 
     area, centroid = area_centroid(profile)
     warnings = _corner_warnings(profile, le, te, nose_tail) + notes
+    le_radius, te_radius = le_circle.radius, te_circle.radius
+    for name in _corner_edges(profile, le, te, nose_tail):
+        # A corner's radius is zero: the circle fitted about the camber line's end (kept, for
+        # a scan plan's edge spacing) is the window's, not the part's.
+        warnings.append("%s is a corner, not a rounded edge: its radius is not reported (the "
+                        "circle fitted there, %.4f mm, is not the part's)"
+                        % (name, (le_circle if name == "LE" else te_circle).radius))
+        if name == "LE":
+            le_radius = None
+        else:
+            te_radius = None
     return Characteristics(
         chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
         axial_chord_mm=extent(profile, axis), stagger_deg=_angle_deg(chord_dir, axis),
         max_thickness_mm=max_thickness, max_thickness_pos_pct=max_pos,
         max_thickness_center=c_max[0], thickness_stations_pct=stations, thickness_mm=thickness,
-        le_radius_mm=le_circle.radius, te_radius_mm=te_circle.radius, le_circle=le_circle,
+        le_radius_mm=le_radius, te_radius_mm=te_radius, le_circle=le_circle,
         te_circle=te_circle, edge_offsets_mm=offsets, le_thickness_mm=le_thk,
         te_thickness_mm=te_thk, inlet_angle_deg=_angle_deg(mcl.le_tangent, axis),
         outlet_angle_deg=_angle_deg(mcl.te_tangent, axis), area_mm2=area,
@@ -1193,6 +1204,18 @@ def edge_spacing_mm(radius_mm, noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_
     return arc / edge_points_needed(noise_mm, radius_sigma_mm, zone_deg)
 
 
+def _corner_edges(profile, le, te, chord):
+    """{"LE" and/or "TE": the corner}: the edges that are a corner of the input points (one
+    within 2 % of the chord of the edge point, _corner_warnings's rule)."""
+    pts = profile.points[profile.corners]
+    out = {}
+    for name, p in (("LE", le), ("TE", te)):
+        near = np.linalg.norm(pts - p, axis=1) < 0.02 * chord
+        if near.any():
+            out[name] = pts[near][0]
+    return out
+
+
 def _corner_warnings(profile, le, te, chord):
     """One line per corner of the input points: the spline rounds a corner off over a point
     spacing, so an edge radius, edge point and chord read there are not the part's."""
@@ -1216,17 +1239,15 @@ def withhold_corner_edges(measured, nominal):
     fit rounds the corner off over the points' spacing and noise, and the same rule then
     reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.006-12 deg off,
     1 sigma 2.6 deg over 22 scans). docs/airfoil.md, "Sharp edges"."""
-    for name, point, angle, radius in (("LE", nominal.le_point, "inlet_angle_deg",
-                                        "le_radius_mm"),
-                                       ("TE", nominal.te_point, "outlet_angle_deg",
-                                        "te_radius_mm")):
-        pts = nominal.profile.points[nominal.profile.corners]
-        near = np.linalg.norm(pts - point, axis=1) < 0.02 * nominal.nose_tail_chord_mm
-        if not near.any():
+    corners = _corner_edges(nominal.profile, nominal.le_point, nominal.te_point,
+                            nominal.nose_tail_chord_mm)
+    for name, angle, radius in (("LE", "inlet_angle_deg", "le_radius_mm"),
+                                ("TE", "outlet_angle_deg", "te_radius_mm")):
+        if name not in corners:
             continue
         setattr(measured, angle, None)
         setattr(measured, radius, None)
-        corner = pts[near][0]
+        corner = corners[name]
         measured.warnings.append(
             "%s: the nominal's %s is a corner at (%.4f, %.4f) mm, not a rounded edge: its "
             "metal angle (%s) and edge radius (%s) are not measurable with this sampling "

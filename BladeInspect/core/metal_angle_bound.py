@@ -40,7 +40,8 @@ def window_span_mm(chars, end, window_pct=airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT
     """(start, end) of arc along each side from the edge point that the definition's window
     reads: past a quarter turn round the edge and the skipped half edge radius, then the
     window's share of the camber line."""
-    r = chars.le_radius_mm if end == "inlet" else chars.te_radius_mm
+    # the fitted circle (a corner edge reports no radius, but the window is still laid off)
+    r = (chars.le_circle if end == "inlet" else chars.te_circle).radius
     start = 0.5 * np.pi * r + airfoil._END_SKIP * r
     return start, start + window_pct / 100.0 * chars.mcl.inner_length
 

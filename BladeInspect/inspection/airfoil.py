@@ -636,10 +636,21 @@ def _judge(block, tolerances, measured_part=True, rule="iso14253"):
     measured = _flat(block["measured"]) if block["measured"] else {}
     sd = _flat(block["uncertainty"]) if block.get("uncertainty") else {}
     deviation, tol_out, verdicts, decisions, failed, unproven = {}, {}, {}, {}, [], []
-    for key in nominal:
+    # A toleranced characteristic the CAD has no value for (a corner's edge radius) is judged
+    # against the drawing's nominal if the row gives one, else cannot be signed off.
+    keys = list(nominal) + [k for k in SCALARS if k not in nominal
+                            and _tolerance_for(tolerances, block["label"], k) is not None]
+    for key in keys:
         t = _tolerance_for(tolerances, block["label"], key)
         if t is not None and t.nominal is not None:
             nominal[key] = t.nominal
+        elif key not in nominal:
+            judged = measured_part and (t.lower is not None or t.upper is not None)
+            tol_out[key] = {"lower": t.lower, "upper": t.upper, "row": t.row}
+            verdicts[key] = "not measured" if judged else "not judged"
+            if judged:
+                failed.append(key + " (no nominal: not a rounded edge on the CAD)")
+            continue
         if key in measured:
             deviation[key] = measured[key] - nominal[key]
         if t is None or (t.lower is None and t.upper is None):
@@ -916,10 +927,11 @@ def csv_rows(blocks):
         mea = _flat(b["measured"]) if b["measured"] else {}
         dev = _flat(b["deviation"]) if b.get("deviation") else {}
         unc = _flat(b["uncertainty"]) if b.get("uncertainty") else {}
-        for key in nom:
+        # a toleranced key the CAD has no value for (a corner's radius) keeps its row
+        for key in list(nom) + [k for k in b["verdicts"] if k not in nom]:
             t = b["tolerance"].get(key, {})
             d = (b.get("decisions") or {}).get(key, {})
-            rows.append([b["label"], key, nom[key], mea.get(key), dev.get(key), unc.get(key),
+            rows.append([b["label"], key, nom.get(key), mea.get(key), dev.get(key), unc.get(key),
                          t.get("lower"), t.get("upper"), d.get("U"), d.get("rule"),
                          b["verdicts"][key]])
     return rows

@@ -33,14 +33,14 @@ def characteristics_rows(block):
     dev = stage_mod._flat(block["deviation"]) if block.get("deviation") else {}
     unc = stage_mod._flat(block["uncertainty"]) if block.get("uncertainty") else {}
     rows = []
-    for key in nom:
+    for key in list(nom) + [k for k in block["verdicts"] if k not in nom]:   # as csv_rows
         t = block["tolerance"].get(key)
         tol = "-" if t is None else "%s .. %s" % (
             "-inf" if t["lower"] is None else "%+g" % t["lower"],
             "+inf" if t["upper"] is None else "%+g" % t["upper"])
         decision = (block.get("decisions") or {}).get(key, {})
         rows.append([characteristic_names.display_name(key, block["nominal"]),
-                     characteristic_names.unit(key), _num(nom[key], key), _num(mea.get(key), key),
+                     characteristic_names.unit(key), _num(nom.get(key), key), _num(mea.get(key), key),
                      _num(dev.get(key), key, "+"),
                      _num(unc.get(key), key), _num(decision.get("U"), key), tol,
                      block["verdicts"].get(key, "-")])
