@@ -348,17 +348,22 @@ def _airfoil_arguments(parser, always):
                         help="which end is the LE when the CAD does not name it: the upstream "
                              "end along the engine axis (default; the flow runs along +axis) "
                              "or the larger edge radius")
+    parser.add_argument("--uncertainty-task", default=None, metavar="FILE",
+                        help="task-specific uncertainty: reuse the re-fit draws stored in FILE "
+                             "for the sections whose measurement matches the task's "
+                             "conditions; FILE absent: make it from this blade (48 draws a "
+                             "section; docs/airfoil.md)")
 
 
 def _airfoil_options(args):
     """inspection.airfoil.Options from the command's arguments; None with --no-airfoil."""
     given = [args.engine_axis, args.characteristics, args.chord_method, args.edge_offsets,
-             args.le_rule]
+             args.le_rule, args.uncertainty_task]
     if getattr(args, "no_airfoil", False):
         if any(v is not None for v in given) or args.airfoil:
             raise InputError("--no-airfoil: cannot be given with --airfoil or the airfoil "
                              "options (--engine-axis, --characteristics, --chord-method, "
-                             "--edge-offsets, --le-rule)")
+                             "--edge-offsets, --le-rule, --uncertainty-task)")
         return None
     from .inspection.airfoil import options_from_args
     return options_from_args(*given)

@@ -5,34 +5,38 @@ uncertainty re-fits, on the demo blade:
 - ``planned``: the CAD's section points at the planned scan's 0.1 mm spacing, sigma 3.5 um (as
   the closed loop's), registered at the identity (tests/test_airfoil_pipeline.py's set-up).
 
-    scripts/fcpython bench/bench_airfoil_speed.py [POINTS.csv]
+    scripts/fcpython bench/bench_airfoil_speed.py [POINTS.csv] [--task-draws N]
 
 Prints the CPU seconds of run_stage for draws 0 and the default draws, of the kernel alone
 (core.airfoil.characteristics on the five nominal cuts), and of one kernel run a measured
-section (what every uncertainty re-fit repeats). BLAS is held to one thread (its
-spinning threads double a CPU figure on a shared machine).
+section (what every uncertainty re-fit repeats). With the task-specific uncertainty
+(inspection.airfoil_task_u) on the planned case: the first blade of the task making the task
+file (``--task-draws``, default the product's 48), and a second blade of the same task (fresh
+noise) reusing it -- the figure issue 15's "five sections in under 1 s" is about. BLAS is held
+to one thread (core.blas_threads.limit_blas_threads, as the command line does: its spinning
+threads double a CPU figure on a shared machine).
 """
 import os
 import sys
+import tempfile
 import time
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from BladeInspect.core import airfoil as kernel  # noqa: E402
-from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
-from BladeInspect.inspection import sections as sections_mod  # noqa: E402
-from BladeInspect.inspection.pipeline import load_nominal, load_points, register  # noqa: E402
+from BladeInspect.core import airfoil as kernel
+from BladeInspect.core.blas_threads import limit_blas_threads
+from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import sections as sections_mod
+from BladeInspect.inspection.pipeline import load_nominal, load_points, register
 
 HEIGHTS = (10.0, 30.0, 50.0, 70.0, 90.0)
 
 
-def stage_cpu(nominal, table, result, draws):
+def stage_cpu(nominal, table, result, draws, **options):
     t = time.process_time()
     stage = stage_mod.run_stage(nominal, stage_mod.planes_of_table(table),
-                                stage_mod.Options(draws=draws), result, table.span_axis)
+                                stage_mod.Options(draws=draws, **options), result,
+                                table.span_axis)
     return time.process_time() - t, stage
 
 
@@ -41,17 +45,48 @@ def report_case(nominal, points_path):
     return sections_mod.section_table(result, nominal), result
 
 
-def planned_case(nominal):
+def planned_case(nominal, seed=0):
     from tests.test_airfoil_pipeline import _noisy, _result
     from BladeInspect.measurement.planning import nominal_section
     planes = stage_mod.nominal_planes(nominal, HEIGHTS)
     sections = [nominal_section(nominal, p.origin, p.normal, 0.1)[:2] for p in planes]
-    xyz = np.vstack(_noisy(sections, 0.0035, 0))
+    xyz = np.vstack(_noisy(sections, 0.0035, seed))
     result = _result(nominal, xyz)
     return sections_mod.section_table(result, nominal, heights_pct=HEIGHTS, band=0.01), result
 
 
+def task_case(nominal, draws):
+    """The planned case's task file made on blade 1, then reused by blade 2 (fresh noise)."""
+    folder = tempfile.mkdtemp(prefix="bench_task_u_")
+    path = os.path.join(folder, "task.json")
+    name = "planned, task-specific u"
+    table, result = planned_case(nominal, seed=0)
+    cpu, stage = stage_cpu(nominal, table, result, stage_mod.DEFAULT_DRAWS,
+                           task_uncertainty=path, task_draws=draws)
+    print("%s: blade 1 makes the task file (%d draws): %.2f s CPU for %d sections (%s)"
+          % (name, draws, cpu, len(stage.blocks),
+             "/".join(stage.settings["uncertainty_task"]["sections"].values())))
+    table, result = planned_case(nominal, seed=1)
+    for repeat in range(2):
+        cpu, stage = stage_cpu(nominal, table, result, stage_mod.DEFAULT_DRAWS,
+                               task_uncertainty=path)
+        print("%s: blade 2 reuses it: %.2f s CPU for %d sections (%s)"
+              % (name, cpu, len(stage.blocks),
+                 "/".join(stage.settings["uncertainty_task"]["sections"].values())))
+        cpu0, _ = stage_cpu(nominal, table, result, 0)
+        print("%s: blade 2, draws 0 beside it: %.2f s CPU" % (name, cpu0))
+    os.unlink(path)
+    os.rmdir(folder)
+
+
 def main():
+    limit_blas_threads()
+    args = list(sys.argv[1:])
+    task_draws = 48
+    if "--task-draws" in args:
+        k = args.index("--task-draws")
+        task_draws = int(args[k + 1])
+        del args[k:k + 2]
     nominal = load_nominal(None)
     from BladeInspect.cad.airfoil_sections import airfoil_section
     cuts = [airfoil_section(nominal.shape, p.origin, p.normal)[0]
@@ -62,8 +97,8 @@ def main():
     print("kernel alone, five nominal cuts (%s points): %.2f s CPU"
           % ("/".join(str(len(c)) for c in cuts), time.process_time() - t))
     cases = [("planned (0.1 mm, sigma 3.5 um)", planned_case(nominal))]
-    if len(sys.argv) > 1:
-        cases.insert(0, ("report on %s" % sys.argv[1], report_case(nominal, sys.argv[1])))
+    if args:
+        cases.insert(0, ("report on %s" % args[0], report_case(nominal, args[0])))
     for name, (table, result) in cases:
         for draws in (0, stage_mod.DEFAULT_DRAWS):
             cpu, stage = stage_cpu(nominal, table, result, draws)
@@ -77,6 +112,7 @@ def main():
             kernel.characteristics(r.points_2d, noise_mm=r.noise_mm, le_hint=r.nominal.le_point)
         print("%s: kernel on the %d measured sections: %.3f s CPU each"
               % (name, len(measured), (time.process_time() - t) / max(len(measured), 1)))
+    task_case(nominal, task_draws)
 
 
 if __name__ == "__main__":

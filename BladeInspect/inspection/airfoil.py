@@ -70,6 +70,11 @@ class Options:
     seed: int = 0
     le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
     decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
+    # task-specific uncertainty (inspection.airfoil_task_u): a task file's path (reused when
+    # it exists and matches, made there when absent) or an airfoil_task_u.TaskUncertainty;
+    # None: every section's u from its own re-fit (``draws``)
+    task_uncertainty: object = None
+    task_draws: int = 48            # re-fits when a task is made (airfoil_task_u)
 
 
 @dataclass
@@ -196,9 +201,13 @@ def read_characteristics(path):
 
 
 def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
-                      edge_offsets=None, le_rule=None):
+                      edge_offsets=None, le_rule=None, uncertainty_task=None):
     """Options from the command line's text values (None: the default)."""
     opts = Options()
+    if uncertainty_task is not None:
+        from . import airfoil_task_u
+        airfoil_task_u.check_file(uncertainty_task)   # an existing file must be a task file
+        opts.task_uncertainty = uncertainty_task
     if le_rule is not None:
         if le_rule not in LE_RULES:
             raise InputError("--le-rule: %r is not one of %s" % (le_rule, ", ".join(LE_RULES)))
@@ -362,9 +371,10 @@ class SectionResult:
     noise_mm: float = None
     block: dict = None
     notes: list = field(default_factory=list)
+    task_u: tuple = None             # (how, why) under a task uncertainty (airfoil_task_u)
 
 
-def _section(nominal, plane, opts, result, rng, counted=None):
+def _section(nominal, plane, opts, result, rng, counted=None, task=None):
     from ..cad.airfoil_sections import airfoil_section
     try:
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis,
@@ -409,7 +419,11 @@ def _section(nominal, plane, opts, result, rng, counted=None):
     measured_values["n_points"] = int(len(idx))
     measured_values["zones"] = cont
     block["measured"] = measured_values
-    if opts.draws:
+    if task is not None:    # task-specific uncertainty (inspection.airfoil_task_u)
+        from . import airfoil_task_u
+        sr.task_u = airfoil_task_u.section_uncertainty(task, sr, result, idx, frame, nom, ch,
+                                                       fit, opts, noise, rng, measured_values)
+    elif opts.draws:
         block["uncertainty"] = _uncertainty(result, idx, frame, nom, ch, fit, opts, noise,
                                             rng, measured_values)
     return sr
@@ -447,8 +461,10 @@ def _measure_at(xyz, normals, frame, nom, opts):
     return ch, fit, cont, ordered, noise
 
 
-def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values):
-    """1 sigma of each measured characteristic by re-fitting perturbed points (module notes)."""
+def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values,
+                 draws_sd=None):
+    """1 sigma of each measured characteristic by re-fitting perturbed points (module notes);
+    ``draws_sd``, a dict, is given the draws' own 1 sigma before the maxima's bias."""
     xyz0 = result.points_cad[idx]
     n0 = result.normal[idx]
     # The measured profile's smooth fit at each point: the draws' noise-free points.
@@ -502,6 +518,8 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     keys = _flat(measured_values).keys()
     sd = {key: _draws_sd([d[key] for d in draws if key in d])
           for key in keys if sum(key in d for d in draws) >= 2}
+    if draws_sd is not None:   # inspection.airfoil_task_u stores these
+        draws_sd.update(sd)
     for key, bias in _maxima_bias(result, idx, pts, nom, fit, sigma, sensor).items():
         if key in sd:
             sd[key] = float(np.hypot(sd[key], bias))
@@ -752,7 +770,15 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     check_sections(opts, planes)
     rng = np.random.default_rng(opts.seed)
     counted = None if result is None else measured_surface(result)
-    results = [_section(nominal, p, opts, result, rng, counted) for p in planes]
+    task = None
+    if opts.task_uncertainty is not None and result is not None:
+        from . import airfoil_task_u
+        task = airfoil_task_u.open_task(
+            opts.task_uncertainty, airfoil_task_u.task_key(nominal, opts, result),
+            opts, result)
+    results = [_section(nominal, p, opts, result, rng, counted, task) for p in planes]
+    if task is not None and not task.made:
+        task.finish()    # written (atomically) to its file, or kept in memory
     if opts.decision_rule not in decision_mod.RULES:
         raise InputError("--decision-rule: unknown rule '%s' (use %s)"
                          % (opts.decision_rule, ", ".join(decision_mod.RULES)))
@@ -788,6 +814,10 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                 "decision_without_u": "a characteristic with no stated u (draws 0) is "
                                       "decided by %s: %s" % (NO_U_RULE,
                                                              decision_mod.RULE_TEXT[NO_U_RULE])}
+    if task is not None:
+        settings.update(airfoil_task_u.settings_of(
+            task, {r.plane.label: r.task_u for r in results if r.task_u is not None},
+            settings["uncertainty_method"]))
     return Stage(results, [r.block for r in results], _lean_bow(results, span_axis), verdict,
                  settings, counted)
 

@@ -1,0 +1,380 @@
+"""Task-specific uncertainty of the airfoil characteristics (issue 15, "all characteristics of
+five sections in under 1 s"; ISO 15530-4 style, uncertainty by simulation of the task).
+
+The re-fit draws of inspection.airfoil (``_uncertainty``) state how much each characteristic
+scatters when the section's points are measured again: through the sensor's noise along the
+beams, its reading bias and the pose covariance, on this CAD, in these planes, with these
+options. That is a property of the measurement *task*, not of one blade. So the draws are made
+once per task (``DEFAULT_TASK_DRAWS`` = 48 of them, so that the u is known to
+1/sqrt(2 x 47) = 10 % rather than the 21 % of the 12 a blade's own re-fit takes) and stored in a
+JSON task file; every later blade of the same task reuses them while its measurement still
+matches the conditions they were made under. Only the draws' standard deviation is stored:
+the form values' maxima bias (``_maxima_bias``) depends on the blade's own deviations and is
+added afresh for every blade, as ``_uncertainty`` adds it.
+
+The task (the file's ``key``; a file made for another task is refused, never reused):
+
+- ``version``: TASK_MODEL_VERSION, raised whenever the draws' model in inspection.airfoil
+  changes, so that old files are refused;
+- ``cad``: sha256 of the nominal's dense samples (``nominal.samples``: points rounded to
+  0.1 um, outward normals to 1e-6, with their count) -- the samples are made from the CAD's
+  faces on a fixed grid, so the same file loads to the same fingerprint in every run, it costs
+  a hash of a few MB, and it changes with the CAD, the sample spacing and ``--flip-face``;
+  cheaper and steadier than a BREP string, whose text carries OCC's version;
+- the airfoil options that change the values: engine_axis, chord_method, edge_offsets_mm,
+  le_rule;
+- the sensor the draws use (every field of its rig.sensor.SensorModel, accuracy included);
+- the registration's fit (result.fit's objective, free, weights_by_zone, datum_faces) and
+  weight model (result.weights' model), and which readings the draws lay noise along
+  (snr and beams known or not);
+
+Sections are not part of the key: a run of fewer or other sections is the same task, each
+section found by its label. Per section the file holds the plane (origin, normal), the draws' 1 sigma per flattened key
+(``_flat``'s names), and the conditions they were made under. A later blade's section uses
+them only when (MATCH_RULE):
+
+- its plane lies within PLANE_LEVEL_MM of the stored one along the normal and its normal within
+  PLANE_ANGLE_DEG (an `inspect`'s planes are fitted to each blade's points);
+- its point count is within +-10 %, its measured noise sigma (the point-to-point scatter,
+  ``noise`` of inspection.airfoil._section) within +-20 %, and sqrt(trace) of the pose
+  covariance's translation part (mm) and of its rotation part (rad) each within +-50 % of the
+  stored ones.
+
+A section that does not match is computed afresh with the blade's own re-fit
+(``Options.draws``) and its notes say why; nothing cached is used silently: the stage's
+``settings`` states the task file, when and from how many draws (and which seed) it was made,
+and per section which way its u was found (``uncertainty_task``); each block says it too
+(``uncertainty_method``, ``uncertainty_draws``).
+
+When the file named does not exist, the stage makes it: every measured section's u from
+``Options.task_draws`` re-fits (that blade's u is then the 48-draw one), written atomically
+(a temporary file in the same folder, then os.replace). The file is never changed afterwards.
+
+A file that cannot be read as a task file (corrupt JSON, another kind of file, another model
+version, or made for another task) gives a one-line InputError naming the file and why: it is
+not recomputed over, because the file was named for this task and something is wrong with it
+(a half-copied file, a changed CAD or option, an upgrade) that the user should see; deleting
+the file makes the next run compute it afresh.
+"""
+
+import datetime
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..core.errors import InputError
+from ..rig.sensor import SensorModel
+from . import uncertainty as uncertainty_mod
+
+# Raise whenever the re-fit draws' model (inspection.airfoil._uncertainty,
+# _point_noise_model, _measure) changes: files of another version are refused.
+TASK_MODEL_VERSION = 1
+FILE_KIND = "BladeInspect airfoil task uncertainty"
+DEFAULT_TASK_DRAWS = 48
+# The match rule: relative half-widths about the stored conditions.
+MATCH_RULE = {"n_points": 0.10, "noise_mm": 0.20, "pose_translation_mm": 0.50,
+              "pose_rotation_rad": 0.50}
+# Conditions this small count as zero (a pose covariance of a fixed pose).
+CONDITION_FLOOR = {"n_points": 1.0, "noise_mm": 1e-9, "pose_translation_mm": 1e-12,
+                   "pose_rotation_rad": 1e-15}
+PLANE_LEVEL_MM = 0.05
+PLANE_ANGLE_DEG = 0.05
+MATCH_RULE_TEXT = ("a section reuses the task's draws when its plane is within %g mm and "
+                   "%g deg of the task's, its point count within +-%d %%, its noise sigma "
+                   "within +-%d %% and sqrt(trace) of the pose covariance's translation and "
+                   "rotation parts each within +-%d %% of the task's; otherwise its u is "
+                   "re-fitted afresh" % (PLANE_LEVEL_MM, PLANE_ANGLE_DEG,
+                                         100 * MATCH_RULE["n_points"],
+                                         100 * MATCH_RULE["noise_mm"],
+                                         100 * MATCH_RULE["pose_translation_mm"]))
+
+
+def _sensor(opts):
+    """The sensor the draws use (as inspection.airfoil._uncertainty takes it)."""
+    return (SensorModel() if opts.accuracy_mm is None
+            else SensorModel(accuracy=float(opts.accuracy_mm)))
+
+
+def cad_fingerprint(nominal):
+    """sha256 of the nominal's dense samples, rounded (module notes)."""
+    xyz = np.round(np.asarray(nominal.samples.xyz, dtype=float), 4) + 0.0   # no -0.0
+    nrm = np.round(np.asarray(nominal.samples.normal, dtype=float), 6) + 0.0
+    h = hashlib.sha256()
+    h.update(np.int64(len(xyz)).tobytes())
+    h.update(np.ascontiguousarray(xyz).tobytes())
+    h.update(np.ascontiguousarray(nrm).tobytes())
+    return "samples-sha256:" + h.hexdigest()
+
+
+def _fit_of(result):
+    fit = getattr(result, "fit", None) or {}
+    weights = getattr(result, "weights", None) or {}
+    return {"objective": fit.get("objective", "least-squares"), "free": fit.get("free", "all"),
+            "weights_by_zone": fit.get("weights_by_zone"),
+            "datum_faces": fit.get("datum_faces"), "weight_model": weights.get("model")}
+
+
+def task_key(nominal, opts, result):
+    """The task's key (module notes): a JSON-able dict."""
+    return {"version": TASK_MODEL_VERSION,
+            "cad": cad_fingerprint(nominal),
+            "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
+            "chord_method": opts.chord_method,
+            "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
+            "le_rule": opts.le_rule,
+            "sensor": json.loads(json.dumps(asdict(_sensor(opts)))),
+            "fit": _fit_of(result),
+            "readings": {"snr": result.snr is not None,
+                         "beams": uncertainty_mod.beam_directions(result) is not None}}
+
+
+def digest(key):
+    return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def conditions(result, n_points, noise):
+    """The conditions a section's draws hold for (module notes)."""
+    cov = np.asarray(result.pose_covariance, dtype=float)
+    cov = np.where(np.isfinite(cov), cov, 0.0)
+    return {"n_points": int(n_points), "noise_mm": float(noise),
+            "pose_translation_mm": float(np.sqrt(max(np.trace(cov[:3, :3]), 0.0))),
+            "pose_rotation_rad": float(np.sqrt(max(np.trace(cov[3:, 3:]), 0.0)))}
+
+
+def mismatch(stored, now):
+    """Why a section's conditions ``now`` are outside the match rule of the ``stored`` ones
+    (an empty list when they match)."""
+    out = []
+    for name, rel in MATCH_RULE.items():
+        a, b = float(now[name]), float(stored[name])
+        floor = CONDITION_FLOOR[name]
+        if abs(a - b) > rel * max(abs(b), floor) and max(abs(a), abs(b)) > floor:
+            out.append("%s %.4g against the task's %.4g (+-%d %%)" % (name, a, b, 100 * rel))
+    return out
+
+
+def plane_mismatch(stored, plane):
+    n0 = np.asarray(stored["normal"], dtype=float)
+    o0 = np.asarray(stored["origin"], dtype=float)
+    n1 = np.asarray(plane.normal, dtype=float)
+    n1 = n1 / np.linalg.norm(n1)
+    angle = float(np.degrees(np.arccos(np.clip(abs(n0 @ n1), -1.0, 1.0))))
+    level = float(abs((np.asarray(plane.origin, dtype=float) - o0) @ n0))
+    out = []
+    if level > PLANE_LEVEL_MM:
+        out.append("plane %.4g mm from the task's (%g allowed)" % (level, PLANE_LEVEL_MM))
+    if angle > PLANE_ANGLE_DEG:
+        out.append("plane normal %.4g deg from the task's (%g allowed)" % (angle, PLANE_ANGLE_DEG))
+    return out
+
+
+def _now():
+    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+@dataclass
+class TaskUncertainty:
+    """A task file's contents (or one being made: ``made`` False until saved)."""
+    key: dict
+    draws: int
+    seed: int
+    made_utc: str = None
+    made_from: str = ""
+    sections: dict = field(default_factory=dict)    # label -> {plane, conditions, sd}
+    path: str = None
+    made: bool = True
+
+    def describe(self):
+        return ("task-specific (file %s, made from %d draws on %s, seed %d%s)"
+                % (self.path or "in memory", self.draws, self.made_utc, self.seed,
+                   ", blade %s" % self.made_from if self.made_from else ""))
+
+    def to_json(self):
+        return {"kind": FILE_KIND, "version": TASK_MODEL_VERSION, "key": self.key,
+                "key_digest": digest(self.key), "draws": self.draws, "seed": self.seed,
+                "made_utc": self.made_utc, "made_from": self.made_from,
+                "match_rule": MATCH_RULE_TEXT, "sections": self.sections}
+
+    def finish(self):
+        """A task just made: written to its file (when a section was measured), or marked
+        made in memory."""
+        if self.path is None:
+            self.made_utc, self.made = _now(), True
+        elif self.sections:
+            self.save()
+
+    def save(self, path=None):
+        """Written atomically: a temporary file beside the target, then os.replace."""
+        path = path or self.path
+        self.made_utc = self.made_utc or _now()
+        folder = os.path.dirname(os.path.abspath(path))
+        fd, tmp = tempfile.mkstemp(prefix=".%s." % os.path.basename(path), suffix=".tmp",
+                                   dir=folder)
+        try:
+            with os.fdopen(fd, "w") as fh:
+                json.dump(self.to_json(), fh, indent=1, allow_nan=False)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        self.path, self.made = path, True
+        return path
+
+
+def load(path):
+    """The task file at ``path``; a one-line InputError when it is not one (module notes)."""
+    try:
+        with open(path) as fh:
+            doc = json.load(fh)
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError("%s: cannot read the uncertainty task file (%s)" % (path, exc))
+    except ValueError as exc:
+        raise InputError("%s: not an uncertainty task file: corrupt JSON (%s); delete it to "
+                         "compute the task afresh" % (path, str(exc).splitlines()[0]))
+    if not isinstance(doc, dict) or doc.get("kind") != FILE_KIND:
+        raise InputError("%s: not an uncertainty task file (no kind %r)" % (path, FILE_KIND))
+    if doc.get("version") != TASK_MODEL_VERSION:
+        raise InputError("%s: uncertainty task file of model version %r, this is version %d: "
+                         "delete it to compute the task afresh"
+                         % (path, doc.get("version"), TASK_MODEL_VERSION))
+    try:
+        key, sections = doc["key"], doc["sections"]
+        draws, seed = int(doc["draws"]), int(doc["seed"])
+        if not isinstance(key, dict) or not isinstance(sections, dict):
+            raise TypeError("key or sections")
+        if doc.get("key_digest") != digest(key):
+            raise ValueError("its key does not match its key_digest")
+        for label, s in sections.items():
+            _ = (np.asarray(s["plane"]["origin"], dtype=float).reshape(3),
+                 np.asarray(s["plane"]["normal"], dtype=float).reshape(3),
+                 [float(s["conditions"][k]) for k in MATCH_RULE],
+                 {k: (None if v is None else float(v)) for k, v in s["sd"].items()})
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError("%s: uncertainty task file is damaged (%s); delete it to compute the "
+                         "task afresh" % (path, exc))
+    return TaskUncertainty(key=key, draws=draws, seed=seed, made_utc=doc.get("made_utc"),
+                           made_from=doc.get("made_from") or "", sections=sections, path=path)
+
+
+def check_file(path):
+    """--uncertainty-task FILE: a file that exists must be a task file (fails early)."""
+    if path is not None and os.path.exists(path):
+        load(path)
+
+
+def open_task(spec, key, opts, result):
+    """The task for a run: ``spec`` a path (loaded when it exists, else a new task to make and
+    write there) or a TaskUncertainty (in memory; made when empty). A task made for another
+    key is refused (InputError naming what differs)."""
+    if isinstance(spec, TaskUncertainty):
+        task = spec
+        if not task.sections and not task.made:
+            task.key = key
+    elif os.path.exists(spec):
+        task = load(spec)
+    else:
+        return TaskUncertainty(key=key, draws=int(opts.task_draws), seed=int(opts.seed),
+                               made_from=getattr(result, "source", "") or "", path=spec,
+                               made=False)
+    if task.key != key:
+        differ = sorted(k for k in set(task.key) | set(key) if task.key.get(k) != key.get(k))
+        raise InputError("%s: uncertainty task file made for another task (differs in %s); "
+                         "use another file or delete it to compute this task afresh"
+                         % (task.path or "task", ", ".join(differ)))
+    return task
+
+
+def maxima_bias(result, idx, frame, nom, ch, fit, opts, noise):
+    """{form key: bias} of one blade's section, with the inputs inspection.airfoil._uncertainty
+    gives _maxima_bias (kept in step with it: tests/test_airfoil_task_u.py checks that the
+    task's u of the blade that made it is that blade's re-fit u)."""
+    from . import airfoil as stage
+    xyz0 = result.points_cad[idx]
+    n0 = result.normal[idx]
+    prof = ch.profile
+    pts = frame.to_2d(stage._into_plane(xyz0, n0, frame.origin, frame.normal))
+    u, _ = prof.closest(pts)
+    out_normal = frame.vector_to_3d(prof.outward_normal(u))
+    sensor = _sensor(opts)
+    sigma = stage._point_noise_model(result, idx, sensor, noise, out_normal)[0]
+    return stage._maxima_bias(result, idx, pts, nom, fit, sigma, sensor)
+
+
+def section_uncertainty(task, sr, result, idx, frame, nom, ch, fit, opts, noise, rng,
+                        measured_values):
+    """The block's ``uncertainty`` of one measured section under a task: the task's draws when
+    the section matches, else made (a task being made) or re-fitted afresh; records how on the
+    block and in ``sr.notes``. Returns ("task" | "made" | "re-fit", reason)."""
+    from . import airfoil as stage
+    label = sr.plane.label
+    now = conditions(result, len(idx), noise)
+    block = sr.block
+    if not task.made:
+        sd = {}
+        u = stage._uncertainty(result, idx, frame, nom, ch, fit,
+                               _with_draws(opts, task.draws), noise, rng, measured_values,
+                               draws_sd=sd)
+        block["uncertainty"] = u
+        if u is not None:
+            task.sections[label] = {
+                "plane": {"origin": np.asarray(sr.plane.origin, float).tolist(),
+                          "normal": (np.asarray(sr.plane.normal, float)
+                                     / np.linalg.norm(sr.plane.normal)).tolist()},
+                "conditions": now,
+                "sd": {k: (None if not np.isfinite(v) else float(v)) for k, v in sd.items()}}
+        block["uncertainty_method"] = "task-specific, made on this blade"
+        block["uncertainty_draws"] = task.draws
+        return "made", None
+    stored = task.sections.get(label)
+    why = (["section not in the task file"] if stored is None else
+           plane_mismatch(stored["plane"], sr.plane) + mismatch(stored["conditions"], now))
+    if why:
+        sr.notes.append("uncertainty: the task's draws not used (%s): re-fitted afresh, "
+                        "%d draws" % ("; ".join(why), opts.draws))
+        block["uncertainty"] = (stage._uncertainty(result, idx, frame, nom, ch, fit, opts,
+                                                   noise, rng, measured_values)
+                                if opts.draws else None)
+        block["uncertainty_method"] = "re-fit"
+        block["uncertainty_draws"] = int(opts.draws)
+        return "re-fit", "; ".join(why)
+    sd = {k: (float("nan") if v is None else float(v)) for k, v in stored["sd"].items()}
+    for key, bias in maxima_bias(result, idx, frame, nom, ch, fit, opts, noise).items():
+        if key in sd:
+            sd[key] = float(np.hypot(sd[key], bias))
+    keys = stage._flat(measured_values).keys()
+    block["uncertainty"] = stage._unflat({k: sd[k] for k in keys if k in sd}, measured_values)
+    block["uncertainty_method"] = "task-specific"
+    block["uncertainty_draws"] = task.draws
+    return "task", None
+
+
+def _with_draws(opts, draws):
+    import dataclasses
+    return dataclasses.replace(opts, draws=int(draws))
+
+
+def settings_of(task, used, refit_text):
+    """The stage settings' fields of a task run: ``uncertainty_method`` and
+    ``uncertainty_task`` (per section how its u was found)."""
+    made_now = any(how == "made" for how, _ in used.values())
+    head = task.describe() if not made_now else (
+        "task-specific, made now (file %s, %d draws, seed %d)"
+        % (task.path or "in memory", task.draws, task.seed))
+    per = {label: ("task" if how == "task" else "made" if how == "made"
+                   else "re-fit: %s" % why) for label, (how, why) in used.items()}
+    text = "%s: the draws' 1 sigma of the task, form values add this blade's bias of a " \
+           "maximum; sections outside the task's conditions: %s" % (head, refit_text)
+    return {"uncertainty_method": text,
+            "uncertainty_task": {"file": task.path, "made_utc": task.made_utc,
+                                 "draws": task.draws, "seed": task.seed,
+                                 "made_from": task.made_from, "key_digest": digest(task.key),
+                                 "cad": task.key.get("cad"), "match_rule": MATCH_RULE_TEXT,
+                                 "sections": per},
+            "uncertainty_relative_accuracy_task": float(1.0 / np.sqrt(2.0 * (task.draws - 1)))}
