@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import bias_take_up
 from .errors import InputError
 from .weights import normalised_weights
 from .transforms import make_transform, rotation_from_vector, rotation_matrix_from_quaternion
@@ -201,25 +202,22 @@ def robust_weights(distances, a, options, neighbourhoods=None, bias_response=Non
 
 def _bias_response(moved, normals, beams_cad, a, max_incidence_rad=None):
     """(N,) s_i: each residual's change per unit reading bias once a weighted (``a``) rigid
-    fit has taken up what it can, beta_i - J_i (J^T W J)^-1 J^T W beta with beta_i = beam_i .
-    n_i (uncertainty.systematic_coefficients' model, at this pose; 0 where unusable). A point
-    whose beam meets its normal more obliquely than ``max_incidence_rad`` (the sensor reads
-    nothing there) has its foot on a face's edge, its normal p - c: it takes up nothing, as in
-    uncertainty.bias_take_up (one such point past the demo blade's hub end held two thirds of
-    the take-up's weakest direction there)."""
-    beta = np.einsum("ij,ij->i", beams_cad, normals)
+    fit has taken up what it can, s_i = beta_i - J_i r, r = core.bias_take_up.take_up (the
+    model of uncertainty.systematic_coefficients, at this pose; 0 where a_i = 0 or beta_i is
+    not finite, everywhere when fewer than 7 points take part). An edge foot (a beam meeting
+    its normal more obliquely than ``max_incidence_rad``) takes up nothing (take_up). The
+    weights are the a_i before the robust factor, which this very s_i goes into, and r is about
+    the a-weighted centroid of the points taking part (s does not depend on the centre)."""
+    beta = bias_take_up.beam_normal(normals, beams_cad)
     keep = (a > 0) & np.isfinite(beta)
     s = np.zeros(len(beta))
-    fit = keep if max_incidence_rad is None else \
-        keep & (np.abs(beta) >= np.cos(max_incidence_rad))
+    fit = bias_take_up.takes_part(moved, normals, beams_cad, a, max_incidence_rad)
     if np.count_nonzero(fit) < 7:
         return s
     w = a[fit]
     center = w @ moved[fit] / w.sum()
-    J_fit = _jacobian(moved[fit], normals[fit], center)
-    JW = J_fit.T * w
-    response = np.linalg.lstsq(JW @ J_fit, JW @ beta[fit], rcond=1e-12)[0]
-    s[keep] = beta[keep] - _jacobian(moved[keep], normals[keep], center) @ response
+    r = bias_take_up.take_up(moved, normals, beams_cad, a, center, max_incidence_rad)
+    s[keep] = bias_take_up.left_over(moved[keep], normals[keep], beams_cad[keep], r, center)
     return s
 
 

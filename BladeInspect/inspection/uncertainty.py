@@ -35,6 +35,7 @@ from typing import Optional
 
 import numpy as np
 
+from ..core import bias_take_up as core_take_up
 from ..core import uncertainty_model
 from ..core.errors import InputError
 from ..core.weights import SensorWeights, beam_in_table
@@ -161,48 +162,38 @@ def beam_directions(result):
 
 def systematic_coefficients(result, sensor=None):
     """(N,) change of each point's deviation per unit reading bias, after the registration has
-    taken up what a rigid motion can (module notes), or None when the beams are not known.
+    taken up what a rigid motion can (module notes): s_i = beta_i - J_i r,
+    core.bias_take_up.left_over of bias_take_up's r; None when the beams are not known.
     ``sensor``: the rig.sensor.SensorModel whose largest incidence tells a reading's normal
     from an edge's (None: the default sensor)."""
     take_up = bias_take_up(result, sensor)
     if take_up is None:
         return None
     beams, response = take_up
-    normal = np.asarray(result.normal, dtype=float)
-    arm = np.asarray(result.points_cad, dtype=float) - np.asarray(result.center)
-    J = np.hstack([normal, np.cross(arm, normal)])
-    return np.einsum("ij,ij->i", beams, normal) - J @ response
+    return core_take_up.left_over(result.points_cad, result.normal, beams, response,
+                                  result.center)
 
 
 def bias_take_up(result, sensor=None):
     """(beams (N, 3) in the CAD frame, r (6,)) of a unit reading bias: each point moves by its
     beam and the registration takes that up by the rigid motion -r ([t mm, w rad] about
     result.center), systematic_coefficients' s_i = beta_i - J_i r being its normal part; None
-    when the beams are not known."""
+    when the beams are not known. r is core.bias_take_up.take_up with the fit's final weights
+    (result.icp_weights, else the SNR, else 1) of the inliers; an edge foot, a point whose beam
+    meets its CAD normal more obliquely than the sensor reads at all, takes up nothing (there
+    the defect test's take-up in core.icp does the same; one such point past the demo blade's
+    hub end once made the span screw's take-up 3.7 where the fit's is 11.5 mm per mm of bias,
+    and the airfoil draws state a section's twist 5 times too small, bench_uncertainty_mc)."""
     beams = beam_directions(result)
     if beams is None:
         return None
-    normal = np.asarray(result.normal, dtype=float)
-    beta = np.einsum("ij,ij->i", beams, normal)
     weights = result.icp_weights if result.icp_weights is not None else result.snr
-    weights = (np.ones(len(beta)) if weights is None else
+    weights = (np.ones(len(beams)) if weights is None else
                np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
     weights = weights * np.asarray(result.inlier, dtype=bool)
-    # A point whose beam meets its CAD normal more obliquely than the sensor reads at all was
-    # not read along that normal: its foot is on a face's edge (a reading just past the CAD's
-    # end, the normal then p - c), whose distance does not follow J under a motion of tens of
-    # um. It takes up nothing here. One such point past the demo blade's hub end, its weight
-    # at core.weights' grazing floor (41 against a median of 0.6), held two thirds of the
-    # weakest direction's information (the span screw) and made the take-up along it 3.7
-    # where the fit's is 11.5 mm per mm of bias: the airfoil draws then stated a section's
-    # twist 5 times too small and its chord 2.5 times too large (bench_uncertainty_mc).
     max_incidence = (sensor or SensorModel()).max_incidence_rad
-    weights = weights * (np.abs(beta) >= np.cos(max_incidence))
-    arm = np.asarray(result.points_cad, dtype=float) - np.asarray(result.center)
-    J = np.hstack([normal, np.cross(arm, normal)])
-    JW = J.T * weights
-    # lstsq: a pose direction the points do not measure takes up nothing of the bias
-    return beams, np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0]
+    return beams, core_take_up.take_up(result.points_cad, result.normal, beams, weights,
+                                       result.center, max_incidence)
 
 
 def expanded_uncertainty(result, index, model=None):
