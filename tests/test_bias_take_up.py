@@ -133,12 +133,14 @@ class TestCallers(unittest.TestCase):
         fit = np.arange(2, len(self.pts))
         c = self.w[fit] @ self.pts[fit] / self.w[fit].sum()
         _, s_ref = independent(self.pts[fit], self.normals[fit], self.beams[fit], self.w[fit], c)
-        np.testing.assert_allclose(s[fit], s_ref, rtol=0, atol=1e-9)
+        # 1e-7: the iterative reference's own convergence on another BLAS (FreeCAD 1.0's
+        # numpy 2.2 gave 1.9e-9); a wrong take-up is off by 1e-2 and more
+        np.testing.assert_allclose(s[fit], s_ref, rtol=0, atol=1e-7)
         self.assertEqual(s[1], 0.0)                        # no weight: nothing stated
         r, _ = independent(self.pts[fit], self.normals[fit], self.beams[fit], self.w[fit], c)
         beta0 = self.beams[0] @ self.normals[0]
         j0 = np.r_[self.normals[0], np.cross(self.pts[0] - c, self.normals[0])]
-        self.assertAlmostEqual(s[0], beta0 - j0 @ r, places=9)   # the edge foot's own s
+        self.assertAlmostEqual(s[0], beta0 - j0 @ r, delta=1e-7)   # the edge foot's own s
 
     def test_uncertainty(self):
         from BladeInspect.inspection import uncertainty as U
