@@ -461,18 +461,29 @@ def _measure_at(xyz, normals, frame, nom, opts):
     return ch, fit, cont, ordered, noise
 
 
+def sensor_of(opts):
+    """The sensor the uncertainty's draws model (the default one, at ``opts.accuracy_mm``)."""
+    return (SensorModel() if opts.accuracy_mm is None
+            else SensorModel(accuracy=float(opts.accuracy_mm)))
+
+
+def on_smooth_fit(result, idx, frame, ch):
+    """(points in the plane frame, their feet on the measured profile's smooth fit, the feet's
+    outward normals in the CAD frame) of a section's points ``idx``."""
+    n0 = result.normal[idx]
+    pts = frame.to_2d(_into_plane(result.points_cad[idx], n0, frame.origin, frame.normal))
+    u, smooth = ch.profile.closest(pts)
+    return pts, smooth, frame.vector_to_3d(ch.profile.outward_normal(u))
+
+
 def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values,
                  draws_sd=None):
     """1 sigma of each measured characteristic by re-fitting perturbed points (module notes);
     ``draws_sd``, a dict, is given the draws' own 1 sigma before the maxima's bias."""
-    xyz0 = result.points_cad[idx]
     n0 = result.normal[idx]
     # The measured profile's smooth fit at each point: the draws' noise-free points.
-    prof = ch.profile
-    pts = frame.to_2d(_into_plane(xyz0, n0, frame.origin, frame.normal))
-    u, smooth = prof.closest(pts)
+    pts, smooth, out_normal = on_smooth_fit(result, idx, frame, ch)
     smooth3 = frame.to_3d(smooth)
-    out_normal = frame.vector_to_3d(prof.outward_normal(u))
     cov = np.asarray(result.pose_covariance, dtype=float)
     cov = np.where(np.isfinite(cov), cov, 0.0)
     try:
@@ -490,8 +501,7 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     # blade's loop); with the noise, bench_uncertainty_mc (16 trials) found section 2's chord
     # 0.77 and section 1's LE thickness at 2 mm 1.26 of the chain's scatter against 0.58 and
     # 1.67 along the normal (a stated u of 2 x 12 draws is itself ~15 % uncertain).
-    sensor = (SensorModel() if opts.accuracy_mm is None
-              else SensorModel(accuracy=float(opts.accuracy_mm)))
+    sensor = sensor_of(opts)
     accuracy = sensor.accuracy
     take_up = uncertainty_mod.bias_take_up(result, sensor)
     if take_up is None:

@@ -67,7 +67,6 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.errors import InputError
-from ..rig.sensor import SensorModel
 from . import uncertainty as uncertainty_mod
 
 # Raise whenever the re-fit draws' model (inspection.airfoil._uncertainty,
@@ -93,12 +92,6 @@ MATCH_RULE_TEXT = ("a section reuses the task's draws when its plane is within %
                                          100 * MATCH_RULE["pose_translation_mm"]))
 
 
-def _sensor(opts):
-    """The sensor the draws use (as inspection.airfoil._uncertainty takes it)."""
-    return (SensorModel() if opts.accuracy_mm is None
-            else SensorModel(accuracy=float(opts.accuracy_mm)))
-
-
 def cad_fingerprint(nominal):
     """sha256 of the nominal's dense samples, rounded (module notes)."""
     xyz = np.round(np.asarray(nominal.samples.xyz, dtype=float), 4) + 0.0   # no -0.0
@@ -120,13 +113,14 @@ def _fit_of(result):
 
 def task_key(nominal, opts, result):
     """The task's key (module notes): a JSON-able dict."""
+    from . import airfoil as stage
     return {"version": TASK_MODEL_VERSION,
             "cad": cad_fingerprint(nominal),
             "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
             "chord_method": opts.chord_method,
             "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
             "le_rule": opts.le_rule,
-            "sensor": json.loads(json.dumps(asdict(_sensor(opts)))),
+            "sensor": json.loads(json.dumps(asdict(stage.sensor_of(opts)))),
             "fit": _fit_of(result),
             "readings": {"snr": result.snr is not None,
                          "beams": uncertainty_mod.beam_directions(result) is not None}}
@@ -296,13 +290,8 @@ def maxima_bias(result, idx, frame, nom, ch, fit, opts, noise):
     gives _maxima_bias (kept in step with it: tests/test_airfoil_task_u.py checks that the
     task's u of the blade that made it is that blade's re-fit u)."""
     from . import airfoil as stage
-    xyz0 = result.points_cad[idx]
-    n0 = result.normal[idx]
-    prof = ch.profile
-    pts = frame.to_2d(stage._into_plane(xyz0, n0, frame.origin, frame.normal))
-    u, _ = prof.closest(pts)
-    out_normal = frame.vector_to_3d(prof.outward_normal(u))
-    sensor = _sensor(opts)
+    pts, _, out_normal = stage.on_smooth_fit(result, idx, frame, ch)
+    sensor = stage.sensor_of(opts)
     sigma = stage._point_noise_model(result, idx, sensor, noise, out_normal)[0]
     return stage._maxima_bias(result, idx, pts, nom, fit, sigma, sensor)
 
