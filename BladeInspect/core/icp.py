@@ -279,10 +279,6 @@ def _extreme_motion(points, center, dt, dw):
     return float(np.linalg.norm(dt + np.cross(dw, v), axis=1).max())
 
 
-def _jacobian(points_cad, normals, center):
-    return np.hstack([normals, np.cross(points_cad - center, normals)])
-
-
 def pose_information(points_cad, normals, weights, residuals, center):
     """(H, s^2, n_w): the pose's Fisher information H = sum w_i J_i^T J_i,
     J_i = [n_i, (p_i - c) x n_i], the unit-weight residual variance
@@ -294,7 +290,7 @@ def pose_information(points_cad, normals, weights, residuals, center):
     n_w = int(np.count_nonzero(keep))
     if n_w <= 6:
         return None, np.inf, n_w
-    J = _jacobian(np.asarray(points_cad)[keep], np.asarray(normals)[keep], center)
+    J = bias_take_up.rigid_jacobian(np.asarray(points_cad)[keep], np.asarray(normals)[keep], center)
     H = (J * w[keep, None]).T @ J
     return H, float(np.sum(w[keep] * r[keep] ** 2)) / (n_w - 6), n_w
 
@@ -395,7 +391,7 @@ def _gauss_newton_step(points_cad, normals, distances, w, center):
     """Small motion (dt, dw) about `center` minimising sum w (d + J [dt, dw])^2; the
     least-squares solver leaves directions the surface does not fix (rank deficiency) alone."""
     keep = w > 0
-    J = _jacobian(points_cad[keep], normals[keep], center)
+    J = bias_take_up.rigid_jacobian(points_cad[keep], normals[keep], center)
     sw = np.sqrt(w[keep])
     x = np.linalg.lstsq(J * sw[:, None], -distances[keep] * sw, rcond=1e-12)[0]
     return x[:3], x[3:]
@@ -483,7 +479,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         # The residuals at the returned pose to first order in the last small step, which
         # saves a closest-point evaluation of the whole cloud.
         moved_before, normals, distances, center, dt, dw = last_step
-        distances = distances + _jacobian(moved_before, normals, center) @ np.r_[dt, dw]
+        distances = distances + bias_take_up.rigid_jacobian(moved_before, normals, center) @ np.r_[dt, dw]
         moved = points @ T[:3, :3].T + T[:3, 3]
         # The foot point that goes with that distance: the point less it along the normal
         # (the foot moved along the tangent plane), where the true one is within curvature x
