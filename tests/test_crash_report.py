@@ -51,9 +51,9 @@ class CrashIsNeverSilent(unittest.TestCase):
                     killed = cli_process(wrapper.pid)
                     self.assertIsNotNone(killed, "no Python child under the wrapper")
                     os.kill(killed, sig)
-                    # After a SIGSEGV the child has been seen to hang in a futex once its
-                    # faulthandler stack was written (FreeCAD's handler; 2026-12-03): a
-                    # watchdog ends it, so a hang is reported as a KILL, never a stuck suite.
+                    # A child that hangs after its SIGSEGV is the wrapper's to end (10 s,
+                    # AHungCrashIsEnded); this timer only keeps a broken wrapper from hanging
+                    # the suite: the test then fails on the wrapper's "killed by signal KILL".
                     self.forced = threading.Timer(60.0, _kill_if_alive, (killed,))
                     self.forced.start()
             rc = wrapper.wait(timeout=120)
@@ -120,9 +120,69 @@ class CrashIsNeverSilent(unittest.TestCase):
         # FreeCAD's own handler turns SIGSEGV into a bare exit status; either way the wrapper
         # reports it, and the log holds the Python stack written by faulthandler.
         log = self._check(signal.SIGSEGV, r"(was killed by signal SEGV|ended with exit status "
-                                          r"\d+ without finishing|was killed by signal KILL)")
+                                          r"\d+ without finishing|hung after its fatal error and was ended by the "
+                                          r"wrapper 10 s later)")
         with open(log) as fh:
             self.assertIn("Fatal Python error", fh.read())
+
+
+class AHungCrashIsEnded(unittest.TestCase):
+    """FreeCAD's SIGSEGV handler has been seen to hang in a futex after faulthandler wrote the
+    Python stack; the wrapper must end such a child rather than hang with it. The hang is made
+    here by stopping the child (SIGSTOP: alive, doing nothing) and writing the line faulthandler
+    writes into the wrapper's log, as the real crash does."""
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="bladeinspect-hung-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+
+    def test_a_child_alive_after_its_logged_crash_is_killed_and_reported(self):
+        out = os.path.join(self.tmp, "out")
+        wrapper = subprocess.Popen(
+            [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
+            cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+            env=dict(os.environ, TMPDIR=self.tmp))
+        child = None
+        stopped_at = None
+        lines = []
+        try:
+            for line in wrapper.stderr:
+                lines.append(line)
+                if child is None and re.match(r"\[\s*\d+%\]", line):
+                    child = cli_process(wrapper.pid)
+                    self.assertIsNotNone(child, "no Python child under the wrapper")
+                    os.kill(child, signal.SIGSTOP)
+                    logs = [n for n in os.listdir(self.tmp)
+                            if n.startswith("bladeinspect-") and n.endswith(".log")]
+                    self.assertEqual(len(logs), 1, logs)
+                    with open(os.path.join(self.tmp, logs[0]), "a") as fh:
+                        fh.write("Fatal Python error: Segmentation fault\n")
+                    stopped_at = time.monotonic()
+                    # Without the wrapper's watchdog the stopped child would hold stderr open
+                    # for ever: this ends it so that the test fails instead of hanging.
+                    backstop = threading.Timer(45.0, _kill_if_alive, (child,))
+                    backstop.start()
+                    self.addCleanup(backstop.cancel)
+            rc = wrapper.wait(timeout=60)
+            waited = time.monotonic() - (stopped_at or 0.0)
+        finally:
+            if child is not None:
+                _kill_if_alive(child)
+            if wrapper.poll() is None:
+                wrapper.kill()
+        self.assertIsNotNone(child, "the run printed no progress: %s" % "".join(lines))
+        self.assertFalse(_alive(child), "the hung child outlived its wrapper")
+        self.assertNotEqual(rc, 0)
+        # The grace is 10 s (the wrapper's crash_grace_s), polled each second.
+        self.assertGreaterEqual(waited, 9.0)
+        self.assertLess(waited, 40.0)
+        self.assertRegex(lines[-1].rstrip("\n"),
+                         r"^bladeinspect: crashed: 'simulate' hung after its fatal error and was"
+                         r" ended by the wrapper 10 s later \(FreeCAD [^)]*\); no result in .*;"
+                         r" log: \S+$")
+        self.assertFalse(os.path.exists(os.path.join(out, "result.json")))
+        beside = [n for n in os.listdir(self.tmp) if n.startswith(".bladeinspect-")]
+        self.assertEqual(beside, [], "a private output folder was left beside --out")
 
 
 class HelpAndUsageAreNoCrash(unittest.TestCase):
