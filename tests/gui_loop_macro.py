@@ -166,12 +166,15 @@ def run():
                 window_shot("loop_planned_paths_window")
                 blade.ViewObject.Transparency = 0
         loop_commands.PLAN_LISTENERS.append(on_plan)
-        t0 = time.time()
+        # CPU seconds, not wall: the loop runs in this process, and a suite sharing two cores
+        # with another once made an unchanged 70 s run take 119 s of wall time.
+        t0, cpu0 = time.time(), time.process_time()
         try:
             panel.accept()
         finally:
             loop_commands.PLAN_LISTENERS.remove(on_plan)
-        state["inspect_s"] = time.time() - t0
+        state["inspect_cpu_s"] = time.process_time() - cpu0
+        state["inspect_wall_s"] = time.time() - t0
         settle()
         check("plan drawn before the planned scan", len(seen) >= 1 and
               "Inspection" not in seen[0]["names"], [s["names"] for s in seen])
@@ -408,8 +411,9 @@ def run():
               np.linalg.norm(off) < 0.002 and angle < 0.001,
               "%.3f um, %.5f deg" % (1e3 * np.linalg.norm(off), angle))
 
-    check("inspect took under 90 s in the GUI", state.get("inspect_s", 1e9) < 90,
-          state.get("inspect_s"))
+    check("inspect took under 90 CPU-s in the GUI", state.get("inspect_cpu_s", 1e9) < 90,
+          "%.1f CPU-s (%.1f s wall)" % (state.get("inspect_cpu_s", -1),
+                                        state.get("inspect_wall_s", -1)))
 
 
 run_scenario(run)
