@@ -20,8 +20,9 @@ A symbolic link at ``path`` is written through (the file it points to is replace
 Temporary files are named ``.<name>.<pid>.<random>.tmp`` beside the target ``<name>``. After a
 SIGKILL or a power cut in the middle of a write one may be left behind (nothing can remove it
 then); the target itself is intact. ``stray_temps(path)`` lists those of a target, by default
-only those whose writing process is no longer alive on this host, so that a caller that knows
-no other writer is at work (e.g. under its own lock) can delete them. Nothing removes them
+only those whose writing process is no longer alive on this host (on Windows, where that
+cannot be asked safely, none), so that a caller that knows no other writer is at work (e.g.
+under its own lock) can delete them. Nothing removes them
 automatically: a folder shared between hosts may hold the temporary file of a live writer
 elsewhere, with a process id that means nothing here.
 
@@ -154,7 +155,7 @@ def atomic_copy(source, target):
 
 
 def _alive(pid):
-    if pid == os.getpid():
+    if pid == os.getpid() or os.name == "nt":   # on Windows os.kill(pid, 0) would kill it
         return True
     try:
         os.kill(pid, 0)
