@@ -32,6 +32,7 @@ from ..core import contracts
 from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core import uncertainty_model
+from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 from . import uncertainty as uncertainty_mod
@@ -1046,12 +1047,10 @@ def write_lot_csv(out_dir, files):
     if not rows:
         return None
     target = os.path.join(out_dir, LOT_CSV)
-    tmp = target + ".tmp"
-    with open(tmp, "w", newline="") as fh:
+    with atomic_write(target, newline="") as fh:
         w = csv.writer(fh)
         w.writerow(("file",) + CSV_HEADER)
         for row in rows:
             w.writerow(["" if v is None else ("%.9g" % v if isinstance(v, float) else v)
                         for v in row])
-    os.replace(tmp, target)
     return target

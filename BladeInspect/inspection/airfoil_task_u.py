@@ -61,11 +61,11 @@ import datetime
 import hashlib
 import json
 import os
-import tempfile
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 from . import uncertainty as uncertainty_mod
 
@@ -205,19 +205,8 @@ class TaskUncertainty:
         """Written atomically: a temporary file beside the target, then os.replace."""
         path = path or self.path
         self.made_utc = self.made_utc or _now()
-        folder = os.path.dirname(os.path.abspath(path))
-        fd, tmp = tempfile.mkstemp(prefix=".%s." % os.path.basename(path), suffix=".tmp",
-                                   dir=folder)
-        try:
-            with os.fdopen(fd, "w") as fh:
-                json.dump(self.to_json(), fh, indent=1, allow_nan=False)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        with atomic_write(path) as fh:
+            json.dump(self.to_json(), fh, indent=1, allow_nan=False)
         self.path, self.made = path, True
         return path
 

@@ -22,6 +22,7 @@ import sys
 import threading
 import time
 
+from ..core.atomic_file import atomic_write
 from ..core.contracts import BUILTIN_CADS, PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
 from . import airfoil as airfoil_mod
@@ -140,13 +141,11 @@ def write_summary(path, rows):
     section_cols = sorted({k for r in rows for k in r if k.startswith("section_")},
                           key=_section_col_key)
     fields = SUMMARY_FIELDS + section_cols + ["error"]
-    tmp = path + ".tmp"
-    with open(tmp, "w", newline="") as fh:
+    with atomic_write(path, newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
         for r in rows:
             writer.writerow({k: _csv_value(r.get(k)) for k in fields})
-    os.replace(tmp, path)
 
 
 def _section_col_key(col):

@@ -12,6 +12,7 @@ import shutil
 import numpy as np
 
 from ..core import contracts
+from ..core.atomic_file import atomic_copy
 from ..core.errors import InputError
 from ..core.pointio import PointSet, read_points
 from ..measurement.journal import JOURNAL_FILE, JournaledRig
@@ -82,7 +83,7 @@ class Checkpoint:
                 # scan.json last and whole: it is what makes the folder a checkpoint.
                 for name in CHECKPOINT_FILES:
                     if os.path.exists(os.path.join(copy_from, name)):
-                        _durable_copy(os.path.join(copy_from, name), self.path(name))
+                        atomic_copy(os.path.join(copy_from, name), self.path(name))
         self.rig = JournaledRig(rig, self.path(JOURNAL_FILE), keep=self.in_place)
         self._session_start = float(self.rig.elapsed_s)
 
@@ -194,15 +195,6 @@ def _live_checkpoint(record_path):
         return _saved_checkpoint(record_path)
     except InputError:
         return None
-
-
-def _durable_copy(source, target):
-    """Copy ``source`` to ``target`` all at once and on disk (a temporary file replaced)."""
-    tmp = target + ".part"
-    shutil.copyfile(source, tmp)
-    with open(tmp, "rb+") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, target)
 
 
 def _saved_checkpoint(record_path):

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..core import fitting
 from ..core import transforms as tf
+from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 from ..rig.kinematics import RigKinematics
 from ..rig.serial_rig import SerialRig
@@ -259,23 +260,12 @@ def _with_axis(kinematics, point, direction):
 
 def _write_atomically(path, kinematics, extra=None):
     import os
-    import tempfile
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise InputError("--out %s: folder %s does not exist" % (path, folder))
-    fd, tmp = tempfile.mkstemp(prefix=".rig-", suffix=".json", dir=folder)
-    os.close(fd)
-    try:
-        if extra:
-            with open(tmp, "w") as fh:
-                json.dump(dict(kinematics.to_dict(), **extra), fh, indent=2)
-                fh.write("\n")
-        else:
-            kinematics.to_json(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    with atomic_write(path) as fh:     # the bytes of RigKinematics.to_json, plus ``extra``
+        json.dump(dict(kinematics.to_dict(), **(extra or {})), fh, indent=2)
+        fh.write("\n")
 
 
 def sphere_residual(rig, kinematics, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES,

@@ -16,11 +16,11 @@ simulated rig reads exactly what it would have.
 
 import json
 import os
-import tempfile
 
 import numpy as np
 
 from .. import __version__
+from ..core.atomic_file import atomic_write
 from ..core.contracts import json_ready
 from ..core.errors import DeviceError, InputError
 from ..rig.kinematics import RigKinematics
@@ -225,18 +225,9 @@ def _load_record(path):
 def write_record(path, record):
     """Replace the JSON file ``path`` by ``record`` atomically (temporary file, fsync,
     os.replace): a reader, or a resume after a crash, sees the old record or the new one."""
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".scan-", suffix=".json", dir=folder)
-    try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(record, f, indent=1)
-            f.write("\n")
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    with atomic_write(path) as f:
+        json.dump(record, f, indent=1)
+        f.write("\n")
 
 
 def _truncate_points(path, size):
