@@ -80,6 +80,7 @@ _DENSE_SPACING_MM = 0.02
 _FOOT_TABLE_MM, _FOOT_TABLE_MAX, _FOOT_NEWTON = 1e-3, 400000, 3
 _FREE_SHARE = 0.75            # of the spline's free coefficients taken off its budget
 _DENSE_MIN, _DENSE_MAX = 2000, 8000
+_GATHER_SPLIT = 64            # Profile._pieces: from this many parameters, one gather a power
 
 
 # ---------------------------------------------------------------- the profile curve
@@ -118,6 +119,10 @@ class Profile:
         keep &= np.diff(pieces[0].x) > 0
         self._breaks = pieces[0].x[:-1][keep]
         self._coef = np.stack([pp.c[:, keep] for pp in pieces], axis=-1).transpose(1, 0, 2)
+        # the same coefficients one contiguous (pieces, 2) array per power: a gather of many
+        # parameters' pieces from these and the Horner steps on contiguous rows run ~1.5x
+        # faster than on the strided slices of one (n, 4, 2) gather (the same arithmetic)
+        self._c4 = tuple(np.ascontiguousarray(self._coef[:, k]) for k in range(4))
         n_dense = int(np.clip(self.length / _DENSE_SPACING_MM, _DENSE_MIN, _DENSE_MAX))
         self.dense_u = np.linspace(0.0, self.length, n_dense, endpoint=False)
         self.dense = self.eval(self.dense_u)
@@ -127,24 +132,30 @@ class Profile:
     def eval(self, u, der=0):
         # Only the asked derivative: most calls want points alone (the same arithmetic as
         # eval3's, so the values are eval3's to the bit).
-        t, c = self._pieces(u)
+        t, (c0, c1, c2, c3) = self._pieces(u)
         if der == 0:
-            return ((c[:, 0] * t + c[:, 1]) * t + c[:, 2]) * t + c[:, 3]
+            return ((c0 * t + c1) * t + c2) * t + c3
         if der == 1:
-            return (3.0 * c[:, 0] * t + 2.0 * c[:, 1]) * t + c[:, 2]
+            return (3.0 * c0 * t + 2.0 * c1) * t + c2
         return self.eval3(u)[der]
 
     def _pieces(self, u):
-        """Each parameter's offset into its spline piece and that piece's coefficients."""
+        """Each parameter's offset into its spline piece and that piece's coefficients (a
+        sequence of the four powers' (n, 2) arrays, highest first)."""
         u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
         i = np.searchsorted(self._breaks, u, side="right") - 1
         i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
-        return (u - self._breaks[i])[:, None], self._coef[i]
+        t = (u - self._breaks[i])[:, None]
+        if len(i) < _GATHER_SPLIT:
+            c = self._coef[i]          # few parameters: one gather costs less than four
+            return t, (c[:, 0], c[:, 1], c[:, 2], c[:, 3])
+        c0, c1, c2, c3 = self._c4
+        return t, (c0.take(i, axis=0), c1.take(i, axis=0), c2.take(i, axis=0),
+                   c3.take(i, axis=0))
 
     def eval3(self, u):
         """Points, first and second derivatives at parameters u (piecewise-cubic Horner)."""
-        t, c = self._pieces(u)
-        c0, c1, c2, c3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
+        t, (c0, c1, c2, c3) = self._pieces(u)
         p = ((c0 * t + c1) * t + c2) * t + c3
         d1 = (3.0 * c0 * t + 2.0 * c1) * t + c2
         d2 = 6.0 * c0 * t + 2.0 * c1
