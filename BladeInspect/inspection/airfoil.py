@@ -556,10 +556,12 @@ def _maxima_bias(result, idx, pts, nom, fit, sigma, sensor):
                                     - turn @ fit.shift_mm, nom.profile)[0]
     # the ends of the after-fit range as maxima of readings clear of zero
     span = float(after.max() - after.min()) + 1.0
-    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model)
-    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model)
+    # only the biases are used: the terms' extra rounds are not run (the same biases)
+    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model, bias_only=True)
+    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model,
+                                              bias_only=True)
     _, bottom, _ = uncertainty_mod.maximum_error(after.max() + span - after, sigma, flipped,
-                                                 model)
+                                                 model, bias_only=True)
     return {"form_location_mm": 2.0 * location, "form_mm": top + bottom}
 
 
