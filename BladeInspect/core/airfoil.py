@@ -200,14 +200,25 @@ class Profile:
 
     def _closest(self, xy, u0, lo, hi):
         u = self.nearest_param(xy) if u0 is None else np.array(u0, dtype=float)
+        # Each point stops once its own step is below 1e-13 of the length (that step taken).
+        tol = 1e-13 * self.length
+        run = np.arange(len(u))
+        ur, xr = u, xy
+        if lo is not None:
+            lo = np.broadcast_to(lo, u.shape)
+            hi = np.broadcast_to(hi, u.shape)
+            lr, hr = lo, hi
         for _ in range(_NEWTON_ITERATIONS):
-            new = self._newton_stationary(u, xy)
+            new = self._newton_stationary(ur, xr)
             if lo is not None:
-                new = np.minimum(np.maximum(new, lo), hi)
-            done = np.max(np.abs(new - u), initial=0.0) < 1e-13 * self.length
-            u = new
-            if done:
+                new = np.minimum(np.maximum(new, lr), hr)
+            going = np.abs(new - ur) >= tol
+            u[run] = new
+            if not going.any():
                 break
+            run, ur, xr = run[going], new[going], xr[going]
+            if lo is not None:
+                lr, hr = lr[going], hr[going]
         return u, self.eval(u)
 
     def _newton_stationary(self, u, xy):
@@ -360,17 +371,24 @@ def _refine_centres(profile, a, b, centre):
     are global nearest points at the start and the end, Newton-tracked in between."""
     c = centre.copy()
     ua, ub = None, None
+    # Each centre stops once its own |d_a - d_b| < 1e-11 mm (its last step taken): a settled
+    # centre's further steps are below that, and the run's cost is the unsettled ones'.
+    run = np.arange(len(c))
     for _ in range(30):
-        ua, ub, fa, fb = _feet(profile, a, b, c, ua, ub)
-        va, vb = c - fa, c - fb
+        ua, ub, fa, fb = _feet(profile, a, b, c[run], ua, ub)
+        cr = c[run]
+        va, vb = cr - fa, cr - fb
         da, db = _norms(va), _norms(vb)
         g = va / da[:, None] - vb / db[:, None]
         g2 = np.einsum("ij,ij->i", g, g)
         f = da - db
         ok = g2 > 1e-12
-        c[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
-        if np.all(np.abs(f) < 1e-11):
+        cr[ok] -= (f[ok] / g2[ok])[:, None] * g[ok]
+        c[run] = cr
+        going = np.abs(f) >= 1e-11
+        if not going.any():
             break
+        run, ua, ub = run[going], ua[going], ub[going]
     ua, ub, fa, fb = _feet(profile, a, b, c)
     return c, ua, ub, fa, fb
 
