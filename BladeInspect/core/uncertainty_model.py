@@ -66,7 +66,7 @@ class SharedTerm:
 
 def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
               competing_sigmas=COMPETING_SIGMAS, draws=DRAWS, seed=0, equal_sigma_max=None,
-              noise_bound_sigmas=FOLD_SIGMAS):
+              noise_bound_sigmas=FOLD_SIGMAS, bias_only=False):
     """The error of the reported max |deviation| as an estimate of the true largest
     |deviation| (module notes): (terms {name: mm}, bias, number of competing readings), the
     bias that of the noise and the sampled shared terms together.
@@ -79,7 +79,10 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
     ``equal_sigma_max``: n -> (mean, sd) of the largest of n unit-variance draws in closed
     form, used instead of sampling the noise when the competitors share one sigma and their
     level lies clear of zero (beyond ``noise_bound_sigmas``, the largest a reading's noise can
-    be in sigmas, where |level + noise| is level + noise)."""
+    be in sigmas, where |level + noise| is level + noise).
+    ``bias_only``: the bias alone is wanted (terms returned empty): of the sampled rounds only
+    the last, noise and every varying term together, is run -- the bias is that round's; the
+    draws are the same, so the bias is the full call's to the bit."""
     dev = np.asarray(deviation, dtype=float).reshape(-1)
     sigma = np.asarray(sigma, dtype=float).reshape(-1)
     rng = np.random.default_rng(seed)
@@ -114,7 +117,7 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
         noise = unit_noise(rng, (draws, n)) * common
         pushes = [t.moves(t.sample(rng, draws), mask) for t in varying]
         total = 0.0
-        for k in range(len(varying) + 1):
+        for k in range(len(varying) if bias_only else 0, len(varying) + 1):
             moved = noise + sum(pushes[:k]) if k else noise
             level = reported
             for _ in range(_FIXED_POINT_ROUNDS + 1):
@@ -123,7 +126,10 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
                     level = max(reported - float(error.mean()), 0.0)
             rms = float(np.sqrt(np.mean(error ** 2)))
             name = "noise_mm" if k == 0 else varying[k - 1].name
-            terms[name] = float(np.sqrt(max(rms ** 2 - total ** 2, 0.0)))
+            if not bias_only:
+                terms[name] = float(np.sqrt(max(rms ** 2 - total ** 2, 0.0)))
             total = rms
             bias = float(error.mean())
+    if bias_only:
+        terms = {}
     return terms, bias, n

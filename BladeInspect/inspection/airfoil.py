@@ -375,6 +375,48 @@ class SectionResult:
     task_u: tuple = None             # (how, why) under a task uncertainty (airfoil_task_u)
 
 
+# The nominal's characteristics of a cut, remembered by the cut's points and the arguments
+# (NOMINAL_CACHE_SIZE cuts): a process that measures blade after blade of one CAD (a batch
+# worker keeps its nominal, the workbench re-runs a section) cuts the same profiles and need
+# not read them again -- the kernel is deterministic, so the same points and arguments give
+# the same characteristics. A one-blade run (report, inspect) gains nothing from it.
+NOMINAL_CACHE_SIZE = 16
+_NOMINAL_CACHE = {}
+
+
+def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstream):
+    """kernel.characteristics of a nominal cut (engine axis +x of its frame), remembered
+    (above); each call has its own Characteristics (its own warnings list), the numbers and
+    the profile shared."""
+    import hashlib
+    xy = np.ascontiguousarray(xy, dtype=float)
+    h = hashlib.sha256(xy.tobytes())
+    h.update(repr((xy.shape, chord_method, [float(v) for v in edge_offsets_mm],
+                   None if le_hint is None else np.asarray(le_hint, float).tolist(),
+                   None if le_upstream is None else np.asarray(le_upstream, float).tolist()))
+             .encode())
+    key = h.hexdigest()
+    ch = _NOMINAL_CACHE.pop(key, None)
+    if ch is None:
+        ch = kernel.characteristics(xy, engine_axis=(1.0, 0.0), chord_method=chord_method,
+                                    edge_offsets_mm=edge_offsets_mm, le_hint=le_hint,
+                                    le_upstream=le_upstream)
+    _NOMINAL_CACHE[key] = ch            # the most recent last
+    while len(_NOMINAL_CACHE) > NOMINAL_CACHE_SIZE:
+        del _NOMINAL_CACHE[next(iter(_NOMINAL_CACHE))]
+    return dataclasses.replace(ch, warnings=list(ch.warnings),
+                               edge_offsets_mm=list(ch.edge_offsets_mm),
+                               thickness_stations_pct=list(ch.thickness_stations_pct),
+                               thickness_mm=list(ch.thickness_mm),
+                               le_thickness_mm=list(ch.le_thickness_mm),
+                               te_thickness_mm=list(ch.te_thickness_mm))
+
+
+def clear_nominal_cache():
+    """Forget the remembered nominal cuts (a benchmark of a one-blade run)."""
+    _NOMINAL_CACHE.clear()
+
+
 def _section(nominal, plane, opts, result, rng, counted=None, task=None):
     from ..cad.airfoil_sections import airfoil_section
     try:
@@ -382,10 +424,8 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
                                     polylines=plane.cut_polylines)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
         upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
-        nom = kernel.characteristics(xy, engine_axis=(1.0, 0.0),
-                                     chord_method=opts.chord_method,
-                                     edge_offsets_mm=opts.edge_offsets_mm, le_hint=hint,
-                                     le_upstream=upstream)
+        nom = nominal_characteristics(xy, opts.chord_method, opts.edge_offsets_mm, hint,
+                                      upstream)
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
@@ -557,10 +597,12 @@ def _maxima_bias(result, idx, pts, nom, fit, sigma, sensor):
                                     - turn @ fit.shift_mm, nom.profile)[0]
     # the ends of the after-fit range as maxima of readings clear of zero
     span = float(after.max() - after.min()) + 1.0
-    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model)
-    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model)
+    # only the biases are used: the terms' extra rounds are not run (the same biases)
+    _, location, _ = uncertainty_mod.maximum_error(before, sigma, shared, model, bias_only=True)
+    _, top, _ = uncertainty_mod.maximum_error(after - after.min() + span, sigma, shared, model,
+                                              bias_only=True)
     _, bottom, _ = uncertainty_mod.maximum_error(after.max() + span - after, sigma, flipped,
-                                                 model)
+                                                 model, bias_only=True)
     return {"form_location_mm": 2.0 * location, "form_mm": top + bottom}
 
 

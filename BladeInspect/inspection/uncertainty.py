@@ -276,15 +276,16 @@ def worst_terms(result, candidates, model=None):
     return worst, terms, n
 
 
-def maximum_error(values, noise, shared, model):
-    """core.uncertainty_model.max_error of these readings in the model's sensor noise."""
+def maximum_error(values, noise, shared, model, bias_only=False):
+    """core.uncertainty_model.max_error of these readings in the model's sensor noise
+    (``bias_only``: its bias alone, the terms not worked out)."""
     from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
     bound = (np.sqrt(3.0) if model.sensor.noise == "uniform"
              else NORMAL_CLIP_SIGMAS / _clipped_normal_std(NORMAL_CLIP_SIGMAS))
     return uncertainty_model.max_error(
         values, noise, unit_noise(model.sensor), shared,
         equal_sigma_max=lambda k: max_of_draws(k, model.sensor.noise),
-        noise_bound_sigmas=bound)
+        noise_bound_sigmas=bound, bias_only=bias_only)
 
 
 def shared_terms(result, index, model):
