@@ -729,44 +729,48 @@ def _thickness_normal(profile, mcl, s):
     return out
 
 
-# The max-thickness position (docs/airfoil.md, "Thickness"): the vertex of a least-squares
-# quartic in arc length of the exact inscribed radii over +-_MAX_POS_WINDOW of the nose-tail
-# chord about the vertex itself, biweight-weighted, _MAX_POS_SAMPLES circles a round.
+# The max-thickness position (docs/airfoil.md, "Thickness"): the vertex of a weighted
+# least-squares quartic of the exact inscribed radii against their centres' projection on the
+# nose-tail chord, over +-_MAX_POS_WINDOW of the chord about the vertex itself (biweight),
+# _MAX_POS_SAMPLES circles a round.
 _MAX_POS_WINDOW = 0.05
-_MAX_POS_SAMPLES = 41
+_MAX_POS_SAMPLES = 61
 _MAX_POS_ROUNDS = 20
 
 
-def _max_thickness_centre(profile, a, b, mcl, s0, window):
-    """The centre of the inscribed circle at the maximum of the radius's local quartic: a
-    fixed point of "fit the quartic over +-window about s, move s to its vertex" from s0 (the
-    largest circle's arc length along ``mcl``). The weights fall smoothly to zero at the
-    window's ends and the stations move with s, so the vertex is a continuous function of the
-    points -- the largest circle's own position jumps between the flat maximum's local maxima
-    (and with every change of a smoothing spline's knots, which tilt them)."""
-    x = np.linspace(-1.0, 1.0, _MAX_POS_SAMPLES)
-    sw = (1.0 - x * x)            # the square root of the biweight (1 - x^2)^2
-    s = float(s0)
+def _max_thickness_position(profile, a, b, mcl, s0, window, le, chord_dir):
+    """The max-thickness position along the chord (mm from ``le``) and the inscribed circle's
+    centre there: a fixed point of "fit the radius's quartic over +-window about x, move x to
+    its vertex", from the largest circle (arc length s0 along ``mcl``). The abscissae are the
+    refined centres' own projections and the weights fall smoothly to zero at the window's
+    ends, so the vertex is a continuous function of the points -- the largest circle's own
+    position jumps between the flat maximum's local maxima."""
     half = min(float(window), 0.45 * mcl.length)
+    grid = np.linspace(-1.1, 1.1, _MAX_POS_SAMPLES)
+    s = float(s0)
+    seed, _ = mcl.at(s)
+    x = float((_refine_centres(profile, a, b, seed)[0][0] - le) @ chord_dir)
+    slope = 1.0                       # ds / dx along the camber line, re-estimated each round
     for _ in range(_MAX_POS_ROUNDS):
-        centre_s = float(np.clip(s, half, mcl.length - half))
-        seeds, _ = mcl.at(centre_s + half * x)
+        seeds, _ = mcl.at(np.clip(s + slope * half * grid, 0.0, mcl.length))
         cs, _, _, fs, _ = _refine_centres(profile, a, b, seeds)
-        r = _norms(fs - cs)
-        q = np.polyfit(x, r, 4, w=sw)
+        r, t = _norms(fs - cs), ((cs - le) @ chord_dir - x) / half
+        inside = np.abs(t) < 1.0
+        if inside.sum() < 2 * _END_DEGREE:
+            break
+        q = np.polyfit(t[inside], r[inside], 4, w=1.0 - t[inside] ** 2)
         roots = np.roots(np.polyder(q))
         roots = roots[np.abs(roots.imag) < 1e-12].real
         roots = roots[(np.abs(roots) < 1.0) & (np.polyval(np.polyder(q, 2), roots) < 0)]
         if not len(roots):
             break
-        new = centre_s + half * float(roots[np.argmin(np.abs(roots))])
-        done = abs(new - s) < 1e-9
-        s = new
-        if done:
+        step = half * float(roots[np.argmin(np.abs(roots))])
+        slope = float(np.polyfit(t * half, s + slope * half * grid, 1)[0])
+        s, x = s + slope * step, x + step
+        if abs(step) < 1e-9:
             break
     seed, _ = mcl.at(s)
-    c, _, _, _, _ = _refine_centres(profile, a, b, seed)
-    return c[0]
+    return x, _refine_centres(profile, a, b, seed)[0][0]
 
 
 # ---------------------------------------------------------------- extents and chords
@@ -1194,9 +1198,10 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed)
     max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
     # Its position: the vertex of the radius's local quartic (continuous in the points).
-    c_pos = _max_thickness_centre(profile, side_a, side_b, mcl, mcl.le_extension + s_max,
-                                  _MAX_POS_WINDOW * nose_tail)
-    max_pos = 100.0 * float((c_pos - le) @ chord_dir) / nose_tail
+    x_pos, c_pos = _max_thickness_position(profile, side_a, side_b, mcl,
+                                           mcl.le_extension + s_max,
+                                           _MAX_POS_WINDOW * nose_tail, le, chord_dir)
+    max_pos = 100.0 * x_pos / nose_tail
 
     stations = [float(p) for p in stations_pct]
     thickness = _thickness_normal(profile, mcl, _stations_to_arc(mcl, le, chord_dir,
