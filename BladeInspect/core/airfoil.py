@@ -497,6 +497,8 @@ class CamberLine:
         self.length = self.le_extension + self.inner_length + float(
             np.linalg.norm(te - centres[-1]))
         self.le_tangent, self.te_tangent = le_tangent, te_tangent
+        self._le_dir = (centres[0] - le) / max(self.le_extension, 1e-300)
+        self._te_dir = (te - centres[-1]) / max(float(np.linalg.norm(te - centres[-1])), 1e-300)
 
     def at(self, s):
         """Points and unit tangents (LE -> TE) at arc lengths s from the LE point."""
@@ -506,10 +508,13 @@ class CamberLine:
         t = _unit(self._spline(inner, 1))
         before = s < self.le_extension
         after = s > self.le_extension + self.inner_length
-        p[before] = self.centres[0] + (s[before] - self.le_extension)[:, None] * self.le_tangent
+        # The extensions run straight from the end centres to the edge points (which lie on
+        # the end tangents but for the edge circle's centre's offset from them, _edge_point);
+        # their tangents are the end tangents (the metal angles).
+        p[before] = self.centres[0] + (s[before] - self.le_extension)[:, None] * self._le_dir
         t[before] = self.le_tangent
         p[after] = self.centres[-1] + (s[after] - self.le_extension
-                                       - self.inner_length)[:, None] * self.te_tangent
+                                       - self.inner_length)[:, None] * self._te_dir
         t[after] = self.te_tangent
         return p, t
 
