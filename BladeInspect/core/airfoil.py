@@ -554,6 +554,8 @@ class CamberLine:
         self.length = self.le_extension + self.inner_length + float(
             np.linalg.norm(te - centres[-1]))
         self.le_tangent, self.te_tangent = le_tangent, te_tangent
+        self._le_dir = (centres[0] - le) / max(self.le_extension, 1e-300)
+        self._te_dir = (te - centres[-1]) / max(float(np.linalg.norm(te - centres[-1])), 1e-300)
 
     def at(self, s):
         """Points and unit tangents (LE -> TE) at arc lengths s from the LE point."""
@@ -563,10 +565,13 @@ class CamberLine:
         t = _unit(self._spline(inner, 1))
         before = s < self.le_extension
         after = s > self.le_extension + self.inner_length
-        p[before] = self.centres[0] + (s[before] - self.le_extension)[:, None] * self.le_tangent
+        # The extensions run straight from the end centres to the edge points (which lie on
+        # the end tangents but for the edge circle's centre's offset from them, _edge_point);
+        # their tangents are the end tangents (the metal angles).
+        p[before] = self.centres[0] + (s[before] - self.le_extension)[:, None] * self._le_dir
         t[before] = self.le_tangent
         p[after] = self.centres[-1] + (s[after] - self.le_extension
-                                       - self.inner_length)[:, None] * self.te_tangent
+                                       - self.inner_length)[:, None] * self._te_dir
         t[after] = self.te_tangent
         return p, t
 
@@ -707,6 +712,42 @@ def _ray_hit(profile, origin, direction, behind=False):
                      + lam[i] * (profile.length / len(profile.dense)))
 
 
+# The edge point on noisy points (docs/airfoil.md, "LE and TE points"): the input points'
+# distances from the edge circle's centre, a weighted local quadratic in their angle from the
+# camber line's direction over +-_EDGE_POINT_DEG (biweight), read at angle 0.
+_EDGE_POINT_DEG = 15.0
+
+
+def _edge_point(profile, circle, outward, noise_mm, u_line, p_line):
+    """The edge point: where the ray from the edge circle's centre along the camber line's
+    outward end direction meets the profile. Noise-free, the profile is the interpolating
+    spline (its exact crossing). On noisy points it is the input points themselves seen from
+    the centre: their distance as a local quadratic in the angle from the ray, weighted by a
+    biweight that falls to zero at +-_EDGE_POINT_DEG (so a point entering or leaving moves it
+    by nothing), when at least _ZONE_MIN_POINTS points weigh in; else the smoothing spline's
+    crossing. The smoothing spline's knots -- FITPACK's, re-chosen by the data -- change with
+    every micrometre the points move and tilt its edges by micrometres; the input points and
+    the circle fitted to them (_edge_circle) do not jump. Returns (parameters, points) as
+    _ray_hit; (u_line, p_line), the extended camber line's crossing, when the ray misses."""
+    centre = np.asarray(circle.center, dtype=float)
+    direction = _unit(np.asarray(outward, dtype=float))
+    if noise_mm > 0:
+        v = profile.points - centre
+        ang = np.arctan2(_cross2(direction, v), v @ direction)
+        x = ang / np.radians(_EDGE_POINT_DEG)
+        near = np.abs(x) < 1.0
+        if near.sum() >= _ZONE_MIN_POINTS:
+            sw = 1.0 - x[near] ** 2          # the square root of the biweight
+            q = np.polyfit(x[near], _norms(v[near]), 2, w=sw)
+            point = centre + q[-1] * direction
+            u, _ = profile.closest(point)
+            return u, point[None, :]
+    try:
+        return _ray_hit(profile, centre, direction)
+    except InputError:
+        return u_line, p_line
+
+
 def _line_hit(profile, origin, direction, u):
     """Newton on cross(S(u) - origin, direction) = 0 from u: the crossing of a line."""
     u = np.atleast_1d(np.asarray(u, dtype=float))
@@ -748,6 +789,50 @@ def _thickness_normal(profile, mcl, s):
         _, xy = _line_hit(profile, m[rows], n[rows], np.concatenate(starts))
         out[found] = _norms(xy[0::2] - xy[1::2])
     return out
+
+
+# The max-thickness position (docs/airfoil.md, "Thickness"): the vertex of a weighted
+# least-squares quartic of the exact inscribed radii against their centres' projection on the
+# nose-tail chord, over +-_MAX_POS_WINDOW of the chord about the vertex itself (biweight),
+# _MAX_POS_SAMPLES circles a round.
+_MAX_POS_WINDOW = 0.05
+_MAX_POS_SAMPLES = 61
+_MAX_POS_ROUNDS = 20
+
+
+def _max_thickness_position(profile, a, b, mcl, s0, window, le, chord_dir):
+    """The max-thickness position along the chord (mm from ``le``) and the inscribed circle's
+    centre there: a fixed point of "fit the radius's quartic over +-window about x, move x to
+    its vertex", from the largest circle (arc length s0 along ``mcl``). The abscissae are the
+    refined centres' own projections and the weights fall smoothly to zero at the window's
+    ends, so the vertex is a continuous function of the points -- the largest circle's own
+    position jumps between the flat maximum's local maxima."""
+    half = min(float(window), 0.45 * mcl.length)
+    grid = np.linspace(-1.1, 1.1, _MAX_POS_SAMPLES)
+    s = float(s0)
+    seed, _ = mcl.at(s)
+    x = float((_refine_centres(profile, a, b, seed)[0][0] - le) @ chord_dir)
+    slope = 1.0                       # ds / dx along the camber line, re-estimated each round
+    for _ in range(_MAX_POS_ROUNDS):
+        seeds, _ = mcl.at(np.clip(s + slope * half * grid, 0.0, mcl.length))
+        cs, _, _, fs, _ = _refine_centres(profile, a, b, seeds)
+        r, t = _norms(fs - cs), ((cs - le) @ chord_dir - x) / half
+        inside = np.abs(t) < 1.0
+        if inside.sum() < 2 * _END_DEGREE:
+            break
+        q = np.polyfit(t[inside], r[inside], 4, w=1.0 - t[inside] ** 2)
+        roots = np.roots(np.polyder(q))
+        roots = roots[np.abs(roots.imag) < 1e-12].real
+        roots = roots[(np.abs(roots) < 1.0) & (np.polyval(np.polyder(q, 2), roots) < 0)]
+        if not len(roots):
+            break
+        step = half * float(roots[np.argmin(np.abs(roots))])
+        slope = float(np.polyfit(t * half, s + slope * half * grid, 1)[0])
+        s, x = s + slope * step, x + step
+        if abs(step) < 1e-9:
+            break
+    seed, _ = mcl.at(s)
+    return x, _refine_centres(profile, a, b, seed)[0][0]
 
 
 # ---------------------------------------------------------------- extents and chords
@@ -1128,6 +1213,9 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
                                                        notes, metal_angle_window_pct)
     circle_a = _edge_circle(profile, circle_a.center, out_a, ua_end[0], edge_zone_deg)
     circle_b = _edge_circle(profile, circle_b.center, out_b, ub_end[0], edge_zone_deg)
+    # The edge points: from each edge circle's centre along the camber line's end direction.
+    ua_end, end_a = _edge_point(profile, circle_a, out_a, noise_mm, ua_end, end_a)
+    ub_end, end_b = _edge_point(profile, circle_b, out_b, noise_mm, ub_end, end_b)
     t0, t1 = -out_a, out_b
     a_is_le, le_rule = _leading_end(end_a[0], end_b[0], circle_a, circle_b, axis, le_hint,
                                     le_upstream, noise_mm)
@@ -1171,7 +1259,11 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     seed, _ = mcl.at(mcl.le_extension + s_max)
     c_max, _, _, fa, _ = _refine_centres(profile, side_a, side_b, seed)
     max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
-    max_pos = 100.0 * float((c_max[0] - le) @ chord_dir) / nose_tail
+    # Its position: the vertex of the radius's local quartic (continuous in the points).
+    x_pos, c_pos = _max_thickness_position(profile, side_a, side_b, mcl,
+                                           mcl.le_extension + s_max,
+                                           _MAX_POS_WINDOW * nose_tail, le, chord_dir)
+    max_pos = 100.0 * x_pos / nose_tail
 
     stations = [float(p) for p in stations_pct]
     thickness = _thickness_normal(profile, mcl, _stations_to_arc(mcl, le, chord_dir,
@@ -1198,7 +1290,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
         axial_chord_mm=extent(profile, axis), stagger_deg=_angle_deg(chord_dir, axis),
         max_thickness_mm=max_thickness, max_thickness_pos_pct=max_pos,
-        max_thickness_center=c_max[0], thickness_stations_pct=stations, thickness_mm=thickness,
+        max_thickness_center=c_pos, thickness_stations_pct=stations, thickness_mm=thickness,
         le_radius_mm=le_radius, te_radius_mm=te_radius, le_circle=le_circle,
         te_circle=te_circle, edge_offsets_mm=offsets, le_thickness_mm=le_thk,
         te_thickness_mm=te_thk, inlet_angle_deg=_angle_deg(mcl.le_tangent, axis),
