@@ -11,13 +11,11 @@ Why a sphere: its centre is the one point of a part that every viewing angle mea
 and with the diameter known the centre follows from a cap seen from above alone.
 """
 
-import json
 
 import numpy as np
 
 from ..core import fitting
 from ..core import transforms as tf
-from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 from ..rig.kinematics import RigKinematics
 from ..rig.serial_rig import SerialRig
@@ -263,9 +261,7 @@ def _write_atomically(path, kinematics, extra=None):
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise InputError("--out %s: folder %s does not exist" % (path, folder))
-    with atomic_write(path) as fh:     # the bytes of RigKinematics.to_json, plus ``extra``
-        json.dump(dict(kinematics.to_dict(), **(extra or {})), fh, indent=2)
-        fh.write("\n")
+    kinematics.to_json(path, extra)
 
 
 def sphere_residual(rig, kinematics, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES,

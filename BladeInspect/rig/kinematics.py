@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import transforms as tf
+from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 
 RIG_FILE_KIND = "BladeInspect rig kinematics"
@@ -106,9 +107,11 @@ class RigKinematics:
         except InputError as exc:
             raise InputError("%s: %s" % (source, exc))
 
-    def to_json(self, path):
-        with open(path, "w") as f:
-            json.dump(self.to_dict(), f, indent=2)
+    def to_json(self, path, extra=None):
+        """Write the rig file ``path`` atomically; ``extra``: more top-level fields (calibrate's
+        fit statistics)."""
+        with atomic_write(path) as f:
+            json.dump(dict(self.to_dict(), **(extra or {})), f, indent=2)
             f.write("\n")
 
     @classmethod
