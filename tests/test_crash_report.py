@@ -30,6 +30,15 @@ def _kill_if_alive(pid):
         pass
 
 
+def _start_simulate(out, tmp):
+    """./bladeinspect simulate into ``out``, its log and status files in ``tmp``; stderr piped
+    (its progress lines say when the run is inside a stage)."""
+    return subprocess.Popen(
+        [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
+        cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        env=dict(os.environ, TMPDIR=tmp))
+
+
 class CrashIsNeverSilent(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.mkdtemp(prefix="bladeinspect-crash-")
@@ -37,10 +46,7 @@ class CrashIsNeverSilent(unittest.TestCase):
 
     def _kill_mid_run(self, sig):
         out = os.path.join(self.tmp, "out-%d" % sig)
-        wrapper = subprocess.Popen(
-            [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
-            cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-            env=dict(os.environ, TMPDIR=self.tmp))
+        wrapper = _start_simulate(out, self.tmp)
         lines = []
         killed = None
         try:
@@ -85,10 +91,7 @@ class CrashIsNeverSilent(unittest.TestCase):
         # SIGKILL included, as it would if the wrapper had exec'd it; SIGTERM is passed on.
         for sig in (signal.SIGKILL, signal.SIGTERM):
             out = os.path.join(self.tmp, "wrapper-%d" % sig)
-            wrapper = subprocess.Popen(
-                [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
-                cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                env=dict(os.environ, TMPDIR=self.tmp))
+            wrapper = _start_simulate(out, self.tmp)
             child = None
             try:
                 for line in wrapper.stderr:
@@ -138,10 +141,7 @@ class AHungCrashIsEnded(unittest.TestCase):
 
     def test_a_child_alive_after_its_logged_crash_is_killed_and_reported(self):
         out = os.path.join(self.tmp, "out")
-        wrapper = subprocess.Popen(
-            [BLADEINSPECT, "simulate", "--out", out, "--points", "20000", "--seed", "3"],
-            cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-            env=dict(os.environ, TMPDIR=self.tmp))
+        wrapper = _start_simulate(out, self.tmp)
         child = None
         stopped_at = None
         lines = []
