@@ -22,6 +22,7 @@ values are maxima: their u adds the maximum's bias (_maxima_bias) to the draws' 
 
 import csv
 import dataclasses
+import hashlib
 import os
 from dataclasses import dataclass, field
 
@@ -388,7 +389,6 @@ def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstr
     """kernel.characteristics of a nominal cut (engine axis +x of its frame), remembered
     (above); each call has its own Characteristics (its own warnings list), the numbers and
     the profile shared."""
-    import hashlib
     xy = np.ascontiguousarray(xy, dtype=float)
     h = hashlib.sha256(xy.tobytes())
     h.update(repr((xy.shape, chord_method, [float(v) for v in edge_offsets_mm],
