@@ -23,6 +23,7 @@ OLD = b"old file: line one\nline two\n" * 1000
 # The child: writes CHUNKS chunks of CHUNK bytes of b"N" into argv[1] through atomic_write.
 # With argv[2] == "step" it reports the temporary file open and each chunk written on stdout
 # and waits for a line on stdin before going on (the parent decides exactly where it dies); with "free" it writes as fast as it can.
+# Either way it then waits for a line before it exits, so that a kill never finds it gone.
 CHILD = r"""
 import sys
 from BladeInspect.core.atomic_file import atomic_write
@@ -40,8 +41,7 @@ with atomic_write(path, "wb") as fh:
             print("wrote", i + 1, flush=True)
             sys.stdin.readline()
 print("replaced", flush=True)
-if step:
-    sys.stdin.readline()
+sys.stdin.readline()
 """
 CHUNKS, CHUNK = 16, 1 << 18          # the new file: 4 MiB of b"N"
 
@@ -277,7 +277,10 @@ class AtomicWriteTest(unittest.TestCase):
         t0 = time.monotonic()
         self.assertEqual(proc.stdout.readline(), b"replaced\n")
         span = time.monotonic() - t0
+        proc.stdin.write(b"\n")
+        proc.stdin.flush()
         proc.wait(timeout=30)
+        self.assertEqual(proc.returncode, 0)
         self.assertEqual(self.read(), new)
         rng = random.Random(5)
         outcomes = []
@@ -285,10 +288,7 @@ class AtomicWriteTest(unittest.TestCase):
             self.write_old()
             proc = self.child("free")
             time.sleep(rng.uniform(0.0, 1.5 * span))
-            if proc.poll() is None:
-                self.kill(proc)
-            else:
-                proc.wait(timeout=30)
+            self.kill(proc)     # the child waits at its end, so it is always there to kill
             got = self.read()
             self.assertIn(got, (OLD, new), "trial %d: %d bytes, a mix" % (trial, len(got)))
             outcomes.append(got == new)
