@@ -144,8 +144,10 @@ class Profile:
     def _pieces(self, u):
         """Each parameter's offset into its spline piece and that piece's coefficients (a
         sequence of the four powers' (n, 2) arrays, highest first)."""
-        u = np.mod(np.asarray(u, dtype=float).reshape(-1), self.length)
-        i = np.searchsorted(self._breaks, u, side="right") - 1
+        # (the array methods and operators: numpy's function wrappers cost more than the
+        # arithmetic on the few parameters of most calls; the same values)
+        u = np.asarray(u, dtype=float).reshape(-1) % self.length
+        i = self._breaks.searchsorted(u, side="right") - 1
         i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
         t = (u - self._breaks[i])[:, None]
         if len(i) < _GATHER_SPLIT:

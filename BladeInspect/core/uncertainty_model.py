@@ -119,9 +119,14 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
         total = 0.0
         for k in range(len(varying) if bias_only else 0, len(varying) + 1):
             moved = noise + sum(pushes[:k]) if k else noise
+            # |side level + moved| = |level + side moved| (side is +-1: exact), and rounding
+            # is monotone, so a row's largest |level + x| is the larger of level + max x and
+            # -(level + min x): each round is two (draws,) sums, the same errors to the bit
+            x = side * moved
+            top, low = x.max(axis=1), x.min(axis=1)
             level = reported
             for _ in range(_FIXED_POINT_ROUNDS + 1):
-                error = np.abs(side * level + moved).max(axis=1) - level
+                error = np.maximum(level + top, -(level + low)) - level
                 if _ < _FIXED_POINT_ROUNDS:
                     level = max(reported - float(error.mean()), 0.0)
             rms = float(np.sqrt(np.mean(error ** 2)))
