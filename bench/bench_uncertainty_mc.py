@@ -276,7 +276,11 @@ class Chain:
         values["worst deviation part"] = abs(verdict["part"]["worst_deviation_mm"])
         stated["worst deviation part"] = 0.5 * verdict["part"]["U_mm"]
         truth["worst deviation part"] = float(np.max(np.abs(field[result.inlier])))
-        opts = airfoil_mod.Options(draws=draws, seed=int(rng.integers(1 << 31)))
+        # the stage states u as the product does: with the rig calibration's term when the
+        # trials draw a calibration error (report/inspect take it from RIG.json)
+        opts = airfoil_mod.Options(draws=draws, seed=int(rng.integers(1 << 31)),
+                                   calibration_mm=(self.model.calibration_mm
+                                                   if "calibration" in errors else None))
         stage = airfoil_mod.run_stage(self.nominal, airfoil_mod.planes_of_table(table), opts,
                                       result, table.span_axis)
         for b in stage.blocks:

@@ -69,6 +69,10 @@ class Options:
     # the sensor's stated accuracy, a reading bias of unknown sign (half-width, mm); None: the
     # sensor model's, as inspection.uncertainty takes it for the deviations
     accuracy_mm: float = None
+    # the rig calibration's 1 sigma at the part (RIG.json's calibration_uncertainty_mm, the
+    # deviations' calibration term); attach takes it from the verdict's measurement model.
+    # None: not in the draws, and the settings say so
+    calibration_mm: float = None
     seed: int = 0
     le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
     decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
@@ -559,6 +563,11 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
         moved = moved + along * (spread * unit(rng, len(moved)))[:, None]
         moved = moved + rng.uniform(-accuracy, accuracy) * bias_step
         p2 = frame.to_2d(_into_plane(moved, n0, frame.origin, frame.normal))
+        if opts.calibration_mm:
+            # the calibration's error at the part as one in-plane translation of the section
+            # (1 sigma per axis): its location part, which the Monte Carlo showed missing
+            # (docs/airfoil.md, "Decisions")
+            p2 = p2 + float(opts.calibration_mm) * rng.standard_normal(2)
         try:
             c, f, k, _ = _measure(p2, nom, opts, noise, nom.le_point)
         except InputError:
@@ -854,8 +863,13 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                       "covariance, each reading's sensor noise along its "
                                       "beam (sigma_beam, the sensor's distribution) on the "
                                       "measured profile's smooth fit and "
-                                      "the sensor's bias, %d draws; form values add the bias of "
-                                      "a maximum" % opts.draws,
+                                      "the sensor's bias, %d draws; %s; form values add the "
+                                      "bias of a maximum"
+                                      % (opts.draws, "the rig calibration's %.4g mm (1 sigma "
+                                         "at the part) as an in-plane shift of each section"
+                                         % opts.calibration_mm if opts.calibration_mm else
+                                         "the rig calibration not included (no RIG.json "
+                                         "stating its uncertainty)"),
                 # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
                 "uncertainty_relative_accuracy": (None if opts.draws < 2 else
                                                   float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),
@@ -879,8 +893,12 @@ def attach(result, nominal, table, verdict, opts=None):
     """The stage for a report or an inspection: the section table's sections measured from
     the result, the part's verdict taking in every judged characteristic (it fails, naming
     them, when one does). The stage is kept on the table for the report's figures."""
-    opts = dataclasses.replace(opts or Options(),
-                               decision_rule=verdict.get("decision_rule", "iso14253"))
+    opts = opts or Options()
+    model = verdict.get("measurement_model") or {}
+    opts = dataclasses.replace(
+        opts, decision_rule=verdict.get("decision_rule", "iso14253"),
+        calibration_mm=(model.get("calibration_mm") if opts.calibration_mm is None
+                        else opts.calibration_mm))
     stage = run_stage(nominal, planes_of_table(table), opts, result, table.span_axis)
     table.airfoil = stage
     if stage.verdict["verdict"] == decision_mod.FAIL:

@@ -24,6 +24,7 @@ The task (the file's ``key``; a file made for another task is refused, never reu
 - the airfoil options that change the values: engine_axis, chord_method, edge_offsets_mm,
   le_rule;
 - the sensor the draws use (every field of its rig.sensor.SensorModel, accuracy included);
+- the rig calibration's 1 sigma at the part (``calibration_mm``), only when the run has one;
 - the registration's fit (result.fit's objective, free, weights_by_zone, datum_faces) and
   weight model (result.weights' model), and which readings the draws lay noise along
   (snr and beams known or not);
@@ -114,7 +115,7 @@ def _fit_of(result):
 def task_key(nominal, opts, result):
     """The task's key (module notes): a JSON-able dict."""
     from . import airfoil as stage
-    return {"version": TASK_MODEL_VERSION,
+    key = {"version": TASK_MODEL_VERSION,
             "cad": cad_fingerprint(nominal),
             "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
             "chord_method": opts.chord_method,
@@ -124,6 +125,9 @@ def task_key(nominal, opts, result):
             "fit": _fit_of(result),
             "readings": {"snr": result.snr is not None,
                          "beams": uncertainty_mod.beam_directions(result) is not None}}
+    if opts.calibration_mm:     # only when given: the files of runs without one stay valid
+        key["calibration_mm"] = round(float(opts.calibration_mm), 12)
+    return key
 
 
 def digest(key):
