@@ -116,15 +116,15 @@ def task_key(nominal, opts, result):
     """The task's key (module notes): a JSON-able dict."""
     from . import airfoil as stage
     key = {"version": TASK_MODEL_VERSION,
-            "cad": cad_fingerprint(nominal),
-            "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
-            "chord_method": opts.chord_method,
-            "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
-            "le_rule": opts.le_rule,
-            "sensor": json.loads(json.dumps(asdict(stage.sensor_of(opts)))),
-            "fit": _fit_of(result),
-            "readings": {"snr": result.snr is not None,
-                         "beams": uncertainty_mod.beam_directions(result) is not None}}
+           "cad": cad_fingerprint(nominal),
+           "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
+           "chord_method": opts.chord_method,
+           "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
+           "le_rule": opts.le_rule,
+           "sensor": json.loads(json.dumps(asdict(stage.sensor_of(opts)))),
+           "fit": _fit_of(result),
+           "readings": {"snr": result.snr is not None,
+                        "beams": uncertainty_mod.beam_directions(result) is not None}}
     if opts.calibration_mm:     # only when given: the files of runs without one stay valid
         key["calibration_mm"] = round(float(opts.calibration_mm), 12)
     return key
