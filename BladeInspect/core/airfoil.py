@@ -553,11 +553,11 @@ class CamberLine:
         self.le, self.te = le, te
         self.le_extension = float(np.linalg.norm(centres[0] - le))
         self.inner_length = float(s[-1])
-        self.length = self.le_extension + self.inner_length + float(
-            np.linalg.norm(te - centres[-1]))
+        te_extension = float(np.linalg.norm(te - centres[-1]))
+        self.length = self.le_extension + self.inner_length + te_extension
         self.le_tangent, self.te_tangent = le_tangent, te_tangent
         self._le_dir = (centres[0] - le) / max(self.le_extension, 1e-300)
-        self._te_dir = (te - centres[-1]) / max(float(np.linalg.norm(te - centres[-1])), 1e-300)
+        self._te_dir = (te - centres[-1]) / max(te_extension, 1e-300)
 
     def at(self, s):
         """Points and unit tangents (LE -> TE) at arc lengths s from the LE point."""
@@ -802,18 +802,18 @@ _MAX_POS_SAMPLES = 61
 _MAX_POS_ROUNDS = 20
 
 
-def _max_thickness_position(profile, a, b, mcl, s0, window, le, chord_dir):
+def _max_thickness_position(profile, a, b, mcl, s0, c0, window, le, chord_dir):
     """The max-thickness position along the chord (mm from ``le``) and the inscribed circle's
     centre there: a fixed point of "fit the radius's quartic over +-window about x, move x to
-    its vertex", from the largest circle (arc length s0 along ``mcl``). The abscissae are the
-    refined centres' own projections and the weights fall smoothly to zero at the window's
-    ends, so the vertex is a continuous function of the points -- the largest circle's own
-    position jumps between the flat maximum's local maxima."""
+    its vertex", from the largest circle (arc length s0 along ``mcl``, its refined centre
+    c0). The abscissae are the refined centres' own projections and the weights fall
+    smoothly to zero at the window's ends, so the vertex is a continuous function of the
+    points -- the largest circle's own position jumps between the flat maximum's local
+    maxima."""
     half = min(float(window), 0.45 * mcl.length)
     grid = np.linspace(-1.1, 1.1, _MAX_POS_SAMPLES)
     s = float(s0)
-    seed, _ = mcl.at(s)
-    x = float((_refine_centres(profile, a, b, seed)[0][0] - le) @ chord_dir)
+    x = float((c0 - le) @ chord_dir)
     slope = 1.0                       # ds / dx along the camber line, re-estimated each round
     for _ in range(_MAX_POS_ROUNDS):
         seeds, _ = mcl.at(np.clip(s + slope * half * grid, 0.0, mcl.length))
@@ -1263,7 +1263,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     max_thickness = 2.0 * float(np.linalg.norm(fa[0] - c_max[0]))
     # Its position: the vertex of the radius's local quartic (continuous in the points).
     x_pos, c_pos = _max_thickness_position(profile, side_a, side_b, mcl,
-                                           mcl.le_extension + s_max,
+                                           mcl.le_extension + s_max, c_max[0],
                                            _MAX_POS_WINDOW * nose_tail, le, chord_dir)
     max_pos = 100.0 * x_pos / nose_tail
 
