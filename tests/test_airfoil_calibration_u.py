@@ -26,7 +26,6 @@ class CalibrationInTheAirfoilU(unittest.TestCase):
         cls.nominal = demo_nominal()
         planes = stage_mod.nominal_planes(cls.nominal, (HEIGHT,))
         section = nominal_section(cls.nominal, planes[0].origin, planes[0].normal, 0.1)[:2]
-        cls.points, cls.normals = section
         xyz = np.vstack(_noisy([section], SENSOR_SIGMA, 3))
         cls.result = _result(cls.nominal, xyz)
         cls.table = sections_mod.section_table(cls.result, cls.nominal, heights_pct=(HEIGHT,),

@@ -851,6 +851,9 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
         unproven += ["section %s: %s" % (r.plane.label, k) for k in n]
         r.block["notes"] = list(r.notes)
     verdict = stage_verdict(results, failed, unproven)
+    calibration = ("the rig calibration's %.4g mm (1 sigma at the part) as an in-plane shift "
+                   "of each section" % opts.calibration_mm if opts.calibration_mm else
+                   "the rig calibration not included (no RIG.json stating its uncertainty)")
     settings = {"engine_axis": list(map(float, opts.engine_axis)),
                 "chord_method": opts.chord_method,
                 "le_rule": opts.le_rule,
@@ -864,12 +867,7 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                                       "beam (sigma_beam, the sensor's distribution) on the "
                                       "measured profile's smooth fit and "
                                       "the sensor's bias, %d draws; %s; form values add the "
-                                      "bias of a maximum"
-                                      % (opts.draws, "the rig calibration's %.4g mm (1 sigma "
-                                         "at the part) as an in-plane shift of each section"
-                                         % opts.calibration_mm if opts.calibration_mm else
-                                         "the rig calibration not included (no RIG.json "
-                                         "stating its uncertainty)"),
+                                      "bias of a maximum" % (opts.draws, calibration),
                 # a standard deviation of n draws is itself uncertain by 1 / sqrt(2 (n - 1))
                 "uncertainty_relative_accuracy": (None if opts.draws < 2 else
                                                   float(1.0 / np.sqrt(2.0 * (opts.draws - 1)))),

@@ -11,7 +11,6 @@ Why a sphere: its centre is the one point of a part that every viewing angle mea
 and with the diameter known the centre follows from a cap seen from above alone.
 """
 
-
 import numpy as np
 
 from ..core import fitting
