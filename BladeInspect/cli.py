@@ -171,6 +171,8 @@ def build_parser():
     b.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     b.add_argument("--scheduler", default=None, help="Dask scheduler tcp://HOST:PORT")
     b.add_argument("--allow-mismatch", action="store_true", help=ALLOW_MISMATCH_HELP)
+    b.add_argument("--rig-file", default=None,
+                   help="RIG.json whose calibration uncertainty enters every blade's U")
     fitting_args(b)
 
     i = sub.add_parser("inspect", help="blind scan, register, CAD-planned scan, report")
@@ -404,7 +406,8 @@ def cmd_batch(args):
     summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
                         scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
                         allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args),
-                        fit_choice=_fit_choice(args), document=_document_writer())
+                        fit_choice=_fit_choice(args), document=_document_writer(),
+                        measurement_model=_model(args))
     sys.stdout.write("%s\n" % summary["message"])
 
 

@@ -102,6 +102,55 @@ class BatchTest(unittest.TestCase):
         self.assertAlmostEqual(float(again[1]["rms_mm"]), float(self.summary[1]["rms_mm"]),
                                delta=1e-6)
 
+    def test_rig_file_enters_every_blade_u(self):
+        """`batch --rig-file`: the RIG.json's calibration term in each blade's U, as `report`
+        takes it; a bad RIG.json stops the lot before anything is written."""
+        import json
+        import subprocess
+        from BladeInspect.rig.kinematics import RigKinematics
+        from tests.helpers import REPO
+        calibration = 0.01
+        scans = os.path.join(self.tmp, "scans_rig")
+        os.makedirs(scans)
+        shutil.copy(os.path.join(self.scans, "blade_a.csv"), scans)
+        rig = os.path.join(self.tmp, "RIG.json")
+        RigKinematics().to_json(rig, extra={"calibration_uncertainty_mm": calibration})
+        out = os.path.join(self.tmp, "lot_rig")
+
+        def batch(rig_file, out_dir):
+            return subprocess.run([os.path.join(REPO, "bladeinspect"), "batch", "--cad", "demo",
+                                   "--scans", scans, "--out", out_dir, "--workers", "1",
+                                   "--rig-file", rig_file],
+                                  cwd=REPO, capture_output=True, text=True, timeout=600)
+        proc = batch(rig, out)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        with open(os.path.join(out, "blade_a", "result.json")) as fh:
+            with_rig = json.load(fh)
+        with open(os.path.join(self.out, "blade_a", "result.json")) as fh:
+            without = json.load(fh)
+        self.assertEqual(with_rig["verdict"]["measurement_model"]["calibration_mm"],
+                         calibration)
+        self.assertIsNone(without["verdict"]["measurement_model"]["calibration_mm"])
+        # The same points and seed: each section's and the part's U grows by the calibration's independent
+        # term alone, U^2 = U0^2 + (k u_cal)^2 (k = 2).
+        judged = [(a, b) for a, b in zip(with_rig["verdict"]["sections"],
+                                         without["verdict"]["sections"]) if "U_mm" in b]
+        self.assertGreaterEqual(len(judged), 1)    # this lot's points cross few planes
+        judged.append((with_rig["verdict"]["part"], without["verdict"]["part"]))
+        for a, b in judged:
+            self.assertAlmostEqual(a["U_mm"] ** 2 - b["U_mm"] ** 2, (2 * calibration) ** 2,
+                                   delta=1e-3 * (2 * calibration) ** 2)
+        self.assertIn("the rig calibration's 0.01 mm",
+                      with_rig["airfoil_settings"]["uncertainty_method"])
+        broken = os.path.join(self.tmp, "RIG_broken.json")
+        with open(broken, "w") as fh:
+            fh.write('{"calibration_uncertainty_mm": -1}')
+        out_bad = os.path.join(self.tmp, "lot_rig_bad")
+        proc = batch(broken, out_bad)
+        self.assertNotEqual(proc.returncode, 0)
+        self.assertIn("RIG_broken.json", proc.stderr.strip().splitlines()[-1])
+        self.assertFalse(os.path.exists(os.path.join(out_bad, "blade_a")))
+
     def test_bad_folders(self):
         with self.assertRaises(InputError):
             B.run_batch(None, os.path.join(self.tmp, "missing"), self.out)

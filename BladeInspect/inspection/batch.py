@@ -94,10 +94,12 @@ def _read_done(folder):
 
 
 def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
-               allow_mismatch=False, airfoil=None, fit_choice=None, document=None):
+               allow_mismatch=False, airfoil=None, fit_choice=None, document=None,
+               measurement_model=None):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
     ``attempt_log``: the file this run is recorded in before it begins; ``document``: as for
-    run_report (a module-level function, so that it pickles to a worker process)."""
+    run_report (a module-level function, so that it pickles to a worker process);
+    ``measurement_model``: as for run_report (read from the lot's RIG.json once, by run_batch)."""
     # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
     # there as the command line starts it, with its module folders on the path (FreeCAD 1.0's
     # Part needs them, or crashes).
@@ -109,7 +111,8 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
     try:
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
                    nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch,
-                   airfoil=airfoil, fit_choice=fit_choice, document=document)
+                   airfoil=airfoil, fit_choice=fit_choice, document=document,
+                   measurement_model=measurement_model)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -169,14 +172,17 @@ def _csv_value(v):
 
 def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
               tolerance=PROFILE_TOLERANCE_MM, seed=0, progress=None,
-              allow_mismatch=False, airfoil=None, fit_choice=None, document=None):
+              allow_mismatch=False, airfoil=None, fit_choice=None, document=None,
+              measurement_model=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
     'message': one line for the command line}. ``allow_mismatch``, ``airfoil``, ``fit_choice``:
     as for `report`; with ``airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil);
-    ``document``: the writer of each file's inspection.FCStd, as for report.run_report."""
+    ``document``: the writer of each file's inspection.FCStd, as for report.run_report;
+    ``measurement_model``: inspection.uncertainty.MeasurementModel of every blade's U (the rig
+    calibration's term from `--rig-file`), as for report.run_report."""
     progress = progress or (lambda f, m: None)
     tolerance = float(tolerance)
     if not tolerance > 0:
@@ -206,10 +212,10 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     t0 = time.perf_counter()
     if todo and scheduler:
         _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                  airfoil, fit_choice, document)
+                  airfoil, fit_choice, document, measurement_model)
     elif todo:
         _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                   airfoil, fit_choice, document)
+                   airfoil, fit_choice, document, measurement_model)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
     airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
@@ -252,7 +258,7 @@ def _attempt_log(out_dir, stem):
 
 
 def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-               airfoil=None, fit_choice=None, document=None):
+               airfoil=None, fit_choice=None, document=None, measurement_model=None):
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
@@ -260,21 +266,21 @@ def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allo
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
                                       seed, _attempt_log(out_dir, stem), allow_mismatch,
-                                      airfoil, fit_choice, document))
+                                      airfoil, fit_choice, document, measurement_model))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                              mp_context=_spawn_context()) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
                                tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
-                               airfoil, fit_choice, document):
+                               airfoil, fit_choice, document, measurement_model):
                    stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
 def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-              airfoil=None, fit_choice=None, document=None):
+              airfoil=None, fit_choice=None, document=None, measurement_model=None):
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -293,7 +299,7 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, all
             fut = client.submit(report_one, cad, os.path.abspath(path),
                                 os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
                                 _attempt_log(out_dir, stem), allow_mismatch, airfoil, fit_choice,
-                                document, pure=False)
+                                document, measurement_model, pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):
