@@ -102,6 +102,48 @@ class BatchTest(unittest.TestCase):
         self.assertAlmostEqual(float(again[1]["rms_mm"]), float(self.summary[1]["rms_mm"]),
                                delta=1e-6)
 
+    def test_a_lot_run_again_otherwise_is_done_again(self):
+        """A done file is one made from the same inputs: another tolerance redoes it (not a
+        summary mixing two tolerances' verdicts), and its result says the new one."""
+        import json
+        scans = os.path.join(self.tmp, "scans_again")
+        os.makedirs(scans)
+        shutil.copy(os.path.join(self.scans, "blade_a.csv"), scans)
+        out = os.path.join(self.tmp, "lot_again")
+        os.makedirs(out)
+        shutil.copytree(os.path.join(self.out, "blade_a"), os.path.join(out, "blade_a"))
+        lot = B.run_batch(None, scans, out, workers=1, tolerance=0.03)
+        self.assertEqual([r["reused"] for r in lot["rows"]], [False])
+        self.assertIn("1 done again", lot["message"])
+        with open(os.path.join(out, "blade_a", "result.json")) as fh:
+            self.assertEqual(json.load(fh)["tolerance_mm"], 0.03)
+        again = B.run_batch(None, scans, out, workers=1, tolerance=0.03)
+        self.assertEqual([r["reused"] for r in again["rows"]], [True])
+
+    def test_done_means_made_from_these_inputs(self):
+        folder = os.path.join(self.out, "blade_a")
+        options = B.lot_options(None, B.PROFILE_TOLERANCE_MM, 0, False, None, None, None)
+        record = B.inputs_record(os.path.join(self.scans, "blade_a.csv"), options)
+        self.assertIsNotNone(B._read_done(folder, record))
+        # the same name scanned again: its points differ
+        other = dict(record, points_sha256="0" * 64)
+        self.assertIsNone(B._read_done(folder, other))
+        for key, value in (("tolerance_mm", 0.05), ("seed", 1), ("allow_mismatch", True)):
+            self.assertIsNone(B._read_done(folder, dict(record, **{key: value})), key)
+        # a result without the record (made by `report`, or an older lot's) is taken when its
+        # own tolerance is the lot's
+        import json
+        copy = os.path.join(self.tmp, "no_record")
+        shutil.copytree(folder, copy)
+        with open(os.path.join(copy, "result.json")) as fh:
+            doc = json.load(fh)
+        self.assertEqual(doc["batch_inputs"], record)
+        del doc["batch_inputs"]
+        with open(os.path.join(copy, "result.json"), "w") as fh:
+            json.dump(doc, fh)
+        self.assertIsNotNone(B._read_done(copy, record))
+        self.assertIsNone(B._read_done(copy, dict(record, tolerance_mm=0.03)))
+
     def test_rig_file_enters_every_blade_u(self):
         """`batch --rig-file`: the RIG.json's calibration term in each blade's U, as `report`
         takes it; a bad RIG.json stops the lot before anything is written."""

@@ -1,8 +1,13 @@
 """A production lot: one report per point file of a folder, and DIR/summary.csv.
 
 Each file gets out_dir/<file stem>/ with the `report` command's files. A file is done when its
-folder holds result.json (written last and atomically), so a lot interrupted midway resumes
-where it stopped; a bad file is reported in the summary and skipped. Files run in parallel in
+folder holds result.json (written last and atomically) made from the same inputs, so a lot
+interrupted midway resumes where it stopped; a bad file is reported in the summary and skipped.
+"The same inputs" is result.json's ``batch_inputs``, written with it: the point file's and the
+CAD file's SHA-256 and every option that changes a result (tolerance, seed, fit, airfoil
+options, the measurement model). A lot
+run again with another tolerance, RIG.json or fit, or a point file scanned again under the
+same name, has those files redone rather than a summary that mixes results made otherwise. Files run in parallel in
 worker processes (concurrent.futures), or on a Dask distributed cluster when a scheduler
 address is given; either way every worker loads the nominal once and keeps it.
 
@@ -14,6 +19,8 @@ lot is complete.
 """
 
 import csv
+import dataclasses
+import hashlib
 import json
 import os
 import shutil
@@ -82,24 +89,68 @@ def _row_from_result_json(name, doc):
     return row
 
 
-def _read_done(folder):
+def _sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _as_json(value):
+    """The options' JSON form for the inputs record (dataclasses as their fields)."""
+    return dataclasses.asdict(value) if dataclasses.is_dataclass(value) else value
+
+
+def lot_options(cad_path, tolerance, seed, allow_mismatch, airfoil, fit_choice,
+                measurement_model):
+    """What every file of the lot is made from besides its points (inputs_record)."""
+    cad = {"cad": cad_path if cad_path in BUILTIN_CADS or cad_path is None
+           else os.path.abspath(cad_path)}
+    if cad_path is not None and cad_path not in BUILTIN_CADS:
+        cad["cad_sha256"] = _sha256(cad_path)
+    options = dict(cad, tolerance_mm=float(tolerance), seed=seed,
+                   allow_mismatch=bool(allow_mismatch), airfoil=_as_json(airfoil),
+                   fit=_as_json(fit_choice), measurement_model=_as_json(measurement_model))
+    # one canonical JSON form, so that a record read back compares equal to a fresh one
+    return json.loads(json.dumps(options, sort_keys=True, default=repr))
+
+
+def inputs_record(points_path, options):
+    return dict(options, points_file=os.path.basename(points_path),
+                points_sha256=_sha256(points_path))
+
+
+def _read_done(folder, record=None):
+    """The folder's result.json, or None when it is not done: absent, unreadable, or (given
+    ``record``) made from other inputs than ``record``. A result.json with no record (made by
+    `report` into the lot, or by an earlier version) is taken when the tolerance it states is
+    the record's: the verdict is against it."""
     path = os.path.join(folder, "result.json")
     if not os.path.exists(path):
         return None
     try:
         with open(path) as fh:
-            return json.load(fh)
+            doc = json.load(fh)
     except (OSError, ValueError):
         return None     # unreadable: the file is simply done again
+    if record is None:
+        return doc
+    if not isinstance(doc, dict):
+        return None
+    if "batch_inputs" in doc:
+        return doc if doc["batch_inputs"] == record else None
+    return doc if doc.get("tolerance_mm") == record["tolerance_mm"] else None
 
 
 def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
                allow_mismatch=False, airfoil=None, fit_choice=None, document=None,
-               measurement_model=None):
+               measurement_model=None, record=None):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
     ``attempt_log``: the file this run is recorded in before it begins; ``document``: as for
     run_report (a module-level function, so that it pickles to a worker process);
-    ``measurement_model``: as for run_report (read from the lot's RIG.json once, by run_batch)."""
+    ``measurement_model``: as for run_report (read from the lot's RIG.json once, by run_batch);
+    ``record``: the file's inputs (inputs_record), kept in its result.json."""
     # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
     # there as the command line starts it, with its module folders on the path (FreeCAD 1.0's
     # Part needs them, or crashes).
@@ -112,7 +163,7 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
         run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
                    nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch,
                    airfoil=airfoil, fit_choice=fit_choice, document=document,
-                   measurement_model=measurement_model)
+                   measurement_model=measurement_model, batch_inputs=record)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -193,13 +244,20 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     os.makedirs(out_dir, exist_ok=True)
     summary_path = os.path.join(out_dir, "summary.csv")
 
+    options = lot_options(cad_path, tolerance, seed, allow_mismatch, airfoil, fit_choice,
+                          measurement_model)
     rows = {}
     todo = []
+    records = {}
+    redone = 0
     for stem, path in files:
-        doc = _read_done(os.path.join(out_dir, stem))
+        records[stem] = inputs_record(path, options)
+        folder = os.path.join(out_dir, stem)
+        doc = _read_done(folder, records[stem])
         if doc is not None:
             rows[stem] = dict(_row_from_result_json(os.path.basename(path), doc), reused=True)
         else:
+            redone += os.path.exists(os.path.join(folder, "result.json"))
             todo.append((stem, path))
 
     def finished(stem, row):
@@ -212,10 +270,10 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     t0 = time.perf_counter()
     if todo and scheduler:
         _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                  airfoil, fit_choice, document, measurement_model)
+                  airfoil, fit_choice, document, measurement_model, records)
     elif todo:
         _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                   airfoil, fit_choice, document, measurement_model)
+                   airfoil, fit_choice, document, measurement_model, records)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
     airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
@@ -226,11 +284,13 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     retried = ["%s (%d attempts)" % (r["file"], r["attempts"]) for r in ordered
                if (r.get("attempts") or 0) > 1]
     not_proven = sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == "not proven")
-    message = ("%d files: %d pass, %d fail, %s%d error (%d already done, %.1f s)%s; %s"
+    message = ("%d files: %d pass, %d fail, %s%d error (%d already done%s, %.1f s)%s; %s"
                % (len(files), count["pass"], count["fail"],
                   "%d not proven, " % not_proven if not_proven else "",
                   sum(1 for r in ordered if r["status"] == "error"),
-                  len(files) - len(todo), time.perf_counter() - t0,
+                  len(files) - len(todo),
+                  "; %d done again: made from other inputs or options" % redone if redone
+                  else "", time.perf_counter() - t0,
                   ("; retried after a lost worker: " + ", ".join(retried)) if retried else "",
                   summary_path))
     progress(1.0, message)
@@ -258,7 +318,9 @@ def _attempt_log(out_dir, stem):
 
 
 def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-               airfoil=None, fit_choice=None, document=None, measurement_model=None):
+               airfoil=None, fit_choice=None, document=None, measurement_model=None,
+               records=None):
+    records = records or {}
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
@@ -266,21 +328,25 @@ def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allo
         for stem, path in todo:
             finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
                                       seed, _attempt_log(out_dir, stem), allow_mismatch,
-                                      airfoil, fit_choice, document, measurement_model))
+                                      airfoil, fit_choice, document, measurement_model,
+                                      records.get(stem)))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                              mp_context=_spawn_context()) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
                                tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
-                               airfoil, fit_choice, document, measurement_model):
+                               airfoil, fit_choice, document, measurement_model,
+                               records.get(stem)):
                    stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
 def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-              airfoil=None, fit_choice=None, document=None, measurement_model=None):
+              airfoil=None, fit_choice=None, document=None, measurement_model=None,
+              records=None):
+    records = records or {}
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -299,7 +365,7 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, all
             fut = client.submit(report_one, cad, os.path.abspath(path),
                                 os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
                                 _attempt_log(out_dir, stem), allow_mismatch, airfoil, fit_choice,
-                                document, measurement_model, pure=False)
+                                document, measurement_model, records.get(stem), pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):

@@ -688,7 +688,8 @@ class AtomicOutput:
 
     def commit(self):
         os.makedirs(self.out_dir, exist_ok=True)
-        for name in os.listdir(self.tmp):
+        # result.json last: a folder holding it is complete (a batch's test of a done file)
+        for name in sorted(os.listdir(self.tmp), key=lambda name: name == "result.json"):
             os.replace(os.path.join(self.tmp, name), os.path.join(self.out_dir, name))
         shutil.rmtree(self.tmp, ignore_errors=True)
 

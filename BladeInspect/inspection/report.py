@@ -548,13 +548,13 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
                seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
                nominal=None, document=None, flip_faces=(), allow_mismatch=False, airfoil=None,
-               fit_choice=None, measurement_model=None):
+               fit_choice=None, measurement_model=None, batch_inputs=None):
     """Register, then write_result_report: result.json, deviations.csv, report.html,
     report.pdf and inspection.FCStd into out_dir, all or nothing. ``nominal`` skips loading
     the CAD (a batch loads it once); ``flip_faces`` as ``--flip-face`` (cad.orient).
     ``allow_mismatch``: write the result of a scan that does not fit the CAD, with the warning
-    (pipeline.register). ``document``, ``airfoil``, ``fit_choice``, ``measurement_model``: as
-    for write_result_report. Returns a summary dict."""
+    (pipeline.register). ``document``, ``airfoil``, ``fit_choice``, ``measurement_model``,
+    ``batch_inputs``: as for write_result_report. Returns a summary dict."""
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     tolerance = contracts.profile_tolerance(tolerance)
@@ -577,13 +577,15 @@ def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PRO
     return write_result_report(result, nominal, out_dir, cmm_data=cmm_data,
                                tolerance=tolerance, progress=progress, heights_pct=heights_pct,
                                document=document, cad_path=cad_path, airfoil=airfoil,
-                               fit_choice=fit_choice, measurement_model=measurement_model)
+                               fit_choice=fit_choice, measurement_model=measurement_model,
+                               batch_inputs=batch_inputs)
 
 
 def write_result_report(result, nominal, out_dir, cmm_data=None,
                         tolerance=contracts.PROFILE_TOLERANCE_MM, progress=None,
                         heights_pct=contracts.SECTION_HEIGHTS_PCT, document=None,
-                        cad_path=None, airfoil=None, fit_choice=None, measurement_model=None):
+                        cad_path=None, airfoil=None, fit_choice=None, measurement_model=None,
+                        batch_inputs=None):
     """The `report` files of a registration already made (a RegistrationResult, e.g. a
     document's Registration): tabulate the sections, judge, and write result.json,
     deviations.csv, report.html, report.pdf and inspection.FCStd into out_dir, all or nothing:
@@ -594,7 +596,8 @@ def write_result_report(result, nominal, out_dir, cmm_data=None,
     ``airfoil``: an inspection.airfoil.Options to add the airfoil characteristics (issue 15;
     None: none). ``fit_choice`` (inspection.fitting.FitChoice, default least squares and ISO
     14253-1) and ``measurement_model`` (inspection.uncertainty) choose the fit and the
-    decision. Returns a summary dict."""
+    decision. ``batch_inputs``: what a batch made this file from (inspection.batch), kept in
+    result.json so that a lot run again knows the file done. Returns a summary dict."""
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
     tolerance = contracts.profile_tolerance(tolerance)
@@ -621,7 +624,8 @@ def write_result_report(result, nominal, out_dir, cmm_data=None,
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance,
-            **airfoil_mod.extras_of(table)},  # issue 15 hook
+            **airfoil_mod.extras_of(table),  # issue 15 hook
+            **({"batch_inputs": batch_inputs} if batch_inputs is not None else {})},
             output=out)
     progress(1.0, verdict["summary"])
     return {"out_dir": os.path.abspath(out_dir), "result": result, "sections": table,
