@@ -41,6 +41,12 @@ take-up.
 
     scripts/fcpython bench/bench_uncertainty_mc.py [--blade demo|rotor67|both] [--trials 40]
         [--seed 2026] [--stated 2] [--errors noise,systematic,calibration] [--sensitivity]
+        [--reanalyse]
+
+Each ratio comes with its bootstrap interval (the trials and the stated trials resampled): a
+row outside +-30 % is "resolved" only when its whole interval is outside, else "unresolved"
+(the run cannot tell it from a correct u). `--reanalyse` prints the table again from the
+last run's saved trials, without running them.
 """
 import argparse
 import os
@@ -323,17 +329,49 @@ def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
             truth.setdefault(key, []).append(x)
     seconds = time.perf_counter() - t0
     with open(os.path.join(tempfile.gettempdir(), "bi-mc-%s-%s.pkl" % (name, "+".join(errors))),
-              "wb") as fh:       # the trials' raw values, for a second look at the figures
+              "wb") as fh:       # the trials' raw values, for a second look (--reanalyse)
         pickle.dump({"values": values, "stated": stated, "truth": truth,
-                     "reference": reference, "biases": biases}, fh)
+                     "reference": reference, "biases": biases, "accuracy": accuracy,
+                     "n_stated": n_stated, "trials": trials}, fh)
     print("\n%s (errors: %s): %d trials, seed %d, %.0f s wall; %d readings a scan; sensor accuracy %.1f um; "
           "calibration 1 sigma at the part %.2f um; pose 1 sigma (worst corner) %.2f um"
           % (name, ", ".join(errors), trials, seed, seconds, len(chain.rec["distance"]),
              1e3 * chain.sensor.accuracy, 1e3 * chain.model.calibration_mm,
              1e3 * np.mean(pose)))
-    print("%-30s %9s %9s %6s %5s %9s %6s %5s %9s %4s %6s"
+    return judge(values, stated, truth, reference, biases, accuracy)
+
+
+# The ratio u / scatter of one row is itself a random variable: u is a mean over the stated
+# trials (each its own draws), the scatter a sample over the trials. A row is counted outside
+# +-30 % as "resolved" only when its whole bootstrap interval is (resampling the trials and,
+# apart, the stated trials); a row whose point ratio is outside but whose interval reaches
+# into [0.7, 1.3] is "unresolved": the run cannot tell it from a correct u.
+BOOTSTRAP = 2000
+INTERVAL = (5.0, 95.0)
+
+
+def _ratio_interval(u_values, err, bias, bias_sd, use_rms, rng):
+    u_values = np.asarray(u_values, dtype=float)
+    n, m = len(err), len(u_values)
+    out = []
+    for _ in range(BOOTSTRAP):
+        i = rng.integers(0, n, n)
+        sd, rms = mc_sampling.scatter_and_rms(err[i], None if bias is None else bias[i],
+                                              bias_sd)
+        spread = rms if use_rms else sd
+        if spread > 0:
+            out.append(np.mean(u_values[rng.integers(0, m, m)]) / spread)
+    return tuple(np.percentile(out, INTERVAL)) if out else (np.nan, np.nan)
+
+
+def judge(values, stated, truth, reference, biases, accuracy, seed=7):
+    """The table: per judged value its stated u against the trials' scatter (a maximum: its
+    RMS error against the truth), the ratio with its bootstrap interval, and the counts."""
+    rng = np.random.default_rng(seed)
+    lo, hi = INTERVAL
+    print("%-30s %9s %9s %6s %5s %9s %6s %5s %9s %4s %6s %15s %10s"
           % ("characteristic", "stated u", "MC 1sd", "ratio", "30%", "MC rmserr", "ratio",
-             "30%", "bias", "out", "judged"))
+             "30%", "bias", "out", "judged", "%g-%g %% interval" % (lo, hi), "outside"))
     rows = []
     for key in sorted(values, key=lambda k: (not k.startswith("worst"), k)):
         if key.endswith("centroid_mm[2]") or key not in stated:
@@ -346,22 +384,41 @@ def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):
         # in: a gross failure of one trial (an edge not found) is not the chain's scatter.
         mad = 1.4826 * np.median(np.abs(err - np.median(err)))
         keep = np.abs(err - np.median(err)) <= OUTLIER_SIGMAS * max(mad, 1e-12)
-        sd, rms = mc_sampling.scatter_and_rms(
-            err[keep], None if biases is None else biases[keep], accuracy / np.sqrt(3.0))
+        bias = None if biases is None else np.asarray(biases)[keep]
+        sd, rms = mc_sampling.scatter_and_rms(err[keep], bias, accuracy / np.sqrt(3.0))
         ratio, ratio_rms = u / sd if sd > 0 else np.nan, u / rms if rms > 0 else np.nan
         ok, ok_rms = 0.7 <= ratio <= 1.3, 0.7 <= ratio_rms <= 1.3
         # A maximum's U states its error against the truth (bias included), not its scatter.
-        judged = ok_rms if is_maximum(key) else ok
-        rows.append((key, u, sd, ratio, ok, rms, ratio_rms, ok_rms, judged))
-        print("%-30s %9.5f %9.5f %6.2f %5s %9.5f %6.2f %5s %+9.5f %4d %6s"
+        maximum = is_maximum(key)
+        judged = ok_rms if maximum else ok
+        a, b = _ratio_interval(stated[key], err[keep], bias, accuracy / np.sqrt(3.0),
+                               maximum, rng)
+        resolved = (not judged) and (b < 0.7 or a > 1.3)
+        rows.append((key, u, sd, ratio, ok, rms, ratio_rms, ok_rms, judged, resolved))
+        print("%-30s %9.5f %9.5f %6.2f %5s %9.5f %6.2f %5s %+9.5f %4d %6s %7.2f-%-7.2f %10s"
               % (key, u, sd, ratio, "yes" if ok else "NO", rms, ratio_rms,
                  "yes" if ok_rms else "NO", float(np.mean(err[keep])), int((~keep).sum()),
-                 ("yes" if judged else "NO") + ("*" if is_maximum(key) else "")))
+                 ("yes" if judged else "NO") + ("*" if maximum else ""), a, b,
+                 "" if judged else ("resolved" if resolved else "unresolved")))
     print("%d of %d within +-30 %% of the scatter, %d of %d of the RMS error against the truth; "
-          "judged (* maxima against the RMS error, the rest against the scatter): %d of %d"
+          "judged (* maxima against the RMS error, the rest against the scatter): %d of %d; "
+          "outside with the whole %g-%g %% interval outside: %d"
           % (sum(r[4] for r in rows), len(rows), sum(r[7] for r in rows), len(rows),
-             sum(r[8] for r in rows), len(rows)))
+             sum(r[8] for r in rows), len(rows), lo, hi, sum(r[9] for r in rows)))
     return rows
+
+
+def reanalyse(name, errors):
+    """The table again from a run's saved trials (run() pickles them)."""
+    path = os.path.join(tempfile.gettempdir(), "bi-mc-%s-%s.pkl" % (name, "+".join(errors)))
+    with open(path, "rb") as fh:
+        saved = pickle.load(fh)
+    accuracy = saved.get("accuracy", SensorModel().accuracy)
+    n = len(next(iter(saved["values"].values())))
+    print("\n%s (errors: %s): %d trials re-analysed from %s"
+          % (name, ", ".join(errors), n, path))
+    return judge(saved["values"], saved["stated"], saved["truth"], saved["reference"],
+                 saved["biases"], accuracy)
 
 
 def systematic_sensitivity(name, seed, record_seed=31):
@@ -396,6 +453,8 @@ def main():
                     % ",".join(ERRORS))
     ap.add_argument("--sensitivity", action="store_true",
                     help="print the systematic term's sensitivities through the chain instead")
+    ap.add_argument("--reanalyse", action="store_true",
+                    help="print the table again from the last run's saved trials")
     args = ap.parse_args()
     if args.sensitivity:
         for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
@@ -403,6 +462,9 @@ def main():
         return
     errors = tuple(e for e in args.errors.split(",") if e)
     for name in (("demo", "rotor67") if args.blade == "both" else (args.blade,)):
+        if args.reanalyse:
+            reanalyse(name, errors)
+            continue
         run(name, args.trials, args.seed, args.stated, errors, args.record_seed)
 
 
