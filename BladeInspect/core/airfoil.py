@@ -119,6 +119,7 @@ class Profile:
         keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
         keep &= np.diff(pieces[0].x) > 0
         self._breaks = pieces[0].x[:-1][keep]
+        self._clamp = not self._breaks[0] <= 0.0
         self._coef = np.stack([pp.c[:, keep] for pp in pieces], axis=-1).transpose(1, 0, 2)
         # the same coefficients one contiguous (pieces, 2) array per power: a gather of many
         # parameters' pieces from these and the Horner steps on contiguous rows run ~1.5x
@@ -141,6 +142,12 @@ class Profile:
             return (3.0 * c0 * t + 2.0 * c1) * t + c2
         return self.eval3(u)[der]
 
+    def eval01(self, u):
+        """Points and first derivatives at parameters u (eval's and eval3's arithmetic, one
+        piece lookup for both)."""
+        t, (c0, c1, c2, c3) = self._pieces(u)
+        return ((c0 * t + c1) * t + c2) * t + c3, (3.0 * c0 * t + 2.0 * c1) * t + c2
+
     def _pieces(self, u):
         """Each parameter's offset into its spline piece and that piece's coefficients (a
         sequence of the four powers' (n, 2) arrays, highest first)."""
@@ -148,7 +155,10 @@ class Profile:
         # arithmetic on the few parameters of most calls; the same values)
         u = np.asarray(u, dtype=float).reshape(-1) % self.length
         i = self._breaks.searchsorted(u, side="right") - 1
-        i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
+        # i <= len(breaks) - 1 always; i >= 0 as u >= 0 when the first break is at 0 (as
+        # FITPACK's knots of a parameter starting at 0 put it)
+        if self._clamp:
+            i = np.maximum(i, 0)
         t = (u - self._breaks[i])[:, None]
         if len(i) < _GATHER_SPLIT:
             c = self._coef[i]          # few parameters: one gather costs less than four
@@ -204,7 +214,7 @@ class Profile:
         u = self.nearest_param(xy) if u0 is None else np.array(u0, dtype=float)
         # Each point stops once its own step is below 1e-13 of the length (that step taken).
         tol = 1e-13 * self.length
-        run = np.arange(len(u))
+        run = None                  # the rows still going: all of them while run is None
         ur, xr = u, xy
         if lo is not None:
             lo = np.broadcast_to(lo, u.shape)
@@ -215,10 +225,18 @@ class Profile:
             if lo is not None:
                 new = np.minimum(np.maximum(new, lr), hr)
             going = np.abs(new - ur) >= tol
-            u[run] = new
-            if not going.any():
+            n_going = np.count_nonzero(going)
+            if run is None:
+                u = new
+            else:
+                u[run] = new
+            if n_going == 0:
                 break
-            run, ur, xr = run[going], new[going], xr[going]
+            if n_going == len(going):       # (no row stopped: the same rows, no gather)
+                ur = new
+                continue
+            run = np.flatnonzero(going) if run is None else run[going]
+            ur, xr = new[going], xr[going]
             if lo is not None:
                 lr, hr = lr[going], hr[going]
         return u, self.eval(u)
@@ -354,6 +372,11 @@ class _Side:
     u: np.ndarray
     xy: np.ndarray
     tree: cKDTree
+
+
+def _side_range(profile, lo, hi):
+    """A side's unwrapped parameter range, lo < hi (as _side's)."""
+    return _Range(lo, hi + profile.length if hi <= lo else hi)
 
 
 def _side(profile, lo, hi):
@@ -756,8 +779,9 @@ def _line_hit(profile, origin, direction, u):
     origin = np.atleast_2d(origin)
     direction = np.atleast_2d(direction)
     for _ in range(_NEWTON_ITERATIONS):
-        f = _cross2(profile.eval(u) - origin, direction)
-        df = _cross2(profile.eval(u, 1), direction)
+        p, d1 = profile.eval01(u)
+        f = _cross2(p - origin, direction)
+        df = _cross2(d1, direction)
         u = u - f / np.where(np.abs(df) > 1e-15, df, 1e-15)
     return u, profile.eval(u)
 
@@ -771,24 +795,27 @@ def _thickness_normal(profile, mcl, s):
     p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
     e = q - p
     h = profile.length / len(profile.dense)
-    starts, found = [], []
-    for k in range(len(s)):
-        den = _cross2(n[k], e)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = _cross2(p - m[k], e) / den
-            lam = _cross2(p - m[k], n[k]) / den
-        ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
-        plus, minus = ok & (tau > 0), ok & (tau < 0)
-        if not plus.any() or not minus.any():
-            continue
-        ip = np.flatnonzero(plus)[np.argmin(tau[plus])]
-        im = np.flatnonzero(minus)[np.argmax(tau[minus])]
-        starts.append(profile.dense_u[[ip, im]] + lam[[ip, im]] * h)
-        found.append(k)
-    if found:
-        # every crossing's Newton run in one call (each runs its fixed steps alone)
+    # every station against every dense segment at once (rows: stations), _cross2's
+    # arithmetic element by element
+    pm = p[None, :, :] - m[:, None, :]
+    n0, n1 = n[:, 0:1], n[:, 1:2]
+    den = n0 * e[None, :, 1] - n1 * e[None, :, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = _cross2(pm, e[None]) / den
+        lam = (pm[..., 0] * n1 - pm[..., 1] * n0) / den
+    ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
+    plus, minus = ok & (tau > 0), ok & (tau < 0)
+    found = np.flatnonzero(plus.any(axis=1) & minus.any(axis=1))
+    if len(found):
+        # the nearest crossing on each side: the first of the least positive tau, of the
+        # greatest negative one
+        ip = np.argmin(np.where(plus[found], tau[found], np.inf), axis=1)
+        im = np.argmax(np.where(minus[found], tau[found], -np.inf), axis=1)
+        seg = np.column_stack([ip, im]).ravel()
         rows = np.repeat(found, 2)
-        _, xy = _line_hit(profile, m[rows], n[rows], np.concatenate(starts))
+        starts = profile.dense_u[seg] + lam[rows, seg] * h
+        # every crossing's Newton run in one call (each runs its fixed steps alone)
+        _, xy = _line_hit(profile, m[rows], n[rows], starts)
         out[found] = _norms(xy[0::2] - xy[1::2])
     return out
 
@@ -844,8 +871,9 @@ def _support(profile, direction, sign):
     proj = sign * (profile.dense @ direction)
     u = np.array([profile.dense_u[np.argmax(proj)]])
     for _ in range(_NEWTON_ITERATIONS):
-        g = profile.eval(u, 1) @ direction
-        h = profile.eval(u, 2) @ direction
+        _, d1, d2 = profile.eval3(u)
+        g = d1 @ direction
+        h = d2 @ direction
         u = u - g / np.where(np.abs(h) > 1e-15, h, 1e-15)
     return profile.eval(u)[0]
 
@@ -1233,7 +1261,9 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     nose_tail = float(np.linalg.norm(te - le))
     chord_dir = (te - le) / nose_tail
     # The two sides between the edge points; the suction side is the longer one (convex).
-    s1, s2 = _side(profile, le_u % L, te_u % L), _side(profile, te_u % L, le_u % L + L)
+    # (their parameter ranges only: no samples or tree of them is wanted)
+    s1, s2 = _side_range(profile, le_u % L, te_u % L), _side_range(profile, te_u % L,
+                                                                   le_u % L + L)
     suction, pressure = (s1, s2) if (s1.hi - s1.lo) >= (s2.hi - s2.lo) else (s2, s1)
 
     bitangent = _pressure_bitangent(profile, pressure, le_u, te_u)
@@ -1268,11 +1298,14 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     max_pos = 100.0 * x_pos / nose_tail
 
     stations = [float(p) for p in stations_pct]
-    thickness = _thickness_normal(profile, mcl, _stations_to_arc(mcl, le, chord_dir,
-                                                                 nose_tail, stations)).tolist()
     offsets = [float(d) for d in edge_offsets_mm]
-    le_thk = _thickness_normal(profile, mcl, np.array(offsets)).tolist()
-    te_thk = _thickness_normal(profile, mcl, mcl.length - np.array(offsets)).tolist()
+    # the stations' and both edges' thicknesses in one call (each its own crossings)
+    s_all = np.concatenate([_stations_to_arc(mcl, le, chord_dir, nose_tail, stations),
+                            np.array(offsets), mcl.length - np.array(offsets)])
+    thk = _thickness_normal(profile, mcl, s_all).tolist()
+    n_st, n_off = len(stations), len(offsets)
+    thickness = thk[:n_st]
+    le_thk, te_thk = thk[n_st:n_st + n_off], thk[n_st + n_off:]
 
     area, centroid = area_centroid(profile)
     warnings = _corner_warnings(profile, le, te, nose_tail) + notes
@@ -1430,7 +1463,7 @@ def area_centroid(profile):
     """Area and centroid of the spline-bounded region (Green's theorem, exact quadrature of
     the piecewise-polynomial integrands)."""
     u, w = profile.knot_quadrature(5)
-    p, d = profile.eval(u), profile.eval(u, 1)
+    p, d = profile.eval01(u)
     x, y, dx, dy = p[:, 0], p[:, 1], d[:, 0], d[:, 1]
     area = 0.5 * np.sum(w * (x * dy - y * dx))
     cx = np.sum(w * x * x * dy) / (2.0 * area)
