@@ -431,22 +431,47 @@ def _feet(profile, a, b, xy, ua=None, ub=None):
     return u[:n], u[n:], foot[:n], foot[n:]
 
 
+_SEED_ROWS = 32            # _seed_radii: feet per block (its arrays stay in the cache)
+
+
+def _seed_radii(fa, inward, q):
+    """The largest circle tangent at each foot ``fa`` (inward normal ``inward``) that no point
+    of ``q`` enters: min over q of |q - fa|^2 / (2 (q - fa) . inward), over the q ahead of the
+    tangent (0 when none is). The feet a block at a time in preallocated arrays: the same
+    arithmetic, a quarter of the time of one (feet, q) array per quantity."""
+    n, m = len(fa), len(q)
+    out = np.empty(n)
+    qx, qy = q[None, :, 0], q[None, :, 1]
+    rows = max(1, min(_SEED_ROWS, n))
+    bufs = [np.empty((rows, m)) for _ in range(4)]
+    ahead = np.empty((rows, m), dtype=bool)
+    for k in range(0, n, rows):
+        r = min(rows, n - k)
+        dx, dy, num, den = (x[:r] for x in bufs)
+        ok = ahead[:r]
+        np.subtract(qx, fa[k:k + r, 0:1], out=dx)
+        np.subtract(qy, fa[k:k + r, 1:2], out=dy)
+        np.multiply(dx, dx, out=num)             # num = dx^2 + dy^2
+        np.multiply(dy, dy, out=den)
+        num += den
+        np.multiply(dx, inward[k:k + r, 0:1], out=den)    # den = 2 (dx n_x + dy n_y)
+        dy *= inward[k:k + r, 1:2]
+        den += dy
+        den *= 2.0
+        np.greater(den, 1e-12, out=ok)
+        dx.fill(np.inf)
+        np.divide(num, den, out=dx, where=ok)
+        dx.min(axis=1, out=out[k:k + r])
+    return np.where(np.isfinite(out), out, 0.0)
+
+
 def _circles_from_feet(profile, a, b, ua0):
     """Inscribed circles seeded at feet ua0 on side a: the largest circle tangent there that no
     point of b enters, refined to be exactly equidistant from both sides. Returns centres,
     radii, feet parameters on a, and whether each is a circle of the camber line."""
     fa = profile.eval(ua0)
     inward = -profile.outward_normal(ua0)
-    # Seeds need only be near: every _SEED_STRIDE-th point of b.
-    q = b.xy[::_SEED_STRIDE]
-    dx = q[None, :, 0] - fa[:, None, 0]
-    dy = q[None, :, 1] - fa[:, None, 1]
-    num = dx * dx + dy * dy
-    den = 2.0 * (dx * inward[:, None, 0] + dy * inward[:, None, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        radius = np.where(den > 1e-12, num / den, np.inf)
-    r0 = radius.min(axis=1)
-    r0 = np.where(np.isfinite(r0), r0, 0.0)
+    r0 = _seed_radii(fa, inward, b.xy[::_SEED_STRIDE])
     centre = fa + r0[:, None] * inward
     c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
     r = _norms(fa - c)
