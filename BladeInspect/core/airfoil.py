@@ -11,6 +11,7 @@ is written out in docs/airfoil.md; the names here are the fields of result.json'
 block. Lengths in mm, angles in degrees, counter-clockwise positive in the section's 2D frame.
 """
 
+import math
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -604,14 +605,17 @@ def _medial_axis(profile, a, b):
     # Near a circular edge the feet crowd at the edge's tangency points and their order may
     # differ from the centres' by far below a micrometre: walking out from the middle, keep
     # the centres that go on in the direction of the axis.
+    # (a walk centre by centre: in Python floats, a numpy call per centre cost more)
     mid = len(c) // 2
     keep = [mid, mid + 1]
+    cl = c.tolist()
     for step in (1, -1):
         chain = keep if step == 1 else keep[::-1]
         i = chain[-1] + step
         while 0 <= i < len(c):
-            last, before = c[chain[-1]], c[chain[-2]]
-            if np.dot(c[i] - last, last - before) > 0 and np.linalg.norm(c[i] - last) > 1e-9:
+            (lx, ly), (bx, by), (x, y) = cl[chain[-1]], cl[chain[-2]], cl[i]
+            dx, dy = x - lx, y - ly
+            if dx * (lx - bx) + dy * (ly - by) > 0 and math.sqrt(dx * dx + dy * dy) > 1e-9:
                 chain.append(i)
             i += step
         keep = chain if step == 1 else chain[::-1]
@@ -622,12 +626,18 @@ def _medial_axis(profile, a, b):
 def _thin(c, r):
     """Centres at least _MCL_SPACING_MM apart, both end centres kept: the closing-in rounds
     pack centres far closer than their sub-nanometre scatter allows a tangent to be taken."""
+    cl = c.tolist()       # (Python floats: a numpy call per centre cost more)
+
+    def apart(i, j):
+        dx, dy = cl[i][0] - cl[j][0], cl[i][1] - cl[j][1]
+        return math.sqrt(dx * dx + dy * dy)
+
     keep = [0]
     for i in range(1, len(c)):
-        if np.linalg.norm(c[i] - c[keep[-1]]) >= _MCL_SPACING_MM:
+        if apart(i, keep[-1]) >= _MCL_SPACING_MM:
             keep.append(i)
     if keep[-1] != len(c) - 1:
-        if len(keep) > 1 and np.linalg.norm(c[-1] - c[keep[-1]]) < _MCL_SPACING_MM:
+        if len(keep) > 1 and apart(len(c) - 1, keep[-1]) < _MCL_SPACING_MM:
             keep[-1] = len(c) - 1
         else:
             keep.append(len(c) - 1)
