@@ -966,6 +966,33 @@ def extent(profile, direction):
     return float((_support(profile, d, 1) - _support(profile, d, -1)) @ d)
 
 
+_PAIR_ROWS = 64
+
+
+def _farthest_column(xy):
+    """j of the first (row-major) pair (i, j) of points furthest apart: the argmax of the
+    (n, n) matrix of x^2 + y^2 (two planes: a sum over a length-2 last axis is numpy's slow
+    case), a block of _PAIR_ROWS rows at a time in two preallocated arrays (the same
+    arithmetic, a third of the time of whole-matrix temporaries)."""
+    n = len(xy)
+    rows = max(1, min(_PAIR_ROWS, n))
+    x, y = xy[None, :, 0], xy[None, :, 1]
+    bx, by = np.empty((rows, n)), np.empty((rows, n))
+    best, where = None, 0
+    for k in range(0, n, rows):
+        r = min(rows, n - k)
+        dx, dy = bx[:r], by[:r]
+        np.subtract(xy[k:k + r, 0:1], x, out=dx)
+        np.subtract(xy[k:k + r, 1:2], y, out=dy)
+        np.square(dx, out=dx)
+        np.square(dy, out=dy)
+        dx += dy
+        a = int(np.argmax(dx))
+        if best is None or dx.flat[a] > best:      # (a tie: the earlier pair, as argmax)
+            best, where = dx.flat[a], a % n
+    return where
+
+
 def _farthest_pair(profile):
     """Maximum Feret (caliper) diameter: the two profile points furthest apart. Each end is the
     point of the curve furthest from the other: the furthest dense sample, then Newton steps
@@ -973,9 +1000,7 @@ def _farthest_pair(profile):
     stationary too)."""
     hull = profile.dense[profile.hull_vertices()]
     hull = hull[::max(1, len(hull) // 400)]
-    # x^2 + y^2 per pair as two planes (a sum over a length-2 last axis is numpy's slow case)
-    d2 = (hull[:, None, 0] - hull[None, :, 0]) ** 2 + (hull[:, None, 1] - hull[None, :, 1]) ** 2
-    i, j = np.unravel_index(np.argmax(d2), d2.shape)
+    j = _farthest_column(hull)
     spacing = profile.length / len(profile.dense)
     uj = profile.nearest_param(hull[j])
 
