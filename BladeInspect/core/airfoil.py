@@ -11,6 +11,7 @@ is written out in docs/airfoil.md; the names here are the fields of result.json'
 block. Lengths in mm, angles in degrees, counter-clockwise positive in the section's 2D frame.
 """
 
+import math
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -119,6 +120,7 @@ class Profile:
         keep = (pieces[0].x[:-1] >= 0.0) & (pieces[0].x[:-1] < self.length)
         keep &= np.diff(pieces[0].x) > 0
         self._breaks = pieces[0].x[:-1][keep]
+        self._clamp = not self._breaks[0] <= 0.0
         self._coef = np.stack([pp.c[:, keep] for pp in pieces], axis=-1).transpose(1, 0, 2)
         # the same coefficients one contiguous (pieces, 2) array per power: a gather of many
         # parameters' pieces from these and the Horner steps on contiguous rows run ~1.5x
@@ -141,6 +143,12 @@ class Profile:
             return (3.0 * c0 * t + 2.0 * c1) * t + c2
         return self.eval3(u)[der]
 
+    def eval01(self, u):
+        """Points and first derivatives at parameters u (eval's and eval3's arithmetic, one
+        piece lookup for both)."""
+        t, (c0, c1, c2, c3) = self._pieces(u)
+        return ((c0 * t + c1) * t + c2) * t + c3, (3.0 * c0 * t + 2.0 * c1) * t + c2
+
     def _pieces(self, u):
         """Each parameter's offset into its spline piece and that piece's coefficients (a
         sequence of the four powers' (n, 2) arrays, highest first)."""
@@ -148,7 +156,10 @@ class Profile:
         # arithmetic on the few parameters of most calls; the same values)
         u = np.asarray(u, dtype=float).reshape(-1) % self.length
         i = self._breaks.searchsorted(u, side="right") - 1
-        i = np.minimum(np.maximum(i, 0), len(self._coef) - 1)
+        # i <= len(breaks) - 1 always; i >= 0 as u >= 0 when the first break is at 0 (as
+        # FITPACK's knots of a parameter starting at 0 put it)
+        if self._clamp:
+            i = np.maximum(i, 0)
         t = (u - self._breaks[i])[:, None]
         if len(i) < _GATHER_SPLIT:
             c = self._coef[i]          # few parameters: one gather costs less than four
@@ -204,7 +215,7 @@ class Profile:
         u = self.nearest_param(xy) if u0 is None else np.array(u0, dtype=float)
         # Each point stops once its own step is below 1e-13 of the length (that step taken).
         tol = 1e-13 * self.length
-        run = np.arange(len(u))
+        run = None                  # the rows still going: all of them while run is None
         ur, xr = u, xy
         if lo is not None:
             lo = np.broadcast_to(lo, u.shape)
@@ -215,17 +226,30 @@ class Profile:
             if lo is not None:
                 new = np.minimum(np.maximum(new, lr), hr)
             going = np.abs(new - ur) >= tol
-            u[run] = new
-            if not going.any():
+            n_going = np.count_nonzero(going)
+            if run is None:
+                u = new
+            else:
+                u[run] = new
+            if n_going == 0:
                 break
-            run, ur, xr = run[going], new[going], xr[going]
+            if n_going == len(going):       # (no row stopped: the same rows, no gather)
+                ur = new
+                continue
+            run = np.flatnonzero(going) if run is None else run[going]
+            ur, xr = new[going], xr[going]
             if lo is not None:
                 lr, hr = lr[going], hr[going]
         return u, self.eval(u)
 
     def _newton_stationary(self, u, xy):
         # Stationary points of |S(u) - xy|^2: the closest point when started next to it.
-        s, s1, s2 = self.eval3(u)
+        # (eval3's arithmetic inline, 2 c1 taken once: the hot loop's fewest calls)
+        t, (c0, c1, c2, c3) = self._pieces(u)
+        c1x2 = 2.0 * c1
+        s = ((c0 * t + c1) * t + c2) * t + c3
+        s1 = (3.0 * c0 * t + c1x2) * t + c2
+        s2 = 6.0 * c0 * t + c1x2
         d = s - xy
         g = np.einsum("ij,ij->i", d, s1)
         speed2 = np.einsum("ij,ij->i", s1, s1)
@@ -265,9 +289,7 @@ def _refit_in_arc_length(pts, first, first_length, noise_mm):
     table_u = np.linspace(0.0, first_length, n_table + 1)
     table = np.column_stack(splev(table_u, first))
     arc = np.concatenate([[0.0], np.cumsum(_norms(np.diff(table, axis=0)))])
-    # (a midpoint-split tree: built in 2/3 of the time of a balanced one, the same nearest)
-    foot = table_u[cKDTree(table[:-1], balanced_tree=False, compact_nodes=False)
-                   .query(pts)[1]]
+    foot = table_u[_nearest_sample(table[:-1], arc[:-1], pts)]
     for _ in range(_FOOT_NEWTON):
         p, d1, d2 = (np.column_stack(splev(foot, first, der=k)) for k in range(3))
         g = np.einsum("ij,ij->i", p - pts, d1)
@@ -302,6 +324,55 @@ def _refit_in_arc_length(pts, first, first_length, noise_mm):
     tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u,
                      s=(len(pts) - _FREE_SHARE * free) * sigma ** 2, per=1, k=3, quiet=1)
     return pts, s, tck
+
+
+_NEAR_BLOCK, _NEAR_BLOCKS = 32, 8      # _nearest_sample: samples a block, blocks looked at
+
+
+def _nearest_sample(table, arc, pts):
+    """The index of each point's nearest row of ``table`` (samples along a curve, ``arc``
+    their arc lengths): a k-d tree's answer, without a tree of the whole table (10^5 samples:
+    its build cost 7 ms a section). The table is cut into blocks of _NEAR_BLOCK consecutive
+    samples, each within ``reach`` (the largest block's arc length) of its first sample; a
+    tree of the first samples gives each point its _NEAR_BLOCKS nearest blocks, and of those
+    every block whose first sample is within the nearest one's distance plus ``reach`` (no
+    other can hold a nearer sample) is searched sample by sample. A point whose last block
+    looked at is still that near (blocks further may count) asks a tree of the whole table."""
+    n, m = len(table), len(pts)
+    size = _NEAR_BLOCK
+    nb = -(-n // size)
+    pad = nb * size - n        # the last block filled up with copies of the last sample
+    full = np.concatenate([table, np.repeat(table[-1:], pad, axis=0)]) if pad else table
+    blocks = full.reshape(nb, size, 2)
+    starts = np.arange(nb) * size
+    reach = float((arc[np.minimum(starts + size - 1, n - 1)] - arc[starts]).max())
+    reach = reach * (1.0 + 1e-9) + 1e-12      # (a chord is never longer than its arc)
+    k = min(_NEAR_BLOCKS, nb)
+    dk, ik = cKDTree(blocks[:, 0]).query(pts, k=k)
+    dk, ik = dk.reshape(m, k), ik.reshape(m, k)
+    near = dk <= dk[:, :1] + reach
+    sure = ~near[:, -1] if k < nb else np.ones(m, bool)
+    pi, pj = np.nonzero(near & sure[:, None])
+    block = ik[pi, pj]
+    c = blocks[block]
+    dx = c[..., 0] - pts[pi, 0:1]
+    dy = c[..., 1] - pts[pi, 1:2]
+    d2 = dx * dx + dy * dy
+    arg = d2.argmin(axis=1)
+    best = d2[np.arange(len(pi)), arg]
+    idx = np.minimum(block * size + arg, n - 1)     # (a copy is never before its sample)
+    # each point's nearest of its blocks' (of equal distances, the lowest index)
+    order = np.lexsort((idx, best, pi))
+    first = order[np.concatenate([[True], pi[order][1:] != pi[order][:-1]])] \
+        if len(order) else order
+    out = np.empty(m, dtype=np.intp)
+    out[pi[first]] = idx[first]
+    if not sure.all():
+        # (a midpoint-split tree: built in 2/3 of the time of a balanced one, the same
+        # nearest)
+        out[~sure] = cKDTree(table, balanced_tree=False, compact_nodes=False) \
+            .query(pts[~sure])[1]
+    return out
 
 
 def _corners(pts):
@@ -356,6 +427,11 @@ class _Side:
     tree: cKDTree
 
 
+def _side_range(profile, lo, hi):
+    """A side's unwrapped parameter range, lo < hi (as _side's)."""
+    return _Range(lo, hi + profile.length if hi <= lo else hi)
+
+
 def _side(profile, lo, hi):
     if hi <= lo:
         hi += profile.length
@@ -408,22 +484,47 @@ def _feet(profile, a, b, xy, ua=None, ub=None):
     return u[:n], u[n:], foot[:n], foot[n:]
 
 
+_SEED_ROWS = 32            # _seed_radii: feet per block (its arrays stay in the cache)
+
+
+def _seed_radii(fa, inward, q):
+    """The largest circle tangent at each foot ``fa`` (inward normal ``inward``) that no point
+    of ``q`` enters: min over q of |q - fa|^2 / (2 (q - fa) . inward), over the q ahead of the
+    tangent (0 when none is). The feet a block at a time in preallocated arrays: the same
+    arithmetic, a quarter of the time of one (feet, q) array per quantity."""
+    n, m = len(fa), len(q)
+    out = np.empty(n)
+    qx, qy = q[None, :, 0], q[None, :, 1]
+    rows = max(1, min(_SEED_ROWS, n))
+    bufs = [np.empty((rows, m)) for _ in range(4)]
+    ahead = np.empty((rows, m), dtype=bool)
+    for k in range(0, n, rows):
+        r = min(rows, n - k)
+        dx, dy, num, den = (x[:r] for x in bufs)
+        ok = ahead[:r]
+        np.subtract(qx, fa[k:k + r, 0:1], out=dx)
+        np.subtract(qy, fa[k:k + r, 1:2], out=dy)
+        np.multiply(dx, dx, out=num)             # num = dx^2 + dy^2
+        np.multiply(dy, dy, out=den)
+        num += den
+        np.multiply(dx, inward[k:k + r, 0:1], out=den)    # den = 2 (dx n_x + dy n_y)
+        dy *= inward[k:k + r, 1:2]
+        den += dy
+        den *= 2.0
+        np.greater(den, 1e-12, out=ok)
+        dx.fill(np.inf)
+        np.divide(num, den, out=dx, where=ok)
+        dx.min(axis=1, out=out[k:k + r])
+    return np.where(np.isfinite(out), out, 0.0)
+
+
 def _circles_from_feet(profile, a, b, ua0):
     """Inscribed circles seeded at feet ua0 on side a: the largest circle tangent there that no
     point of b enters, refined to be exactly equidistant from both sides. Returns centres,
     radii, feet parameters on a, and whether each is a circle of the camber line."""
     fa = profile.eval(ua0)
     inward = -profile.outward_normal(ua0)
-    # Seeds need only be near: every _SEED_STRIDE-th point of b.
-    q = b.xy[::_SEED_STRIDE]
-    dx = q[None, :, 0] - fa[:, None, 0]
-    dy = q[None, :, 1] - fa[:, None, 1]
-    num = dx * dx + dy * dy
-    den = 2.0 * (dx * inward[:, None, 0] + dy * inward[:, None, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        radius = np.where(den > 1e-12, num / den, np.inf)
-    r0 = radius.min(axis=1)
-    r0 = np.where(np.isfinite(r0), r0, 0.0)
+    r0 = _seed_radii(fa, inward, b.xy[::_SEED_STRIDE])
     centre = fa + r0[:, None] * inward
     c, ua, ub, fa, fb = _refine_centres(profile, a, b, centre)
     r = _norms(fa - c)
@@ -509,14 +610,17 @@ def _medial_axis(profile, a, b):
     # Near a circular edge the feet crowd at the edge's tangency points and their order may
     # differ from the centres' by far below a micrometre: walking out from the middle, keep
     # the centres that go on in the direction of the axis.
+    # (a walk centre by centre: in Python floats, a numpy call per centre cost more)
     mid = len(c) // 2
     keep = [mid, mid + 1]
+    cl = c.tolist()
     for step in (1, -1):
         chain = keep if step == 1 else keep[::-1]
         i = chain[-1] + step
         while 0 <= i < len(c):
-            last, before = c[chain[-1]], c[chain[-2]]
-            if np.dot(c[i] - last, last - before) > 0 and np.linalg.norm(c[i] - last) > 1e-9:
+            (lx, ly), (bx, by), (x, y) = cl[chain[-1]], cl[chain[-2]], cl[i]
+            dx, dy = x - lx, y - ly
+            if dx * (lx - bx) + dy * (ly - by) > 0 and math.sqrt(dx * dx + dy * dy) > 1e-9:
                 chain.append(i)
             i += step
         keep = chain if step == 1 else chain[::-1]
@@ -527,12 +631,18 @@ def _medial_axis(profile, a, b):
 def _thin(c, r):
     """Centres at least _MCL_SPACING_MM apart, both end centres kept: the closing-in rounds
     pack centres far closer than their sub-nanometre scatter allows a tangent to be taken."""
+    cl = c.tolist()       # (Python floats: a numpy call per centre cost more)
+
+    def apart(i, j):
+        dx, dy = cl[i][0] - cl[j][0], cl[i][1] - cl[j][1]
+        return math.sqrt(dx * dx + dy * dy)
+
     keep = [0]
     for i in range(1, len(c)):
-        if np.linalg.norm(c[i] - c[keep[-1]]) >= _MCL_SPACING_MM:
+        if apart(i, keep[-1]) >= _MCL_SPACING_MM:
             keep.append(i)
     if keep[-1] != len(c) - 1:
-        if len(keep) > 1 and np.linalg.norm(c[-1] - c[keep[-1]]) < _MCL_SPACING_MM:
+        if len(keep) > 1 and apart(len(c) - 1, keep[-1]) < _MCL_SPACING_MM:
             keep[-1] = len(c) - 1
         else:
             keep.append(len(c) - 1)
@@ -756,8 +866,9 @@ def _line_hit(profile, origin, direction, u):
     origin = np.atleast_2d(origin)
     direction = np.atleast_2d(direction)
     for _ in range(_NEWTON_ITERATIONS):
-        f = _cross2(profile.eval(u) - origin, direction)
-        df = _cross2(profile.eval(u, 1), direction)
+        p, d1 = profile.eval01(u)
+        f = _cross2(p - origin, direction)
+        df = _cross2(d1, direction)
         u = u - f / np.where(np.abs(df) > 1e-15, df, 1e-15)
     return u, profile.eval(u)
 
@@ -771,24 +882,27 @@ def _thickness_normal(profile, mcl, s):
     p, q = profile.dense, np.roll(profile.dense, -1, axis=0)
     e = q - p
     h = profile.length / len(profile.dense)
-    starts, found = [], []
-    for k in range(len(s)):
-        den = _cross2(n[k], e)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = _cross2(p - m[k], e) / den
-            lam = _cross2(p - m[k], n[k]) / den
-        ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
-        plus, minus = ok & (tau > 0), ok & (tau < 0)
-        if not plus.any() or not minus.any():
-            continue
-        ip = np.flatnonzero(plus)[np.argmin(tau[plus])]
-        im = np.flatnonzero(minus)[np.argmax(tau[minus])]
-        starts.append(profile.dense_u[[ip, im]] + lam[[ip, im]] * h)
-        found.append(k)
-    if found:
-        # every crossing's Newton run in one call (each runs its fixed steps alone)
+    # every station against every dense segment at once (rows: stations), _cross2's
+    # arithmetic element by element
+    pm = p[None, :, :] - m[:, None, :]
+    n0, n1 = n[:, 0:1], n[:, 1:2]
+    den = n0 * e[None, :, 1] - n1 * e[None, :, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = _cross2(pm, e[None]) / den
+        lam = (pm[..., 0] * n1 - pm[..., 1] * n0) / den
+    ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1)
+    plus, minus = ok & (tau > 0), ok & (tau < 0)
+    found = np.flatnonzero(plus.any(axis=1) & minus.any(axis=1))
+    if len(found):
+        # the nearest crossing on each side: the first of the least positive tau, of the
+        # greatest negative one
+        ip = np.argmin(np.where(plus[found], tau[found], np.inf), axis=1)
+        im = np.argmax(np.where(minus[found], tau[found], -np.inf), axis=1)
+        seg = np.column_stack([ip, im]).ravel()
         rows = np.repeat(found, 2)
-        _, xy = _line_hit(profile, m[rows], n[rows], np.concatenate(starts))
+        starts = profile.dense_u[seg] + lam[rows, seg] * h
+        # every crossing's Newton run in one call (each runs its fixed steps alone)
+        _, xy = _line_hit(profile, m[rows], n[rows], starts)
         out[found] = _norms(xy[0::2] - xy[1::2])
     return out
 
@@ -844,8 +958,9 @@ def _support(profile, direction, sign):
     proj = sign * (profile.dense @ direction)
     u = np.array([profile.dense_u[np.argmax(proj)]])
     for _ in range(_NEWTON_ITERATIONS):
-        g = profile.eval(u, 1) @ direction
-        h = profile.eval(u, 2) @ direction
+        _, d1, d2 = profile.eval3(u)
+        g = d1 @ direction
+        h = d2 @ direction
         u = u - g / np.where(np.abs(h) > 1e-15, h, 1e-15)
     return profile.eval(u)[0]
 
@@ -856,6 +971,33 @@ def extent(profile, direction):
     return float((_support(profile, d, 1) - _support(profile, d, -1)) @ d)
 
 
+_PAIR_ROWS = 64
+
+
+def _farthest_column(xy):
+    """j of the first (row-major) pair (i, j) of points furthest apart: the argmax of the
+    (n, n) matrix of x^2 + y^2 (two planes: a sum over a length-2 last axis is numpy's slow
+    case), a block of _PAIR_ROWS rows at a time in two preallocated arrays (the same
+    arithmetic, a third of the time of whole-matrix temporaries)."""
+    n = len(xy)
+    rows = max(1, min(_PAIR_ROWS, n))
+    x, y = xy[None, :, 0], xy[None, :, 1]
+    bx, by = np.empty((rows, n)), np.empty((rows, n))
+    best, where = None, 0
+    for k in range(0, n, rows):
+        r = min(rows, n - k)
+        dx, dy = bx[:r], by[:r]
+        np.subtract(xy[k:k + r, 0:1], x, out=dx)
+        np.subtract(xy[k:k + r, 1:2], y, out=dy)
+        np.square(dx, out=dx)
+        np.square(dy, out=dy)
+        dx += dy
+        a = int(np.argmax(dx))
+        if best is None or dx.flat[a] > best:      # (a tie: the earlier pair, as argmax)
+            best, where = dx.flat[a], a % n
+    return where
+
+
 def _farthest_pair(profile):
     """Maximum Feret (caliper) diameter: the two profile points furthest apart. Each end is the
     point of the curve furthest from the other: the furthest dense sample, then Newton steps
@@ -863,9 +1005,7 @@ def _farthest_pair(profile):
     stationary too)."""
     hull = profile.dense[profile.hull_vertices()]
     hull = hull[::max(1, len(hull) // 400)]
-    # x^2 + y^2 per pair as two planes (a sum over a length-2 last axis is numpy's slow case)
-    d2 = (hull[:, None, 0] - hull[None, :, 0]) ** 2 + (hull[:, None, 1] - hull[None, :, 1]) ** 2
-    i, j = np.unravel_index(np.argmax(d2), d2.shape)
+    j = _farthest_column(hull)
     spacing = profile.length / len(profile.dense)
     uj = profile.nearest_param(hull[j])
 
@@ -1233,7 +1373,9 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     nose_tail = float(np.linalg.norm(te - le))
     chord_dir = (te - le) / nose_tail
     # The two sides between the edge points; the suction side is the longer one (convex).
-    s1, s2 = _side(profile, le_u % L, te_u % L), _side(profile, te_u % L, le_u % L + L)
+    # (their parameter ranges only: no samples or tree of them is wanted)
+    s1, s2 = _side_range(profile, le_u % L, te_u % L), _side_range(profile, te_u % L,
+                                                                   le_u % L + L)
     suction, pressure = (s1, s2) if (s1.hi - s1.lo) >= (s2.hi - s2.lo) else (s2, s1)
 
     bitangent = _pressure_bitangent(profile, pressure, le_u, te_u)
@@ -1268,11 +1410,14 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     max_pos = 100.0 * x_pos / nose_tail
 
     stations = [float(p) for p in stations_pct]
-    thickness = _thickness_normal(profile, mcl, _stations_to_arc(mcl, le, chord_dir,
-                                                                 nose_tail, stations)).tolist()
     offsets = [float(d) for d in edge_offsets_mm]
-    le_thk = _thickness_normal(profile, mcl, np.array(offsets)).tolist()
-    te_thk = _thickness_normal(profile, mcl, mcl.length - np.array(offsets)).tolist()
+    # the stations' and both edges' thicknesses in one call (each its own crossings)
+    s_all = np.concatenate([_stations_to_arc(mcl, le, chord_dir, nose_tail, stations),
+                            np.array(offsets), mcl.length - np.array(offsets)])
+    thk = _thickness_normal(profile, mcl, s_all).tolist()
+    n_st, n_off = len(stations), len(offsets)
+    thickness = thk[:n_st]
+    le_thk, te_thk = thk[n_st:n_st + n_off], thk[n_st + n_off:]
 
     area, centroid = area_centroid(profile)
     warnings = _corner_warnings(profile, le, te, nose_tail) + notes
@@ -1430,7 +1575,7 @@ def area_centroid(profile):
     """Area and centroid of the spline-bounded region (Green's theorem, exact quadrature of
     the piecewise-polynomial integrands)."""
     u, w = profile.knot_quadrature(5)
-    p, d = profile.eval(u), profile.eval(u, 1)
+    p, d = profile.eval01(u)
     x, y, dx, dy = p[:, 0], p[:, 1], d[:, 0], d[:, 1]
     area = 0.5 * np.sum(w * (x * dy - y * dx))
     cx = np.sum(w * x * x * dy) / (2.0 * area)
