@@ -389,10 +389,13 @@ NOMINAL_CACHE_SIZE = 16
 _NOMINAL_CACHE = {}
 
 
-def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstream):
+def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstream,
+                            states=None):
     """kernel.characteristics of a nominal cut (engine axis +x of its frame), remembered
     (above); each call has its own Characteristics (its own warnings list), the numbers and
-    the profile shared."""
+    the profile shared. ``states``: a dict of computed cuts by the same key
+    (kernel.characteristics_state; an uncertainty task file keeps its nominal cuts so): a cut
+    found there is read back instead of computed (the same bits), one computed is added."""
     xy = np.ascontiguousarray(xy, dtype=float)
     h = hashlib.sha256(xy.tobytes())
     h.update(repr((xy.shape, chord_method, [float(v) for v in edge_offsets_mm],
@@ -401,10 +404,14 @@ def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstr
              .encode())
     key = h.hexdigest()
     ch = _NOMINAL_CACHE.pop(key, None)
+    if ch is None and states is not None and key in states:
+        ch = kernel.characteristics_from_state(states[key], kernel.Profile(xy))
     if ch is None:
         ch = kernel.characteristics(xy, engine_axis=(1.0, 0.0), chord_method=chord_method,
                                     edge_offsets_mm=edge_offsets_mm, le_hint=le_hint,
                                     le_upstream=le_upstream)
+    if states is not None and key not in states:
+        states[key] = kernel.characteristics_state(ch)
     _NOMINAL_CACHE[key] = ch            # the most recent last
     while len(_NOMINAL_CACHE) > NOMINAL_CACHE_SIZE:
         del _NOMINAL_CACHE[next(iter(_NOMINAL_CACHE))]
@@ -429,7 +436,7 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
         upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
         nom = nominal_characteristics(xy, opts.chord_method, opts.edge_offsets_mm, hint,
-                                      upstream)
+                                      upstream, None if task is None else task.nominal)
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])

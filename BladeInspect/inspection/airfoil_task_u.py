@@ -47,6 +47,14 @@ A section that does not match is computed afresh with the blade's own re-fit
 and per section which way its u was found (``uncertainty_task``); each block says it too
 (``uncertainty_method``, ``uncertainty_draws``).
 
+The file also keeps the task's nominal cuts (``nominal``: inspection.airfoil.
+nominal_characteristics' key, a sha256 of the cut's points and the kernel's arguments, ->
+core.airfoil.characteristics_state), made by the first blade: a later blade's nominal cut of
+the very same points is read back, to the bit, instead of computed (the cost of a nominal
+cut is as large as a measured one's); a cut of other points (an `inspect`'s planes fitted to
+its blade) is computed. ``nominal_digest`` guards them: a file whose kept cuts were changed is
+refused as damaged. Files made before the cuts were kept have none and stay valid.
+
 When the file named does not exist, the stage makes it: every measured section's u from
 ``Options.task_draws`` re-fits (that blade's u is then the 48-draw one), written atomically
 (a temporary file in the same folder, then os.replace). The file is never changed afterwards.
@@ -185,6 +193,9 @@ class TaskUncertainty:
     sections: dict = field(default_factory=dict)    # label -> {plane, conditions, sd}
     path: str = None
     made: bool = True
+    # the nominal cuts' characteristics (inspection.airfoil.nominal_characteristics' key ->
+    # kernel.characteristics_state): a task's nominal is the same for every blade of it
+    nominal: dict = field(default_factory=dict)
 
     def describe(self):
         return ("task-specific (file %s, made from %d draws on %s, seed %d%s)"
@@ -195,7 +206,8 @@ class TaskUncertainty:
         return {"kind": FILE_KIND, "version": TASK_MODEL_VERSION, "key": self.key,
                 "key_digest": digest(self.key), "draws": self.draws, "seed": self.seed,
                 "made_utc": self.made_utc, "made_from": self.made_from,
-                "match_rule": MATCH_RULE_TEXT, "sections": self.sections}
+                "match_rule": MATCH_RULE_TEXT, "sections": self.sections,
+                "nominal": self.nominal, "nominal_digest": digest(self.nominal)}
 
     def finish(self):
         """A task just made: written to its file (when a section was measured), or marked
@@ -243,11 +255,17 @@ def load(path):
                  np.asarray(s["plane"]["normal"], dtype=float).reshape(3),
                  [float(s["conditions"][k]) for k in MATCH_RULE],
                  {k: (None if v is None else float(v)) for k, v in s["sd"].items()})
+        # files made before the nominal cuts were kept have none (they are computed)
+        nominal = doc.get("nominal") or {}
+        if not isinstance(nominal, dict) or (nominal and doc.get("nominal_digest")
+                                             != digest(nominal)):
+            raise ValueError("its nominal cuts do not match their nominal_digest")
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError("%s: uncertainty task file is damaged (%s); delete it to compute the "
                          "task afresh" % (path, exc))
     return TaskUncertainty(key=key, draws=draws, seed=seed, made_utc=doc.get("made_utc"),
-                           made_from=doc.get("made_from") or "", sections=sections, path=path)
+                           made_from=doc.get("made_from") or "", sections=sections, path=path,
+                           nominal=nominal)
 
 
 def check_file(path):
