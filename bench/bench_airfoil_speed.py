@@ -21,10 +21,12 @@ The figure: blade 2's run_stage (nominal and measured characteristics of the fiv
 their U from the task file) ``--repeats`` times (default 5), each beside a draws-0 run of the
 same blade (interleaved), in CPU seconds of this process, with the nominal cuts' remembered
 characteristics (inspection.airfoil.nominal_characteristics) forgotten first, as in a
-one-blade process (report, inspect), and once more with them remembered (a batch worker's next
-blade); the last line states the medians, the range and the load average (os.getloadavg,
-uptime's) before and after, and whether the medians are under 1 s. CPU seconds rise with the machine's load (two shared cores: caches, memory
-bandwidth), so the load goes with the figure. ``--figure-only`` skips the other figures and
+one-blade process (report, inspect), and for blade 3 with them remembered (a batch worker's
+next blade; another blade, so that no foot of blade 2's points on a nominal profile serves
+it); the last line states the medians, the range and the load average (os.getloadavg,
+uptime's) before and after, and whether the medians are under 1 s. CPU seconds rise with the
+machine's load (two shared cores: caches, memory bandwidth), so the load goes with the
+figure. ``--figure-only`` skips the other figures and
 makes the task file from 2 draws (blade 2 reuses only the draws' sigma: its cost does not
 depend on how many draws made the file).
 """
@@ -88,6 +90,9 @@ def task_case(nominal, draws, repeats=5):
           % (name, draws, cpu, len(stage.blocks),
              "/".join(stage.settings["uncertainty_task"]["sections"].values())))
     table, result = planned_case(nominal, seed=1)
+    # a batch worker's next blade is another blade: the nominal profiles' remembered feet of
+    # blade 2's points must not serve it (they would, measuring blade 2 again)
+    table3, result3 = planned_case(nominal, seed=2)
     load_before = _load()
     reused, bare, warm = [], [], []
     for repeat in range(repeats):
@@ -101,11 +106,11 @@ def task_case(nominal, draws, repeats=5):
         cpu0, _ = stage_cpu(nominal, table, result, 0)
         bare.append(cpu0)
         print("%s: blade 2, draws 0 beside it: %.2f s CPU" % (name, cpu0))
-        # a batch worker's next blade: the nominal cuts' characteristics remembered
-        cpu1, _ = stage_cpu(nominal, table, result, stage_mod.DEFAULT_DRAWS, warm=True,
+        # a batch worker's next blade (blade 3): the nominal cuts' characteristics remembered
+        cpu1, _ = stage_cpu(nominal, table3, result3, stage_mod.DEFAULT_DRAWS, warm=True,
                             task_uncertainty=path)
         warm.append(cpu1)
-        print("%s: blade 2 reuses it, nominal cuts remembered (a batch worker's next blade): "
+        print("%s: blade 3 reuses it, nominal cuts remembered (a batch worker's next blade): "
               "%.2f s CPU" % (name, cpu1))
     os.unlink(path)
     os.rmdir(folder)
