@@ -434,8 +434,8 @@ def _side_range(profile, lo, hi):
 
 
 def _side(profile, lo, hi):
-    if hi <= lo:
-        hi += profile.length
+    side = _side_range(profile, lo, hi)
+    lo, hi = side.lo, side.hi
     u = profile.dense_u.copy()
     u = np.where(u < lo, u + profile.length, u)
     keep = (u >= lo) & (u <= hi)
@@ -1327,8 +1327,6 @@ def characteristics_from_state(state, profile):
     """The Characteristics of ``state`` (characteristics_state) on ``profile``: the Profile of
     the points the state was computed from. A state missing a field or holding a value of the
     wrong kind raises InputError."""
-    if not isinstance(profile, Profile):
-        profile = Profile(profile)
     try:
         values = {f.name: _value_of_state(state[f.name])
                   for f in dataclasses.fields(Characteristics) if f.name != "profile"}
