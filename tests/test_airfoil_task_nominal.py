@@ -150,6 +150,21 @@ class TaskKeepsTheNominal(unittest.TestCase):
         self.assertEqual(len(states), len(doc["nominal"]) + 1)   # a new key, none reused
         _same(ch, kernel.characteristics(xy, edge_offsets_mm=(0.5, 1.0, 2.0)))
 
+    def test_a_kept_cut_of_another_version_is_computed(self):
+        """A kept state that no longer fits Characteristics (a field it lacks, as a file made
+        by an older version would) is computed afresh and kept anew, not a section lost."""
+        xy = ArcSection().points(0.05)
+        args = ("nose-tail", (0.5, 1.0, 2.0), None, None)
+        states = {}
+        stage_mod.clear_nominal_cache()
+        stage_mod.nominal_characteristics(xy, *args, states)
+        (key, state), = states.items()
+        del state["le_circle"]
+        stage_mod.clear_nominal_cache()
+        ch = stage_mod.nominal_characteristics(xy, *args, states)
+        _same(ch, kernel.characteristics(xy, edge_offsets_mm=(0.5, 1.0, 2.0)))
+        self.assertIn("le_circle", states[key])
+
     def test_changed_nominal_cut_refused(self):
         doc = json.load(open(self.path))
         key = sorted(doc["nominal"])[0]

@@ -405,7 +405,12 @@ def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstr
     key = h.hexdigest()
     ch = _NOMINAL_CACHE.pop(key, None)
     if ch is None and states is not None and key in states:
-        ch = kernel.characteristics_from_state(states[key], kernel.Profile(xy))
+        try:
+            ch = kernel.characteristics_from_state(states[key], kernel.Profile(xy))
+        except InputError:
+            # a kept cut that no longer fits Characteristics (made by another version of
+            # it) is computed afresh, not taken for a section the kernel cannot read
+            del states[key]
     if ch is None:
         ch = kernel.characteristics(xy, engine_axis=(1.0, 0.0), chord_method=chord_method,
                                     edge_offsets_mm=edge_offsets_mm, le_hint=le_hint,
