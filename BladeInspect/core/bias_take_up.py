@@ -67,10 +67,18 @@ def take_up(points, normals, beams, weights, center, max_incidence_rad=None):
     points, normals, beams: (N, 3), one frame (normals and beams unit); weights (N,);
     max_incidence_rad: the sensor's largest incidence (None: no point is an edge foot)."""
     keep = takes_part(points, normals, beams, weights, max_incidence_rad)
-    if not keep.any():
+    return take_up_of(points, normals, beams, weights, center, keep)
+
+
+def take_up_of(points, normals, displacements, weights, center, keep):
+    """(6,) the weighted least-squares rigid motion (take_up's r) whose normal parts best fit
+    those of the points' ``displacements`` (N, 3), any small error field linear in one
+    parameter (a unit reading bias: the beams; an axis error's field,
+    inspection.uncertainty.calibration_fields), over the points ``keep``."""
+    if not np.any(keep):
         return np.zeros(6)
     normals = np.asarray(normals, dtype=float)[keep]
-    beta = beam_normal(normals, np.asarray(beams, dtype=float)[keep])
+    beta = beam_normal(normals, np.asarray(displacements, dtype=float)[keep])
     w = np.asarray(weights, dtype=float)[keep]
     J = rigid_jacobian(np.asarray(points, dtype=float)[keep], normals, center)
     JW = J.T * w

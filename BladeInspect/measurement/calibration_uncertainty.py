@@ -91,18 +91,33 @@ def parameter_covariance(centres, centre_covariances):
 def error_jacobian(kinematics, parameters, table_point, angle_deg):
     """(3, 4): the table-frame error of ``table_point`` read at ``angle_deg`` per unit error of
     each axis parameter (module notes)."""
-    q = np.asarray(table_point, dtype=float).reshape(1, 3)
+    return error_fields(kinematics, parameters, np.reshape(table_point, (1, 3)),
+                        [float(angle_deg)])[0]
+
+
+def error_fields(kinematics, parameters, table_points, angles_deg):
+    """(N, 3, 4): error_jacobian of each table-frame point (N, 3) read at its own angle (N,),
+    one pass of the central differences per distinct angle (a scan's readings come at a few
+    dozen rotary angles)."""
+    q = np.asarray(table_points, dtype=float).reshape(-1, 3)
+    angles = np.asarray(angles_deg, dtype=float).reshape(-1)
+    if len(angles) != len(q):
+        raise ValueError("error_fields: %d points, %d angles" % (len(q), len(angles)))
+    parameters = np.asarray(parameters, dtype=float)
     believed = kinematics_with(kinematics, parameters)
-    G = np.zeros((3, 4))
+    moved = []
     for k in range(4):
         step = np.zeros(4)
         step[k] = PARAMETER_STEP
-        placed = []
-        for sign in (1.0, -1.0):
-            true = kinematics_with(kinematics, parameters + sign * step)
-            placed.append(believed.table_point(true.machine_point_of_table(q, angle_deg),
-                                               angle_deg)[0])
-        G[:, k] = (placed[0] - placed[1]) / (2.0 * PARAMETER_STEP)
+        moved.append([kinematics_with(kinematics, parameters + sign * step)
+                      for sign in (1.0, -1.0)])
+    G = np.zeros((len(q), 3, 4))
+    for angle in np.unique(angles):
+        at = angles == angle
+        for k, (plus, minus) in enumerate(moved):
+            placed = [believed.table_point(true.machine_point_of_table(q[at], angle), angle)
+                      for true in (plus, minus)]
+            G[at, :, k] = (placed[0] - placed[1]) / (2.0 * PARAMETER_STEP)
     return G
 
 
