@@ -24,7 +24,9 @@ The task (the file's ``key``; a file made for another task is refused, never reu
 - the airfoil options that change the values: engine_axis, chord_method, edge_offsets_mm,
   le_rule;
 - the sensor the draws use (every field of its rig.sensor.SensorModel, accuracy included);
-- the rig calibration's 1 sigma at the part (``calibration_mm``), only when the run has one;
+- the rig calibration's 1 sigma at the part (``calibration_mm``) and its axis parameters and
+  covariance (``calibration_axis``, which the draws propagate through each reading's angle),
+  each only when the run has it;
 - the registration's fit (result.fit's objective, free, weights_by_zone, datum_faces) and
   weight model (result.weights' model), and which readings the draws lay noise along
   (snr and beams known or not);
@@ -135,6 +137,10 @@ def task_key(nominal, opts, result):
                         "beams": uncertainty_mod.beam_directions(result) is not None}}
     if opts.calibration_mm:     # only when given: the files of runs without one stay valid
         key["calibration_mm"] = round(float(opts.calibration_mm), 12)
+    if opts.calibration_axis is not None:
+        key["calibration_axis"] = {name: np.asarray(opts.calibration_axis[name],
+                                                     dtype=float).tolist()
+                                   for name in ("parameters", "covariance")}
     return key
 
 

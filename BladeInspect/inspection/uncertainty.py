@@ -19,8 +19,10 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
   about result.center) propagated to the point along its normal: J Sigma J^T with
   J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c);
 - calibration: the rig calibration's own uncertainty at the part, when a RIG.json stating one
-  is given (``calibration_uncertainty_mm``); otherwise the term is not included and the model
-  says so;
+  is given (``calibration_uncertainty_mm``, an average over directions at the calibration
+  sphere, the registration's take-up not subtracted); otherwise the term is not included and
+  the model says so. The airfoil draws use the axis covariance itself through each reading's
+  angle when the RIG.json states it (calibration_fields);
 - fit: the pose covariance above is that of the least-squares fit of the same points; under a
   Chebyshev objective (minimax, tolerance) it states what the measurement determines, not that
   estimator's own, larger scatter, which is not included (core.fits, "Covariance").
@@ -51,6 +53,9 @@ class MeasurementModel:
     sensor: SensorModel = field(default_factory=SensorModel)
     calibration_mm: Optional[float] = None     # 1 sigma at the part, from RIG.json
     calibration_source: Optional[str] = None
+    # RIG.json's axis parameters (4,) and their covariance (4, 4), when it states them: the
+    # airfoil draws propagate these through each reading's angle (calibration_fields)
+    calibration_axis: Optional[dict] = None
 
     def to_json(self):
         return {
@@ -68,6 +73,7 @@ class MeasurementModel:
                           % self.sensor.accuracy,
             "pose": "pose covariance propagated along the normal, J S J^T, J = [n, (p-c) x n]",
             "calibration_mm": self.calibration_mm,
+            "calibration_axis": self.calibration_axis,
             "calibration": ("from %s" % self.calibration_source if self.calibration_mm
                             is not None else "not included (no RIG.json stating the "
                             "calibration's uncertainty)"),
@@ -93,7 +99,72 @@ def model_from_rig_file(path, sensor=None):
             raise InputError("%s: calibration_uncertainty_mm must be a finite number >= 0"
                              % path)
     return MeasurementModel(sensor=sensor, calibration_mm=value,
-                            calibration_source=path if value is not None else None)
+                            calibration_source=path if value is not None else None,
+                            calibration_axis=(calibration_axis_of(data, path)
+                                              if value is not None else None))
+
+
+def calibration_axis_of(data, source):
+    """{"parameters": (4,), "covariance": (4, 4)} of a RIG.json's axis calibration
+    (measurement.calibration_uncertainty), None when the file does not state them (a RIG.json
+    written before they were); InputError when it states them wrongly."""
+    values, cov = data.get("calibration_parameter_values"), data.get("calibration_covariance")
+    if values is None and cov is None:
+        return None
+    try:
+        values = np.asarray(values, dtype=float)
+        cov = np.asarray(cov, dtype=float)
+    except (TypeError, ValueError):
+        values = cov = None
+    ok = (values is not None and values.shape == (4,) and cov.shape == (4, 4)
+          and np.all(np.isfinite(values)) and np.all(np.isfinite(cov)))
+    if ok:
+        ok = (np.allclose(cov, cov.T, rtol=1e-9, atol=1e-30)
+              and np.linalg.eigvalsh(0.5 * (cov + cov.T)).min()
+              >= -1e-9 * max(np.abs(cov).max(), 1e-300))
+    if not ok:
+        raise InputError("%s: calibration_parameter_values must be 4 finite numbers and "
+                         "calibration_covariance a symmetric positive semi-definite 4 x 4 "
+                         "matrix" % source)
+    return {"parameters": values.tolist(), "covariance": cov.tolist()}
+
+
+def calibration_fields(result, axis, sensor=None):
+    """(N, 3, 4) of each point's error in the CAD frame per unit error of each axis parameter
+    of ``axis`` (calibration_axis_of's), less the rigid motion by which the registration takes
+    that error up (core.bias_take_up.take_up_of, the fit's weights and points as bias_take_up's);
+    None without the points' rotary angles.
+
+    A reading at angle a through an axis off by d lands at K(K'^-1(q, a), a) instead of q
+    (measurement.calibration_uncertainty.error_fields): the views see the part through
+    differently wrong axes, so the error is not one translation; the part common to all the
+    readings, a rigid motion, is what the registration removes."""
+    from ..measurement.calibration_uncertainty import error_fields
+    from ..rig.kinematics import RigKinematics
+    angles = (result.columns or {}).get("angle_deg")
+    if axis is None or angles is None:
+        return None
+    angles = np.asarray(angles, dtype=float)
+    if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
+        return None
+    to_cad = np.asarray(result.measured_to_cad, dtype=float)
+    points = np.asarray(result.points_cad, dtype=float)
+    table = (points - to_cad[:3, 3]) @ to_cad[:3, :3]
+    fields = error_fields(RigKinematics(), axis["parameters"], table, angles)
+    fields = np.einsum("ij,njk->nik", to_cad[:3, :3], fields)
+    beams = beam_directions(result)
+    weights = result.icp_weights if result.icp_weights is not None else result.snr
+    weights = (np.ones(len(points)) if weights is None else
+               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
+    weights = weights * np.asarray(result.inlier, dtype=bool)
+    keep = core_take_up.takes_part(points, result.normal, beams, weights,
+                                   (sensor or SensorModel()).max_incidence_rad)
+    centre = np.asarray(result.center, dtype=float)
+    for k in range(4):
+        r = core_take_up.take_up_of(points, result.normal, fields[:, :, k], weights, centre,
+                                    keep)
+        fields[:, :, k] -= r[:3] + np.cross(r[3:], points - centre)
+    return fields
 
 
 def standard_terms(result, index, model=None):
