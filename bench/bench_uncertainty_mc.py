@@ -230,7 +230,8 @@ class Chain:
         self.axis_cov = np.asarray(calib["calibration_covariance"])
         self.model = uncertainty_mod.MeasurementModel(
             sensor=self.sensor, calibration_mm=calib["calibration_uncertainty_mm"],
-            calibration_source="simulated calibration")
+            calibration_source="simulated calibration",
+            calibration_axis=uncertainty_mod.calibration_axis_of(calib, "simulated calibration"))
         truth_cad = tf.apply_transform(self.rec["table_to_cad"], self.rec["table"])
         self.field = np.asarray(self.bump(self.nominal.signed_distance(truth_cad).closest))
 
@@ -286,7 +287,9 @@ class Chain:
         # trials draw a calibration error (report/inspect take it from RIG.json)
         opts = airfoil_mod.Options(draws=draws, seed=int(rng.integers(1 << 31)),
                                    calibration_mm=(self.model.calibration_mm
-                                                   if "calibration" in errors else None))
+                                                   if "calibration" in errors else None),
+                                   calibration_axis=(self.model.calibration_axis
+                                                     if "calibration" in errors else None))
         stage = airfoil_mod.run_stage(self.nominal, airfoil_mod.planes_of_table(table), opts,
                                       result, table.span_axis)
         for b in stage.blocks:
