@@ -14,7 +14,13 @@ at K.table_point(K'.machine_point_of_table(q, a), a) instead of q (K believed, K
 error G(q, a) d, linear in d. Its variance along a direction, averaged over the three machine
 directions (a surface normal of unknown orientation) and over the calibration's angles, at the
 sphere's table position (where the part is mounted), is ``at_part_mm`` squared. The rigid part of
-that error that the registration absorbs is not subtracted: the figure is an upper estimate.
+that error that the registration absorbs is not subtracted, yet the figure is an average, not a
+bound at every reading: a tilt's error grows along the axis. On the demo loop's scan (16264
+readings at 22 angles), each reading's error along its normal after the take-up
+(inspection.uncertainty.calibration_fields) is 0.14 um at the median, 0.23 um at the 95th
+percentile and 0.35 um at most, against at_part_mm 0.22 um. The deviations' term uses the
+figure (beside ~3.4 um of noise it moves their U by under 0.1 %); the airfoil draws use the
+fields of ``error_fields``.
 """
 
 from dataclasses import dataclass
