@@ -128,6 +128,60 @@ class DecisionThroughVerdictTest(unittest.TestCase):
                         self.assertTrue(v["summary"].startswith("NOT PROVEN"), v["summary"])
 
 
+class PartWorstBesideLeftOutReadings(unittest.TestCase):
+    """The part's worst is the largest |deviation| among the fit's inliers; readings the fit
+    left out that lie beyond it are named (docs/fits.md, "Why the part's worst is
+    over-stated"): a bump whose top the robust fit rejected, below the tolerance."""
+
+    @classmethod
+    def setUpClass(cls):
+        from BladeInspect.inspection import sections
+        cls.nominal = fx.demo_nominal()
+        cls.on = demo_cloud(cls.nominal, lambda p: np.zeros(len(p)))
+        mid = cls.on[np.argmin(np.abs(cls.on[:, 2] - np.median(cls.on[:, 2])))]
+        cls.order = np.argsort(np.linalg.norm(cls.on - mid, axis=1))
+        axis, (lo, hi) = sections.span_axis_of(cls.nominal)
+        cls.table = sections.section_table(fx.make_result(cls.nominal, cls.on), cls.nominal,
+                                           heights_pct=[100.0 * (mid[2] - lo) / (hi - lo)])
+
+    def judged(self, dev, inlier):
+        from BladeInspect.inspection import fit_report, verdict
+        result = fx.make_result(self.nominal, fx.displaced(self.nominal, self.on, dev),
+                                inlier=inlier)
+        judged = verdict.judge(result, self.table, tolerance=T)
+        return result, judged, fit_report.decision_rows(judged)[1]
+
+    def test_the_left_out_top_of_a_bump_is_named(self):
+        dev = np.zeros(len(self.on))
+        top, flank = self.order[:5], self.order[5:12]
+        dev[top] = [0.030, 0.029, 0.028, 0.027, 0.026]
+        dev[flank] = 0.015
+        inlier = np.ones(len(self.on), bool)
+        inlier[top] = False
+        result, judged, rows = self.judged(dev, inlier)
+        part = judged["part"]
+        self.assertAlmostEqual(abs(part["worst_deviation_mm"]), 0.015, delta=2e-4)
+        larger = part["larger_not_fitted"]
+        self.assertEqual(larger["n"], 5)
+        self.assertAlmostEqual(larger["worst_deviation_mm"], result.deviation[top[0]],
+                               delta=1e-12)
+        np.testing.assert_allclose(larger["xyz"], result.points_cad[top[0]])
+        self.assertTrue(any("5 reading(s) the fit left out" in r[0] for r in rows))
+
+    def test_nothing_is_named_when_the_worst_is_fitted_or_the_larger_is_an_outlier(self):
+        dev = np.zeros(len(self.on))
+        dev[self.order[:5]] = 0.020
+        inlier = np.ones(len(self.on), bool)
+        inlier[self.order[5:9]] = False       # left out, smaller than the worst
+        self.assertIsNone(self.judged(dev, inlier)[1]["part"]["larger_not_fitted"])
+        dev[self.order[20]] = 0.2             # one isolated reading beyond the tolerance
+        inlier[self.order[20]] = False
+        result, judged, rows = self.judged(dev, inlier)
+        self.assertEqual(judged["n_isolated_out"], 1)
+        self.assertIsNone(judged["part"]["larger_not_fitted"])
+        self.assertFalse(any("left out" in r[0] for r in rows))
+
+
 class FitObjectivesTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

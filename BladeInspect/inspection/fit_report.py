@@ -38,6 +38,11 @@ def decision_rows(verdict):
     if part:
         rows.append(["part worst inlier (reported)", "%+.4f" % part["worst_deviation_mm"],
                      _u(part["U_mm"]), _u(part["tur"]), part["verdict"]])
+        larger = part.get("larger_not_fitted")
+        if larger:
+            rows.append(["  %d reading(s) the fit left out lie beyond it, up to"
+                         % larger["n"], "%+.4f" % larger["worst_deviation_mm"], "", "",
+                         "not fitted"])
     return header, rows
 
 

@@ -81,6 +81,23 @@ def decided(value, U, tolerance, rule):
             not np.isfinite(d.test_uncertainty_ratio) else float(d.test_uncertainty_ratio)}
 
 
+def _larger_not_fitted(result, dev, worst, isolated):
+    """The readings the fit gave no weight (not the isolated outliers) whose |deviation|
+    exceeds the part's worst inlier: {n, worst_deviation_mm, xyz}, None when there are none.
+    Where a defect straddles the robust fit's cut-off, the worst inlier is pinned under it and
+    which readings are inliers follows their measured deviations (docs/fits.md, "Why the part's
+    worst is over-stated"): the part's largest deviation is then not that row's; those
+    readings are judged where a section's band or a spot holds them."""
+    left_out = np.flatnonzero(~np.asarray(result.inlier, dtype=bool))
+    left_out = left_out[~np.isin(left_out, isolated)]
+    larger = left_out[np.abs(dev[left_out]) > abs(dev[worst])]
+    if not len(larger):
+        return None
+    top = larger[np.argmax(np.abs(dev[larger]))]
+    return {"n": int(len(larger)), "worst_deviation_mm": float(dev[top]),
+            "xyz": result.points_cad[top].tolist()}
+
+
 def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NEIGHBOURS,
           min_spot_points=MIN_SPOT_POINTS, n_worst=5, decision_rule="iso14253",
           measurement_model=None):
@@ -172,6 +189,7 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
                 "xyz": result.points_cad[worst].tolist()}
         part.update(decided(dev[worst], uncertainty_mod.worst_expanded_uncertainty(
             result, judged, measurement_model)[1], tolerance, decision_rule))
+        part["larger_not_fitted"] = _larger_not_fitted(result, dev, worst, isolated)
     decision = decision_mod.combine([s["verdict"] for s in sections_out if "verdict" in s]
                                     + [s["verdict"] for s in spot_out])
     passed = bool(not spots and all(s["pass"] is not False for s in sections_out)
