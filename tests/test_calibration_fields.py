@@ -209,6 +209,17 @@ class InTheAirfoilDraws(unittest.TestCase):
             self.assertLess(s, 1.3 * expected, name)
 
 
+    def test_without_angles_the_translation_serves(self):
+        import copy
+        no_angles = copy.copy(self.result)
+        no_angles.columns = {}
+        opts = self.stage_mod.Options(draws=8, calibration_axis=self.AXIS, calibration_mm=0.02,
+                                      seed=4)
+        stage = self.stage_mod.run_stage(self.nominal, self.planes, opts, no_angles,
+                                         self.table.span_axis)
+        self.assertIn("as an in-plane shift", stage.settings["uncertainty_method"])
+        self.assertGreater(min(stage.blocks[0]["uncertainty"]["shift_mm"]), 0.01)
+
     def test_the_task_key_holds_the_axis_only_when_given(self):
         from BladeInspect.inspection import airfoil_task_u
         plain = airfoil_task_u.task_key(self.nominal, self.stage_mod.Options(), self.result)
