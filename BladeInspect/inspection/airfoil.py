@@ -608,8 +608,8 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
 def _calibration_model(result, idx, opts, sensor):
     """(fields (n, 3, 4), Cholesky factor (4, 4)) of the section's readings' axis errors
     (uncertainty.calibration_fields) when the options carry RIG.json's axis covariance and the
-    readings their angles, else (None, None): calibration_mm's in-plane translation, an upper
-    estimate, serves instead. The fields of the whole scan cost ~0.04 s (demo loop, 16264
+    readings their angles, else (None, None): calibration_mm's in-plane translation serves
+    instead (it over-states the shifts and holds no shape part, docs/airfoil.md). The fields of the whole scan cost ~0.04 s (demo loop, 16264
     readings), against ~1 s of a section's re-fits: not kept between sections."""
     if opts.calibration_axis is None:
         return None, None

@@ -153,10 +153,7 @@ def calibration_fields(result, axis, sensor=None):
     fields = error_fields(RigKinematics(), axis["parameters"], table, angles)
     fields = np.einsum("ij,njk->nik", to_cad[:3, :3], fields)
     beams = beam_directions(result)
-    weights = result.icp_weights if result.icp_weights is not None else result.snr
-    weights = (np.ones(len(points)) if weights is None else
-               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
-    weights = weights * np.asarray(result.inlier, dtype=bool)
+    weights = _fit_weights(result)
     keep = core_take_up.takes_part(points, result.normal, beams, weights,
                                    (sensor or SensorModel()).max_incidence_rad)
     centre = np.asarray(result.center, dtype=float)
@@ -258,13 +255,18 @@ def bias_take_up(result, sensor=None):
     beams = beam_directions(result)
     if beams is None:
         return None
-    weights = result.icp_weights if result.icp_weights is not None else result.snr
-    weights = (np.ones(len(beams)) if weights is None else
-               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
-    weights = weights * np.asarray(result.inlier, dtype=bool)
     max_incidence = (sensor or SensorModel()).max_incidence_rad
-    return beams, core_take_up.take_up(result.points_cad, result.normal, beams, weights,
-                                       result.center, max_incidence)
+    return beams, core_take_up.take_up(result.points_cad, result.normal, beams,
+                                       _fit_weights(result), result.center, max_incidence)
+
+
+def _fit_weights(result):
+    """(N,) the fine fit's final weights (result.icp_weights, else the SNR, else 1) of its
+    inliers, 0 elsewhere: what a take-up of the registration weighs its points by."""
+    weights = result.icp_weights if result.icp_weights is not None else result.snr
+    weights = (np.ones(len(result.points_cad)) if weights is None else
+               np.clip(np.nan_to_num(np.asarray(weights, dtype=float)), 0.0, None))
+    return weights * np.asarray(result.inlier, dtype=bool)
 
 
 def expanded_uncertainty(result, index, model=None):
