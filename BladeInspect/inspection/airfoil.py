@@ -609,8 +609,9 @@ def _calibration_model(result, idx, opts, sensor):
     """(fields (n, 3, 4), Cholesky factor (4, 4)) of the section's readings' axis errors
     (uncertainty.calibration_fields) when the options carry RIG.json's axis covariance and the
     readings their angles, else (None, None): calibration_mm's in-plane translation serves
-    instead (it over-states the shifts and holds no shape part, docs/airfoil.md). The fields of the whole scan cost ~0.04 s (demo loop, 16264
-    readings), against ~1 s of a section's re-fits: not kept between sections."""
+    instead (it over-states the shifts and holds no shape part, docs/airfoil.md). The fields
+    of the whole scan cost ~0.04 s (demo loop, 16264 readings), against ~1 s of a section's
+    re-fits: not kept between sections."""
     if opts.calibration_axis is None:
         return None, None
     fields = uncertainty_mod.calibration_fields(result, opts.calibration_axis, sensor)
@@ -887,7 +888,7 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
         r.block["notes"] = list(r.notes)
     verdict = stage_verdict(results, failed, unproven)
     if result is not None and opts.calibration_axis is not None and \
-            (result.columns or {}).get("angle_deg") is not None:
+            uncertainty_mod.reading_angles(result) is not None:
         calibration = ("the rig calibration's axis covariance (RIG.json) through each "
                        "reading's rotary angle, less the registration's take-up")
     elif opts.calibration_mm:

@@ -141,11 +141,8 @@ def calibration_fields(result, axis, sensor=None):
     readings, a rigid motion, is what the registration removes."""
     from ..measurement.calibration_uncertainty import error_fields
     from ..rig.kinematics import RigKinematics
-    angles = (result.columns or {}).get("angle_deg")
+    angles = reading_angles(result)
     if axis is None or angles is None:
-        return None
-    angles = np.asarray(angles, dtype=float)
-    if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
         return None
     to_cad = np.asarray(result.measured_to_cad, dtype=float)
     points = np.asarray(result.points_cad, dtype=float)
@@ -206,14 +203,23 @@ def normal_noise(result, index=None, sensor=None):
     return model.normal_sigma(result.measured_to_cad, np.asarray(result.normal)[index])
 
 
-def _beams_measured(result):
-    """(N, 3) unit beam directions in the measured frame from the rotary angles, or None."""
-    from ..rig.kinematics import RigKinematics
+def reading_angles(result):
+    """(N,) each point's rotary angle (the ``angle_deg`` column), or None when the points do
+    not carry one finite angle each."""
     angles = (result.columns or {}).get("angle_deg")
     if angles is None:
         return None
     angles = np.asarray(angles, dtype=float)
     if angles.shape != (len(result.points_cad),) or not np.all(np.isfinite(angles)):
+        return None
+    return angles
+
+
+def _beams_measured(result):
+    """(N, 3) unit beam directions in the measured frame from the rotary angles, or None."""
+    from ..rig.kinematics import RigKinematics
+    angles = reading_angles(result)
+    if angles is None:
         return None
     return beam_in_table(angles, RigKinematics().axis_direction, BEAM_MACHINE)
 
