@@ -337,7 +337,8 @@ def _char_values(ch, frame, fit=None, contour=None):
 
 def _measure(pts2d, nominal_chars, opts, noise, le_hint):
     ordered = kernel.order_by_nominal(pts2d, nominal_chars.profile)
-    ch = kernel.characteristics(ordered, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
+    measured = kernel.Profile(ordered, noise, nominal=nominal_chars.profile)
+    ch = kernel.characteristics(measured, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
                                 edge_offsets_mm=opts.edge_offsets_mm, le_hint=le_hint,
                                 noise_mm=noise)
     ch = kernel.withhold_corner_edges(ch, nominal_chars)      # metal-angle hook: sharp edges

@@ -81,8 +81,10 @@ from ..core.errors import InputError
 from . import uncertainty as uncertainty_mod
 
 # Raise whenever the re-fit draws' model (inspection.airfoil._uncertainty,
-# _point_noise_model, _measure) changes: files of another version are refused.
-TASK_MODEL_VERSION = 1
+# _point_noise_model, _measure) changes: files of another version are refused. 2: the measured
+# profile's fit takes the nominal's knots where the points thin out (core.airfoil
+# ._knots_from_nominal), which changes the draws' scatter.
+TASK_MODEL_VERSION = 2
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48
 # The match rule: relative half-widths about the stored conditions.
