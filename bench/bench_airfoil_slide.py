@@ -11,11 +11,13 @@ fit jumps depends on the scan), registered as the loop does; its points are slid
 nominal profile's tangent and measured by core.airfoil alone.
 
     scripts/fcpython bench/bench_airfoil_slide.py [--from -0.003] [--to 0.001] [--steps 17]
-        [--bias-um -3] [--normal]
+        [--bias-um -3] [--normal] [--smoothing]
 
 Prints per slide (mm) the outlet and inlet angles, the max-thickness position, the TE radius
 and the fit's knot count, then each one's largest change between neighbouring slides.
-``--normal`` slides along the normal instead (a real offset of the curve, for comparison).
+``--normal`` slides along the normal instead (a real offset of the curve, for comparison);
+``--smoothing`` fits without the nominal's knots (core.airfoil._knots_from_nominal), as the
+stage did before 2026-12-05.
 """
 import argparse
 import os
@@ -59,6 +61,8 @@ def main():
     ap.add_argument("--steps", type=int, default=17)
     ap.add_argument("--bias-um", type=float, default=-3.0)
     ap.add_argument("--normal", action="store_true")
+    ap.add_argument("--smoothing", action="store_true",
+                    help="FITPACK's smoothing spline alone (no nominal's knots)")
     args = ap.parse_args()
     pts, noise, nominal = measured_section(1e-3 * args.bias_um)
     u, _ = nominal.profile.closest(pts)
@@ -72,7 +76,7 @@ def main():
     rows = []
     for d in np.linspace(args.start, args.stop, args.steps):
         profile = kernel.Profile(kernel.order_by_nominal(pts + d * along, nominal.profile),
-                                 noise)
+                                 noise, nominal=None if args.smoothing else nominal.profile)
         ch = kernel.characteristics(profile, noise_mm=noise)
         rows.append([getattr(ch, f) for f in FIELDS])
         print("%+9.2f %10.4f %10.4f %9.3f %9.2f %6d"
