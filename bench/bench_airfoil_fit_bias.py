@@ -30,7 +30,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bench_uncertainty_mc as mc  # noqa: E402
 from BladeInspect.core import airfoil as kernel  # noqa: E402
-from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
 
 SCALARS = ("axial_chord_mm", "max_thickness_mm", "max_thickness_pos_pct", "le_radius_mm",
            "te_radius_mm", "inlet_angle_deg", "outlet_angle_deg")
@@ -41,26 +40,13 @@ def scans(blade, seed, count, draws):
     section, each section's nominal Characteristics, and the stage's stated u of each section
     (its uncertainty block) on one more scan, ``draws`` re-fits."""
     chain = mc.Chain(blade, 2026, 31)
-    kept = {}
-    run_stage = stage_mod.run_stage
-
-    def keeping(*a, **k):
-        kept["stage"] = run_stage(*a, **k)
-        return kept["stage"]
-    mc.airfoil_mod.run_stage = keeping
-    try:
-        chain.trial(np.random.default_rng(seed), errors=())
-        truth = [sr.points_2d for sr in kept["stage"].sections]
-        nominals = [sr.nominal for sr in kept["stage"].sections]
-        noisy = []
-        for k in range(count):
-            chain.trial(np.random.default_rng(seed + 1 + k), errors=("noise",), bias_mm=0.0)
-            noisy.append([(sr.points_2d, sr.noise_mm) for sr in kept["stage"].sections])
-        chain.trial(np.random.default_rng(seed + 1 + count), draws=draws)
-        stated = [sr.block["uncertainty"] for sr in kept["stage"].sections]
-    finally:
-        mc.airfoil_mod.run_stage = run_stage
-    return truth, noisy, nominals, stated
+    exact = chain.stage_sections(np.random.default_rng(seed), errors=())
+    noisy = [[(sr.points_2d, sr.noise_mm) for sr in chain.stage_sections(
+        np.random.default_rng(seed + 1 + k), errors=("noise",), bias_mm=0.0)]
+        for k in range(count)]
+    stated = [sr.block["uncertainty"] for sr in chain.stage_sections(
+        np.random.default_rng(seed + 1 + count), draws=draws)]
+    return [sr.points_2d for sr in exact], noisy, [sr.nominal for sr in exact], stated
 
 
 def values(points, noise, nominal, variant):

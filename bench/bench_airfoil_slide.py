@@ -30,7 +30,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bench_uncertainty_mc as mc  # noqa: E402
 from BladeInspect.core import airfoil as kernel  # noqa: E402
-from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
 
 FIELDS = ("outlet_angle_deg", "inlet_angle_deg", "max_thickness_pos_pct", "te_radius_mm")
 
@@ -38,19 +37,8 @@ FIELDS = ("outlet_angle_deg", "inlet_angle_deg", "max_thickness_pos_pct", "te_ra
 def measured_section(bias_mm, noise_seed=11, section=1):
     """(points in the plane, their noise, the nominal Characteristics) of one section of the
     Monte Carlo's demo scan measured with noise and a reading bias ``bias_mm``."""
-    chain = mc.Chain("demo", 2026, 31)
-    kept = {}
-    run_stage = stage_mod.run_stage
-
-    def keeping(*a, **k):
-        kept["stage"] = run_stage(*a, **k)
-        return kept["stage"]
-    mc.airfoil_mod.run_stage = keeping
-    try:
-        chain.trial(np.random.default_rng(noise_seed), errors=("noise",), bias_mm=bias_mm)
-    finally:
-        mc.airfoil_mod.run_stage = run_stage
-    sr = kept["stage"].sections[section]
+    sr = mc.Chain("demo", 2026, 31).stage_sections(np.random.default_rng(noise_seed),
+                                                   errors=("noise",), bias_mm=bias_mm)[section]
     return sr.points_2d, sr.noise_mm, sr.nominal
 
 

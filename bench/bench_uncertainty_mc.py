@@ -235,6 +235,22 @@ class Chain:
         truth_cad = tf.apply_transform(self.rec["table_to_cad"], self.rec["table"])
         self.field = np.asarray(self.bump(self.nominal.signed_distance(truth_cad).closest))
 
+    def stage_sections(self, rng, **trial_args):
+        """One trial (``trial``'s arguments) and the airfoil stage's SectionResults it made:
+        the sections' points in their planes, noise, nominal and blocks."""
+        kept = {}
+        run_stage = airfoil_mod.run_stage
+
+        def keeping(*a, **k):
+            kept["stage"] = run_stage(*a, **k)
+            return kept["stage"]
+        airfoil_mod.run_stage = keeping
+        try:
+            self.trial(rng, **trial_args)
+        finally:
+            airfoil_mod.run_stage = run_stage
+        return kept["stage"].sections
+
     def trial(self, rng, draws=0, errors=ERRORS, bias_mm=None):
         """One measurement of the recorded scan with the model's errors drawn afresh: the
         judged values {name: value}, their stated u (k = 1) {name: u} and the truth.
