@@ -12,8 +12,8 @@ inside U.
 ``--variant``: ``nominal-knots`` is the stage's fit (core.airfoil._knots_from_nominal: the
 knots the nominal's shape wants, joined with the smoothing spline's, least squares on them);
 ``smoothing`` is FITPACK's smoothing spline alone -- the stage's fit before 2026-12-05, and
-still the fit of a profile measured without its nominal or too sparsely for those knots
-(docs/airfoil.md, "The knots from the nominal"). The stated u is the stage's either way.
+still the fit of a profile measured without its nominal or whose points do not thin out in
+runs (docs/airfoil.md, "Where the points thin out"). The stated u is the stage's either way.
 
     scripts/fcpython bench/bench_airfoil_fit_bias.py [--blade demo|rotor67] [--scans 24]
         [--seed 100] [--draws 12] [--variant nominal-knots|smoothing]
