@@ -30,7 +30,7 @@ from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
 from BladeInspect.inspection import sections as sections_mod  # noqa: E402
 from BladeInspect.measurement.planning import plan_sections  # noqa: E402
 from BladeInspect.rig.sensor import SensorModel  # noqa: E402
-from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose  # noqa: E402
+from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of  # noqa: E402
 from tests.helpers import planned_readings_result  # noqa: E402
 
 HEIGHTS = (10.0, 50.0, 90.0)
@@ -49,9 +49,7 @@ def load(blade):
 
 def truth_pose(nominal, seed):
     axis, _ = sections_mod.span_axis_of(nominal)
-    c = nominal.bbox_corners
-    return random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
-                               cad_center=0.5 * (c.min(0) + c.max(0)))
+    return random_fixture_pose_of(nominal, np.random.default_rng(seed), axis)
 
 
 def loop_result(nominal, rig, heights, edge_sigma, seed):

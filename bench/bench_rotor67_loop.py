@@ -24,11 +24,10 @@ def one_loop(nominal, seed, n_sections):
     from BladeInspect.core.pointio import read_points
     from BladeInspect.inspection.closed_loop import run_inspect
     from BladeInspect.rig.sensor import SensorModel
-    from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+    from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
     axis, bump = _bump_at_section(nominal, HEIGHTS[0])
     corners = nominal.bbox_corners
-    truth = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
-                                cad_center=0.5 * (corners.min(0) + corners.max(0)))
+    truth = random_fixture_pose_of(nominal, np.random.default_rng(seed), axis)
     rig = SimulatedRig(nominal, truth, sensor=SensorModel(accuracy=0.0005), error_field=bump,
                        seed=seed)
     log = record_passes(rig)

@@ -131,13 +131,11 @@ def record(name, seed):
         with open(path, "rb") as fh:
             return pickle.load(fh)
     from BladeInspect.inspection.closed_loop import run_inspect
-    from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+    from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
     import json
     nominal, heights = blade(name)
     axis, bump = bump_at(nominal, heights[0])
-    corners = nominal.bbox_corners
-    truth = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
-                                cad_center=0.5 * (corners.min(0) + corners.max(0)))
+    truth = random_fixture_pose_of(nominal, np.random.default_rng(seed), axis)
     log = {}
     context = {}
 

@@ -4,7 +4,7 @@ against the sensor model's 1 / (sigma_beam cos theta)^2 on a planned-section sca
     scripts/fcpython bench/bench_weights.py [--cad rotor67|demo] [--scans 200] \
         [--seed 31] [--heights 10,30,50,70,90] [--blind 0] [--accuracy 0.0005]
 
-One fixture pose (the truth, random_fixture_pose(seed)), the sections planned from it
+One fixture pose (the truth, random_fixture_pose_of(nominal, seed)), the sections planned from it
 (measurement.planning.plan_sections, as `inspect` plans them after its blind scan; with
 ``--blind N`` the kept readings of an N-section blind scan too, as inspect's final fit has
 them) and their rays cast once onto the CAD; then ``--scans`` scans of fresh sensor noise (rig.sensor.read:
@@ -36,7 +36,7 @@ from BladeInspect.inspection.sections import span_axis_of
 from BladeInspect.inspection.weighting import sensor_weights
 from BladeInspect.measurement.planning import plan_sections
 from BladeInspect.rig.sensor import SensorModel
-from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
 
 
 def load(cad):
@@ -162,8 +162,7 @@ def main():
     nominal = load(args.cad)
     corners = nominal.bbox_corners
     axis, _ = span_axis_of(nominal)
-    truth = random_fixture_pose(np.random.default_rng(args.seed), blade_span_axis=axis,
-                                cad_center=0.5 * (corners.min(0) + corners.max(0)))
+    truth = random_fixture_pose_of(nominal, np.random.default_rng(args.seed), axis)
     sensor = SensorModel(accuracy=args.accuracy)
     rig = SimulatedRig(nominal, truth, sensor=sensor, seed=args.seed)
     heights = [float(h) for h in args.heights.split(",")]

@@ -17,7 +17,7 @@ from BladeInspect.inspection import airfoil as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
 from BladeInspect.rig.sensor import SensorModel
-from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
 from tests.helpers import demo_nominal, planned_readings_result, suction_bump_at
 
 HEIGHTS = (30.0, 70.0)
@@ -35,9 +35,7 @@ class DefectPointsCount(unittest.TestCase):
     def setUpClass(cls):
         nominal = cls.nominal = demo_nominal()
         axis, bump = suction_bump_at(nominal, HEIGHTS[0], BUMP_RADIUS_MM, BUMP_MM)
-        corners = nominal.bbox_corners
-        truth = random_fixture_pose(np.random.default_rng(SEED), blade_span_axis=axis,
-                                    cad_center=0.5 * (corners.min(0) + corners.max(0)))
+        truth = random_fixture_pose_of(nominal, np.random.default_rng(SEED), axis)
         rig = SimulatedRig(nominal, truth, sensor=SensorModel(accuracy=0.0005), seed=SEED,
                            error_field=bump)
         plan = planning.plan_sections(nominal, truth, HEIGHTS, rig.sensor, rig.limits,

@@ -17,7 +17,7 @@ from BladeInspect.core import airfoil as kernel
 from BladeInspect.inspection import airfoil as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
-from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
 from tests.airfoil_shapes import ArcSection
 from tests.helpers import demo_nominal, planned_readings_result
 
@@ -34,9 +34,7 @@ class EdgeThicknessWhereThePointsThinOut(unittest.TestCase):
     def setUpClass(cls):
         nominal = demo_nominal()
         axis, _ = sections_mod.span_axis_of(nominal)
-        corners = nominal.bbox_corners
-        truth = random_fixture_pose(np.random.default_rng(POSE_SEED), blade_span_axis=axis,
-                                    cad_center=0.5 * (corners.min(0) + corners.max(0)))
+        truth = random_fixture_pose_of(nominal, np.random.default_rng(POSE_SEED), axis)
         cls.scans = []
         for seed in range(SCANS):
             rig = SimulatedRig(nominal, truth, seed=100 + seed)

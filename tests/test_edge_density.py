@@ -18,7 +18,7 @@ from BladeInspect.inspection import airfoil as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
 from BladeInspect.rig.sensor import SensorModel
-from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
 from tests.helpers import demo_nominal, planned_readings_result
 
 HEIGHTS = (15.0, 85.0)
@@ -85,11 +85,9 @@ class EdgeDensityInTheInspectPlan(unittest.TestCase):
         cls.sensor = SensorModel()
         axis, _ = sections_mod.span_axis_of(cls.nominal)
         cls.axis = axis
-        corners = cls.nominal.bbox_corners
         cls.runs = []
         for seed in SEEDS:
-            truth = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=axis,
-                                        cad_center=0.5 * (corners.min(0) + corners.max(0)))
+            truth = random_fixture_pose_of(cls.nominal, np.random.default_rng(seed), axis)
             rig = SimulatedRig(cls.nominal, truth, sensor=cls.sensor, seed=seed)
             plan = planning.plan_sections(
                 cls.nominal, truth, HEIGHTS, rig.sensor, rig.limits, span_axis=axis,

@@ -166,13 +166,11 @@ class TestInspectLoop(unittest.TestCase):
         from BladeInspect.core.pointio import read_points
         from BladeInspect.inspection.closed_loop import run_inspect
         from BladeInspect.rig.sensor import SensorModel
-        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
         nominal = cls.nominal = rotor67_nominal()
         axis, bump = _bump_at_section(nominal, HEIGHTS[0])
         cls.bump = staticmethod(bump)
-        corners = nominal.bbox_corners
-        cls.truth = random_fixture_pose(np.random.default_rng(SEED_LOOP), blade_span_axis=axis,
-                                        cad_center=0.5 * (corners.min(0) + corners.max(0)))
+        cls.truth = random_fixture_pose_of(nominal, np.random.default_rng(SEED_LOOP), axis)
         cls.sensor = SensorModel(accuracy=0.0005)
         rig = SimulatedRig(nominal, cls.truth, sensor=cls.sensor, error_field=bump,
                            seed=SEED_LOOP)

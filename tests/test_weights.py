@@ -221,13 +221,11 @@ class TestPlannedScanOfTheDemoBlade(unittest.TestCase):
     def setUpClass(cls):
         from BladeInspect.inspection.sections import span_axis_of
         from BladeInspect.measurement.planning import plan_sections
-        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose
+        from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
         from tests.helpers import demo_nominal
         cls.nominal = demo_nominal()
-        corners = cls.nominal.bbox_corners
         axis, _ = span_axis_of(cls.nominal)
-        cls.truth = random_fixture_pose(np.random.default_rng(3), blade_span_axis=axis,
-                                        cad_center=0.5 * (corners.min(0) + corners.max(0)))
+        cls.truth = random_fixture_pose_of(cls.nominal, np.random.default_rng(3), axis)
         rig = SimulatedRig(cls.nominal, cls.truth, seed=3)
         plan = plan_sections(cls.nominal, cls.truth, (30.0, 70.0), rig.sensor, rig.limits,
                              span_axis=axis)

@@ -82,16 +82,20 @@ def make_thickening(curve_points, radius, height):
     return field
 
 
-def simulated_rig_for(part, seed=0, **rig_options):
-    """A SimulatedRig of ``part`` (with ``bbox_corners``) clamped at a random fixture pose
-    drawn from ``seed``: its span (the bounding box's longest side) along the rotary axis, the
-    box centre near the axis. The same seed gives the same pose and the same readings."""
+def random_fixture_pose_of(part, rng, span_axis=None):
+    """random_fixture_pose of ``part`` (with ``bbox_corners``): its span along the rotary axis
+    (``span_axis``, default the bounding box's longest side), the box centre near the axis."""
     corners = np.asarray(part.bbox_corners, dtype=float)
-    extent = corners.max(axis=0) - corners.min(axis=0)
-    span_axis = np.eye(3)[int(np.argmax(extent))]
-    centre = 0.5 * (corners.max(axis=0) + corners.min(axis=0))
-    pose = random_fixture_pose(np.random.default_rng(seed), blade_span_axis=span_axis,
-                               cad_center=centre)
+    if span_axis is None:
+        span_axis = np.eye(3)[int(np.argmax(corners.max(axis=0) - corners.min(axis=0)))]
+    return random_fixture_pose(rng, blade_span_axis=span_axis,
+                               cad_center=0.5 * (corners.min(axis=0) + corners.max(axis=0)))
+
+
+def simulated_rig_for(part, seed=0, **rig_options):
+    """A SimulatedRig of ``part`` clamped at a random fixture pose drawn from ``seed``
+    (random_fixture_pose_of). The same seed gives the same pose and the same readings."""
+    pose = random_fixture_pose_of(part, np.random.default_rng(seed))
     return SimulatedRig(part, pose, seed=seed, **rig_options)
 
 
