@@ -9,7 +9,9 @@ within ~1 um of the plane, where the two agree.
 
 Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
 draw moves the section's points by a pose drawn from the registration's covariance, lays
-fresh sensor noise on the measured profile's smooth fit at the same places -- each reading's
+fresh sensor noise on the measured profile's smooth fit where each reading's beam meets it
+(beam_feet; "The draws' base": the closest point would keep the scan's own error along the
+surface beneath the draw's, docs/fits.md) -- each reading's
 own sigma_beam(SNR) along its beam, in the sensor's distribution (its normal part is
 inspection.uncertainty.normal_noise; along the normal without beams, the section's
 point-to-point scatter only for readings without SNR) -- and adds one reading bias within
@@ -538,14 +540,51 @@ def on_smooth_fit(result, idx, frame, ch):
     return pts, smooth, frame.vector_to_3d(ch.profile.outward_normal(u))
 
 
+# A reading's foot along its beam is taken only within this many of its beam sigmas of the
+# reading (farther, the beam runs nearly along the fit: its closest foot is kept).
+BEAM_FOOT_SIGMAS = 10.0
+_BEAM_FOOT_ROUNDS = 3
+
+
+def beam_feet(profile, pts, feet, beams2d, reach):
+    """Where each point's beam (in-plane directions ``beams2d``, as _into_plane carries a move
+    along the beam into the plane) meets ``profile``: the point with its reading's error along
+    the beam taken out, the noise-free reading the sensor model assumes. ``feet``, the closest
+    points, are kept where the beam misses the profile within ``reach`` (per point) of the
+    point or has no direction. A few Newton steps on the signed distance along the beam."""
+    t = np.zeros(len(pts))
+    ok = np.all(np.isfinite(beams2d), axis=1) & (np.linalg.norm(beams2d, axis=1) > 0)
+    b = np.where(ok[:, None], beams2d, 0.0)
+    for _ in range(_BEAM_FOOT_ROUNDS):
+        u, at = profile.closest(pts - t[:, None] * b)
+        n = profile.outward_normal(u)
+        cos = np.einsum("ij,ij->i", b, n)
+        ok &= np.abs(cos) > 1e-3
+        dev = np.einsum("ij,ij->i", pts - t[:, None] * b - at, n)
+        t = t + np.where(ok, dev / np.where(ok, cos, 1.0), 0.0)
+    ok &= np.abs(t) * np.linalg.norm(b, axis=1) <= reach
+    _, on = profile.closest(pts - t[:, None] * b)
+    return np.where(ok[:, None], on, feet)
+
+
+def _beams_in_plane(beams, surface_normal, frame):
+    """(n, 2) in-plane displacement that _into_plane makes of a unit move along each beam (a
+    move out of the plane is slid back along the surface, which turns it in the plane)."""
+    pn = np.asarray(frame.normal, dtype=float)
+    s = pn - (surface_normal @ pn)[:, None] * surface_normal
+    along = s @ pn
+    ok = along > 0.2
+    step = np.where(ok, (beams @ pn) / np.where(ok, along, 1.0), beams @ pn)
+    moved = beams - step[:, None] * np.where(ok[:, None], s, pn)
+    return np.column_stack([moved @ frame.e1, moved @ frame.e2])
+
+
 def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_values,
                  draws_sd=None):
     """1 sigma of each measured characteristic by re-fitting perturbed points (module notes);
     ``draws_sd``, a dict, is given the draws' own 1 sigma before the maxima's bias."""
     n0 = result.normal[idx]
-    # The measured profile's smooth fit at each point: the draws' noise-free points.
     pts, smooth, out_normal = on_smooth_fit(result, idx, frame, ch)
-    smooth3 = frame.to_3d(smooth)
     cov = np.asarray(result.pose_covariance, dtype=float)
     cov = np.where(np.isfinite(cov), cov, 0.0)
     try:
@@ -565,13 +604,17 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     # 1.67 along the normal (a stated u of 2 x 12 draws is itself ~15 % uncertain).
     sensor = sensor_of(opts)
     accuracy = sensor.accuracy
+    sigma, spread, along, unit = _point_noise_model(result, idx, sensor, noise, out_normal)
+    # The draws' noise-free points: each reading's beam where it meets the measured profile's
+    # smooth fit (module notes).
+    smooth3 = frame.to_3d(beam_feet(ch.profile, pts, smooth, _beams_in_plane(along, n0, frame),
+                                     BEAM_FOOT_SIGMAS * spread))
     take_up = uncertainty_mod.bias_take_up(result, sensor)
     if take_up is None:
         bias_step = n0
     else:
         beams, r = take_up
         bias_step = beams[idx] - r[:3] - np.cross(r[3:], smooth3 - centre)
-    sigma, spread, along, unit = _point_noise_model(result, idx, sensor, noise, out_normal)
     axis_fields, axis_chol = _calibration_model(result, idx, opts, sensor)
     draws = []
     for _ in range(max(int(opts.draws), 2)):

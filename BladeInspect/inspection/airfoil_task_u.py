@@ -83,8 +83,9 @@ from . import uncertainty as uncertainty_mod
 # Raise whenever the re-fit draws' model (inspection.airfoil._uncertainty,
 # _point_noise_model, _measure) changes: files of another version are refused. 2: the measured
 # profile's fit takes the nominal's knots where the points thin out (core.airfoil
-# ._knots_from_nominal), which changes the draws' scatter.
-TASK_MODEL_VERSION = 2
+# ._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is each
+# reading's beam where it meets the smooth fit (inspection.airfoil.beam_feet).
+TASK_MODEL_VERSION = 3
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48
 # The match rule: relative half-widths about the stored conditions.
