@@ -365,6 +365,30 @@ def pose_covariance(points_cad, normals, weights, residuals, center):
     return split.covariance
 
 
+def random_residual_share(weights, residuals, n_parameters=6):
+    """s_d^2 / s^2, at most 1, of a fit's residuals in acquisition order (the points with
+    weight > 0): s^2 = sum w r^2 / (n - k) is the unit-weight variance pose_covariance scales
+    by, s_d^2 = mean((z_(i+1) - z_i)^2) / 2 of the weighted residuals z = sqrt(w) r in their
+    order. A misfit that changes slowly from reading to reading (the part of a reading bias
+    the rigid fit cannot take up, a defect, form error) cancels in the differences and stays in
+    s^2; white noise is in both. Points in no spatial order give ~1. 1 when it is undefined.
+
+    Why: an uncertainty budget that carries the sensor's bias as its own term would count it
+    twice through a pose covariance scaled by s^2 (Rotor 67's planned scan, a 6 um bias: the
+    covariance's 1 sigma 1.8x the noise-only one; docs/fits.md, "The pose term's scale")."""
+    w = np.asarray(weights, dtype=float)
+    r = np.asarray(residuals, dtype=float)
+    keep = np.isfinite(w) & np.isfinite(r) & (w > 0)
+    z = np.sqrt(w[keep]) * r[keep]
+    if len(z) <= n_parameters + 1:
+        return 1.0
+    s2 = float(np.sum(z ** 2)) / (len(z) - n_parameters)
+    s2d = float(np.sum(np.diff(z) ** 2)) / (2.0 * (len(z) - 1))
+    if not (s2 > 0 and np.isfinite(s2) and np.isfinite(s2d)):
+        return 1.0
+    return min(1.0, s2d / s2)
+
+
 def pose_uncertainty(cov, center, corners):
     """1 sigma displacement at the worst corner: a corner x moves by dt + dw x (x - c), i.e.
     J_x [dt, dw] with J_x = [I, -[x - c]_x]; its RMS is sqrt(trace(J_x C J_x^T)).

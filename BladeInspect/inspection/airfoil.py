@@ -8,7 +8,8 @@ raster band 0.25 mm off the plane moves along the part, not off it. A planned sc
 within ~1 um of the plane, where the two agree.
 
 Uncertainty (``uncertainty`` block, 1 sigma, k = 1) is by re-fitting perturbed points: each
-draw moves the section's points by a pose drawn from the registration's covariance, lays
+draw moves the section's points by a pose drawn from the registration's covariance (its random
+part, inspection.uncertainty.random_pose_covariance), lays
 fresh sensor noise on the measured profile's smooth fit where each reading's beam meets it
 (beam_feet; "The draws' base": the closest point would keep the scan's own error along the
 surface beneath the draw's, docs/fits.md) -- each reading's
@@ -585,7 +586,7 @@ def _uncertainty(result, idx, frame, nom, ch, fit, opts, noise, rng, measured_va
     ``draws_sd``, a dict, is given the draws' own 1 sigma before the maxima's bias."""
     n0 = result.normal[idx]
     pts, smooth, out_normal = on_smooth_fit(result, idx, frame, ch)
-    cov = np.asarray(result.pose_covariance, dtype=float)
+    cov = uncertainty_mod.random_pose_covariance(result)
     cov = np.where(np.isfinite(cov), cov, 0.0)
     try:
         chol = np.linalg.cholesky(cov + 1e-30 * np.eye(6))

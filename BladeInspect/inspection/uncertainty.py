@@ -17,7 +17,9 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
   blade's loop the fit takes up more than half of it, bench/bench_uncertainty_mc.py);
 - pose: the registration's pose covariance Sigma (result.pose_covariance, 6x6 [t mm, w rad]
   about result.center) propagated to the point along its normal: J Sigma J^T with
-  J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c);
+  J = [n, (p - c) x n] (the deviation's change under a twist (t, w) about c). Sigma's
+  residual scale is cut to the residuals' random part (random_pose_covariance): the bias's
+  left-over misfit is the systematic term's, not the pose's;
 - calibration: the rig calibration's own uncertainty at the part, when a RIG.json stating one
   is given (``calibration_uncertainty_mm``, an average over directions at the calibration
   sphere, the registration's take-up not subtracted); otherwise the term is not included and
@@ -38,6 +40,7 @@ from typing import Optional
 import numpy as np
 
 from ..core import bias_take_up as core_take_up
+from ..core import icp as core_icp
 from ..core import uncertainty_model
 from ..core.errors import InputError
 from ..core.weights import SensorWeights, beam_in_table
@@ -170,7 +173,7 @@ def standard_terms(result, index, model=None):
     normal = np.asarray(result.normal, dtype=float)[index]
     arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
     J = np.hstack([normal, np.cross(arm, normal)])
-    cov = np.asarray(result.pose_covariance, dtype=float)
+    cov = random_pose_covariance(result)
     with np.errstate(invalid="ignore"):
         pose_var = np.einsum("ij,jk,ik->i", J, cov, J) if np.all(np.isfinite(cov)) \
             else np.full(n, np.inf)
@@ -264,6 +267,20 @@ def bias_take_up(result, sensor=None):
     max_incidence = (sensor or SensorModel()).max_incidence_rad
     return beams, core_take_up.take_up(result.points_cad, result.normal, beams,
                                        _fit_weights(result), result.center, max_incidence)
+
+
+def random_pose_covariance(result):
+    """result.pose_covariance with its unit-weight variance s^2 cut to the residuals' random
+    part (core.icp.random_residual_share of the fine fit's weights and residuals, in the
+    readings' order): what the noise makes the pose scatter by. The misfit the registration
+    leaves (the reading bias's left-over, a defect, form) inflates s^2 but moves the pose by a
+    fixed amount, which the systematic term already carries. As given when the result does not
+    hold the fit's own weights (a covariance from elsewhere)."""
+    cov = np.asarray(result.pose_covariance, dtype=float)
+    if result.icp_weights is None or not np.all(np.isfinite(cov)):
+        return cov
+    share = core_icp.random_residual_share(_fit_weights(result), result.deviation)
+    return share * cov
 
 
 def _fit_weights(result):
@@ -377,7 +394,7 @@ def shared_terms(result, index, model):
     shared.append(uncertainty_model.SharedTerm(
         "systematic_mm", np.ones(len(index)) if coefficient is None
         else coefficient[index], lambda rng, k: rng.uniform(-a, a, (k, 1))))
-    cov = np.asarray(result.pose_covariance, dtype=float)
+    cov = random_pose_covariance(result)
     if np.all(np.isfinite(cov)):
         normal = np.asarray(result.normal, dtype=float)[index]
         arm = np.asarray(result.points_cad, dtype=float)[index] - np.asarray(result.center)
