@@ -84,7 +84,8 @@ from . import uncertainty as uncertainty_mod
 # _point_noise_model, _measure) changes: files of another version are refused. 2: the measured
 # profile's fit takes the nominal's knots where the points thin out (core.airfoil
 # ._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is each
-# reading's beam where it meets the smooth fit (inspection.airfoil.beam_feet).
+# reading's beam where it meets the smooth fit (inspection.airfoil.beam_feet), and their pose
+# the covariance's random part (inspection.uncertainty.random_pose_covariance).
 TASK_MODEL_VERSION = 3
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48
