@@ -210,22 +210,42 @@ def face_points(face, n, rng, margin=0.05):
     return p, nrm / np.linalg.norm(nrm, axis=1)[:, None], uv
 
 
-def planned_readings_result(nominal, rig, plan):
-    """The plan's paths read on a simulated rig and mapped into the CAD by the rig's true pose:
-    (a RegistrationResult with no registration error, (n, 2) planned [section, point] of each
-    reading)."""
-    from BladeInspect.core import stats
-    from BladeInspect.inspection.result import RegistrationResult
+def _read_plan(rig, plan):
+    """Each path of the plan read on a simulated rig: (path, which spots gave a reading, their
+    table points, their SNR)."""
     k = rig.kinematics
-    xyz, snr, planned = [], [], []
     for path in plan.paths:
         r = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
         d = np.asarray(r.reading_mm, dtype=float)
         ok = np.isfinite(d)
         table = k.table_point(k.machine_point(np.asarray(r.stage_xyz)[ok], d[ok]),
                               path.angle_deg)
+        yield path, ok, table, np.asarray(r.snr)[ok]
+
+
+def planned_pointset(rig, plan):
+    """The plan's paths read on a simulated rig, as the rig reports them: a PointSet of table
+    points with their SNR and an ``angle_deg`` column (what a planned scan writes)."""
+    from BladeInspect.core.pointio import PointSet
+    xyz, snr, angle = [], [], []
+    for path, ok, table, s in _read_plan(rig, plan):
+        xyz.append(table)
+        snr.append(s)
+        angle.append(np.full(int(ok.sum()), path.angle_deg))
+    return PointSet(xyz=np.vstack(xyz), snr=np.concatenate(snr),
+                    columns={"angle_deg": np.concatenate(angle)}, source="planned")
+
+
+def planned_readings_result(nominal, rig, plan):
+    """The plan's paths read on a simulated rig and mapped into the CAD by the rig's true pose:
+    (a RegistrationResult with no registration error, (n, 2) planned [section, point] of each
+    reading)."""
+    from BladeInspect.core import stats
+    from BladeInspect.inspection.result import RegistrationResult
+    xyz, snr, planned = [], [], []
+    for path, ok, table, s in _read_plan(rig, plan):
         xyz.append(tf.apply_transform(rig.table_to_cad, table))
-        snr.append(np.asarray(r.snr)[ok])
+        snr.append(s)
         planned.append(np.column_stack([np.full(ok.sum(), path.section), path.points[ok]]))
     xyz, snr = np.vstack(xyz), np.concatenate(snr)
     dist = nominal.signed_distance(xyz)

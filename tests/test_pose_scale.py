@@ -11,7 +11,6 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import icp as icp_mod
-from BladeInspect.core.pointio import PointSet
 from BladeInspect.inspection import uncertainty as uncertainty_mod
 
 N = 20000
@@ -75,7 +74,7 @@ class ThickenedPartOnThePlannedScan(unittest.TestCase):
         from BladeInspect.inspection.weighting import weight_model_for
         from BladeInspect.measurement.planning import plan_sections
         from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
-        from tests.helpers import demo_nominal, sensor_pose_bound
+        from tests.helpers import demo_nominal, planned_pointset, sensor_pose_bound
         nominal = demo_nominal()
         axis, _ = span_axis_of(nominal)
         truth = random_fixture_pose_of(nominal, np.random.default_rng(3), axis)
@@ -84,17 +83,7 @@ class ThickenedPartOnThePlannedScan(unittest.TestCase):
             rig = SimulatedRig(nominal, truth, seed=3, error_field=field)
             plan = plan_sections(nominal, truth, (30.0, 70.0), rig.sensor, rig.limits,
                                  span_axis=axis)
-            xyz, snr, angle = [], [], []
-            for path in plan.paths:
-                readings = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
-                d = np.asarray(readings.reading_mm)
-                ok = np.isfinite(d)
-                machine = rig.kinematics.machine_point(np.asarray(readings.stage_xyz)[ok], d[ok])
-                xyz.append(rig.kinematics.table_point(machine, path.angle_deg))
-                snr.append(np.asarray(readings.snr)[ok])
-                angle.append(np.full(int(ok.sum()), path.angle_deg))
-            points = PointSet(xyz=np.vstack(xyz), snr=np.concatenate(snr),
-                              columns={"angle_deg": np.concatenate(angle)}, source="planned")
+            points = planned_pointset(rig, plan)
             model, _ = weight_model_for(points)
             fit = pipeline.fine_register(points.xyz, points.snr, nominal, truth,
                                          weight_model=model)

@@ -222,24 +222,14 @@ class TestPlannedScanOfTheDemoBlade(unittest.TestCase):
         from BladeInspect.inspection.sections import span_axis_of
         from BladeInspect.measurement.planning import plan_sections
         from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
-        from tests.helpers import demo_nominal
+        from tests.helpers import demo_nominal, planned_pointset
         cls.nominal = demo_nominal()
         axis, _ = span_axis_of(cls.nominal)
         cls.truth = random_fixture_pose_of(cls.nominal, np.random.default_rng(3), axis)
         rig = SimulatedRig(cls.nominal, cls.truth, seed=3)
         plan = plan_sections(cls.nominal, cls.truth, (30.0, 70.0), rig.sensor, rig.limits,
                              span_axis=axis)
-        xyz, snr, angle = [], [], []
-        for path in plan.paths:
-            readings = rig.scan_path(plan.path_stage_xyz(path), path.angle_deg)
-            d = np.asarray(readings.reading_mm)
-            ok = np.isfinite(d)
-            machine = rig.kinematics.machine_point(np.asarray(readings.stage_xyz)[ok], d[ok])
-            xyz.append(rig.kinematics.table_point(machine, path.angle_deg))
-            snr.append(np.asarray(readings.snr)[ok])
-            angle.append(np.full(int(ok.sum()), path.angle_deg))
-        cls.pointset = PointSet(xyz=np.vstack(xyz), snr=np.concatenate(snr),
-                                columns={"angle_deg": np.concatenate(angle)}, source="planned")
+        cls.pointset = planned_pointset(rig, plan)
 
     def test_sensor_weights_by_default_and_within_the_bound(self):
         from BladeInspect.inspection import pipeline
