@@ -54,15 +54,21 @@ def circle_profile():
     return kernel.Profile(RADIUS * np.column_stack([np.cos(a), np.sin(a)]))
 
 
+def tilted_beams(normal, rng, max_deg):
+    """Unit beams against the outward normals, each turned by an incidence uniform in
+    +-max_deg."""
+    tilt = np.radians(rng.uniform(-max_deg, max_deg, len(normal)))
+    c, s = np.cos(tilt), np.sin(tilt)
+    return -np.column_stack([c * normal[:, 0] - s * normal[:, 1],
+                             s * normal[:, 0] + c * normal[:, 1]])
+
+
 def readings_on_circle(rng, n, error_mm):
     """(true points on the circle, their readings moved along the beams, unit beams): beams
     at incidences up to 80 deg against the inward normal, errors uniform in +-error_mm."""
     a = rng.uniform(0.0, 2.0 * np.pi, n)
     normal = np.column_stack([np.cos(a), np.sin(a)])
-    tilt = np.radians(rng.uniform(-80.0, 80.0, n))
-    c, s = np.cos(tilt), np.sin(tilt)
-    beams = -np.column_stack([c * normal[:, 0] - s * normal[:, 1],
-                              s * normal[:, 0] + c * normal[:, 1]])
+    beams = tilted_beams(normal, rng, 80.0)
     true = RADIUS * normal
     return true, true + rng.uniform(-error_mm, error_mm, n)[:, None] * beams, beams
 
@@ -105,10 +111,7 @@ class DrawsBaseAlongTheBeam(unittest.TestCase):
         rng = np.random.default_rng(11)
         a = np.linspace(0.0, 2.0 * np.pi, 3000, endpoint=False)
         normal = np.column_stack([np.cos(a), np.sin(a)])
-        tilt = np.radians(rng.uniform(-70.0, 70.0, len(a)))
-        c, s = np.cos(tilt), np.sin(tilt)
-        beams = -np.column_stack([c * normal[:, 0] - s * normal[:, 1],
-                                  s * normal[:, 0] + c * normal[:, 1]])
+        beams = tilted_beams(normal, rng, 70.0)
         true = RADIUS * normal
         read = true + rng.uniform(-0.006, 0.006, len(a))[:, None] * beams
         smooth = kernel.Profile(read, 0.006 / np.sqrt(3.0))     # sigma_beam: >= the normal noise

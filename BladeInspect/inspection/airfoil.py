@@ -282,15 +282,21 @@ def nominal_planes(nominal, heights_pct):
 
 # ---------------------------------------------------------------- per section
 
-def _into_plane(xyz, surface_normal, origin, plane_normal):
-    """Points slid along the CAD surface into the plane (see the module notes)."""
-    h = (xyz - origin) @ plane_normal
+def _slide(surface_normal, plane_normal):
+    """(direction (n, 3), divisor (n,)) of the slide into the plane: a point h above it moves
+    by -h / divisor along direction -- the surface's tangent nearest the plane normal, or the
+    plane normal itself where the surface lies nearly in the plane."""
     s = plane_normal - (surface_normal @ plane_normal)[:, None] * surface_normal
     along = s @ plane_normal
     ok = along > 0.2
-    step = np.where(ok, h / np.where(ok, along, 1.0), h)
-    direction = np.where(ok[:, None], s, plane_normal)
-    return xyz - step[:, None] * direction
+    return np.where(ok[:, None], s, plane_normal), np.where(ok, along, 1.0)
+
+
+def _into_plane(xyz, surface_normal, origin, plane_normal):
+    """Points slid along the CAD surface into the plane (see the module notes)."""
+    direction, divisor = _slide(surface_normal, plane_normal)
+    h = (xyz - origin) @ plane_normal
+    return xyz - (h / divisor)[:, None] * direction
 
 
 def _point_noise(pts2d, nominal_profile):
@@ -572,11 +578,8 @@ def _beams_in_plane(beams, surface_normal, frame):
     """(n, 2) in-plane displacement that _into_plane makes of a unit move along each beam (a
     move out of the plane is slid back along the surface, which turns it in the plane)."""
     pn = np.asarray(frame.normal, dtype=float)
-    s = pn - (surface_normal @ pn)[:, None] * surface_normal
-    along = s @ pn
-    ok = along > 0.2
-    step = np.where(ok, (beams @ pn) / np.where(ok, along, 1.0), beams @ pn)
-    moved = beams - step[:, None] * np.where(ok[:, None], s, pn)
+    direction, divisor = _slide(surface_normal, pn)
+    moved = beams - ((beams @ pn) / divisor)[:, None] * direction
     return np.column_stack([moved @ frame.e1, moved @ frame.e2])
 
 
