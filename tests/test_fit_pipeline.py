@@ -130,8 +130,8 @@ class DecisionThroughVerdictTest(unittest.TestCase):
 
 class PartWorstBesideLeftOutReadings(unittest.TestCase):
     """The part's worst is the largest |deviation| among the fit's inliers; readings the fit
-    left out that lie beyond it are named (docs/fits.md, "Why the part's worst is
-    over-stated"): a bump whose top the robust fit rejected, below the tolerance."""
+    left out that lie beyond it are named (docs/fits.md, "The part's worst inlier: a
+    censored maximum"): a bump whose top the robust fit rejected, below the tolerance."""
 
     @classmethod
     def setUpClass(cls):

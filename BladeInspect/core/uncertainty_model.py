@@ -18,6 +18,13 @@ samples of the competing readings; a lone competitor is a single reading (bias 0
 sigma), in closed form. Errors common to the readings (``SharedTerm``: a reading bias the fit
 left unevenly, the pose) are sampled with the noise where they move the competitors
 differently, since the maximum then takes the largest push.
+
+Where a selection has kept only readings measured at most a cut-off (a robust fit that gives a
+defect's top no weight and keeps its flanks), the largest kept reading is a censored maximum
+(``censored_max_error``): a reading that noise pushes above the cut-off is left out rather than
+reported, and one whose true level lies above it is kept when its noise pulls it below. The
+upward bias of max_error is then gone and the truth itself (the largest true level among the
+kept readings) follows the noise; there the readings' own levels, not a plateau, decide.
 """
 
 import numpy as np
@@ -137,4 +144,37 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
             bias = float(error.mean())
     if bias_only:
         terms = {}
+    return terms, bias, n
+
+
+def censored_max_error(level, sigma, cutoff, unit_noise=uniform_unit_noise, shared=(),
+                       draws=DRAWS, seed=0):
+    """The error of the largest reading a selection kept, the selection keeping a reading
+    only when its measured value is at most ``cutoff`` (module notes): (terms {name: mm},
+    bias, number of readings). ``level``: the readings' true levels, signed so that the
+    maximum is the largest (the caller turns the measured side up); ``sigma``: each one's
+    noise 1 sigma. Each draw measures every reading afresh (noise in ``unit_noise``, and the
+    ``shared`` terms' pushes), keeps those at most ``cutoff``, and errs by the largest kept
+    measured value less the largest kept true level; a draw that keeps none is not counted.
+    Terms as max_error's: "noise_mm" that of the noise alone, then what each shared term adds
+    (root sum of squares: the RMS error, bias included)."""
+    level = np.asarray(level, dtype=float).reshape(-1)
+    sigma = np.asarray(sigma, dtype=float).reshape(-1)
+    n = len(level)
+    rng = np.random.default_rng(seed)
+    draws = int(np.clip(_MAX_SAMPLES // max(n, 1), _MIN_DRAWS, draws))
+    measured = level + unit_noise(rng, (draws, n)) * sigma
+    terms, total, bias = {}, 0.0, 0.0
+    for k, term in enumerate([None] + list(shared)):
+        if term is not None:
+            measured = measured + term.moves(term.sample(rng, draws))
+        kept = measured <= cutoff
+        some = kept.any(axis=1)
+        error = (np.where(kept, measured, -np.inf).max(axis=1)
+                 - np.where(kept, level, -np.inf).max(axis=1))[some]
+        rms = float(np.sqrt(np.mean(error ** 2))) if len(error) else float("inf")
+        terms["noise_mm" if term is None else term.name] = float(
+            np.sqrt(max(rms ** 2 - total ** 2, 0.0)))
+        total = rms
+        bias = float(error.mean()) if len(error) else float("nan")
     return terms, bias, n

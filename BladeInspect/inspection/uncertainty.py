@@ -31,7 +31,9 @@ worst). Its standard uncertainty combines, as independent terms (GUM, root sum o
 
 A worst deviation (a section's, a spot's, the part's: verdict.judge) is a maximum over points:
 its U is that of the error of a maximum (worst_terms, core.uncertainty_model), the upward bias
-of the largest of several noisy readings included in U rather than corrected.
+of the largest of several noisy readings included in U rather than corrected. The part's worst
+inlier, where the fit left out a defect's top beside it, is a censored maximum
+(censored_worst_terms).
 """
 
 from dataclasses import dataclass, field
@@ -342,9 +344,12 @@ def unit_noise(sensor):
     return lambda rng, shape: np.clip(rng.standard_normal(shape), -c, c) / s
 
 
-def worst_terms(result, candidates, model=None):
+def worst_terms(result, candidates, model=None, left_out=None):
     """The worst |deviation| among the points ``candidates`` and its standard uncertainty
     terms as the error of a maximum: (worst index, {term: mm}, number of competing points).
+    ``left_out``: readings a selection left out of ``candidates`` by their measured values
+    (the robust fit's zero weights, for the part's worst inlier): where any of them could
+    have been kept, the worst is a censored maximum (censored_worst_terms).
 
     core.uncertainty_model.max_error: the competitors are the readings within
     COMPETING_SIGMAS combined sigmas of the worst (their own noise along the normal,
@@ -367,21 +372,97 @@ def worst_terms(result, candidates, model=None):
     candidates, dev, noise = candidates[usable], dev[usable], noise[usable]
     worst = int(candidates[np.argmax(np.abs(dev))])
     terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
-    sampled, _, n = maximum_error(dev, noise, shared_terms(result, candidates, model), model)
+    censored = (None if left_out is None or not len(left_out) else
+                censored_worst_terms(result, worst, candidates, left_out, model))
+    sampled, _, n = censored or maximum_error(dev, noise, shared_terms(result, candidates,
+                                                                       model), model)
     terms.update(sampled)
     return worst, terms, n
+
+
+# Each reading's true level is estimated as the mean measured deviation over this many nearest
+# readings (itself included): the size of core.icp's defect-test neighbourhoods, enough to put a
+# level's noise at a quarter of one reading's while a defect's flank stays resolved.
+LEVEL_NEIGHBOURS = 16
+# Draws of the shared terms from which each reading's largest push is taken
+_PUSH_PROBES = 64
+
+
+def censored_worst_terms(result, worst, candidates, left_out, model):
+    """The error terms of the worst among ``candidates`` (index ``worst``) where a selection
+    kept them and left out ``left_out`` by their measured values: (terms, bias, n) of
+    core.uncertainty_model.censored_max_error, or None when none of the left-out readings
+    could have been kept (the plain maximum's model applies).
+
+    Where a defect straddles the robust fit's cut-off, the fit keeps its flanks and gives its
+    top no weight, and which flank readings it keeps follows their measured deviations; the
+    worst inlier is then pinned under the cut-off and so is its truth (docs/fits.md, "The
+    part's worst inlier: a censored maximum"). The cut-off is taken at the reported worst
+    (every kept reading lies at or under it); each reading's true level is the mean of the
+    measured deviations of its LEVEL_NEIGHBOURS nearest readings (kept or left out), turned
+    to the worst's side. The competitors are the readings whose level lies within
+    COMPETING_SIGMAS combined noise sigmas under the cut-off, and at most the reach of the
+    noise and the shared terms above it (they could have brought it under); the model applies
+    when a left-out competitor's level lies above the cut-off. The systematic bias and the
+    pose are sampled with the noise, since they move which readings the cut-off keeps. Each
+    reading's own noise decides the cut here, where core.icp's defect test decides it by
+    neighbourhood means (noise averaged down): on Rotor 67 the noise term is over-stated
+    (docs/fits.md, same section)."""
+    from scipy.spatial import cKDTree
+    dev = np.asarray(result.deviation, dtype=float)
+    side = -1.0 if dev[worst] < 0 else 1.0
+    pool = np.union1d(candidates, np.asarray(left_out, dtype=int))
+    noise = normal_noise(result, pool, model.sensor)
+    pool, noise = pool[np.isfinite(noise)], noise[np.isfinite(noise)]
+    cutoff = side * dev[worst]
+    sigma_worst = float(normal_noise(result, [worst], model.sensor)[0])
+    below = COMPETING_SIGMAS * np.sqrt(sigma_worst ** 2 + noise ** 2)
+    # Above the cut-off, a reading competes when its noise, or its noise and the shared
+    # terms' push (a bias that lowers every reading keeps a higher band of the defect), could
+    # bring it under the cut-off.
+    shared = shared_terms(result, pool, model)
+    rng = np.random.default_rng(0)
+    above = _noise_bound_sigmas(model.sensor) * noise + sum(
+        np.abs(t.moves(t.sample(rng, _PUSH_PROBES))).max(axis=0) for t in shared)
+    # a level is a mean over neighbours: a reading whose own value lies further from the
+    # cut-off than the band plus its own noise's reach is not worth a neighbour search
+    near = side * dev[pool] >= cutoff - below - 2.0 * above
+    points = np.asarray(result.points_cad, dtype=float)
+    k = min(LEVEL_NEIGHBOURS, len(pool))
+    _, neighbours = cKDTree(points[pool]).query(points[pool[near]], k)
+    level = (side * dev[pool])[np.asarray(neighbours).reshape(int(near.sum()), k)].mean(axis=1)
+    competes = np.zeros(len(pool), dtype=bool)
+    competes[near] = ((level >= cutoff - below[near]) & (level <= cutoff + above[near]))
+    competes |= pool == worst
+    levels = np.full(len(pool), -np.inf)
+    levels[near] = level
+    # the cut-off decided where the fit left out a competitor whose level lies above it (the
+    # defect's top beyond the kept flank); a worst inlier with no such reading beside it (the
+    # part in its noise, a rejected gross error) is a plain maximum
+    if not (competes & np.isin(pool, left_out) & (levels >= cutoff)).any():
+        return None
+    # the shared terms' draws are symmetric about zero: their pushes need no turning to the side
+    return uncertainty_model.censored_max_error(
+        levels[competes], noise[competes], cutoff, unit_noise(model.sensor),
+        [uncertainty_model.SharedTerm(t.name, t.coefficients[competes], t.sample)
+         for t in shared])
+
+
+def _noise_bound_sigmas(sensor):
+    """The largest a reading's noise can be, in its sigmas: sqrt 3 for uniform noise, the
+    clip over the clipped normal's sigma otherwise (rig.sensor)."""
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    return (np.sqrt(3.0) if sensor.noise == "uniform"
+            else NORMAL_CLIP_SIGMAS / _clipped_normal_std(NORMAL_CLIP_SIGMAS))
 
 
 def maximum_error(values, noise, shared, model, bias_only=False):
     """core.uncertainty_model.max_error of these readings in the model's sensor noise
     (``bias_only``: its bias alone, the terms not worked out)."""
-    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
-    bound = (np.sqrt(3.0) if model.sensor.noise == "uniform"
-             else NORMAL_CLIP_SIGMAS / _clipped_normal_std(NORMAL_CLIP_SIGMAS))
     return uncertainty_model.max_error(
         values, noise, unit_noise(model.sensor), shared,
         equal_sigma_max=lambda k: max_of_draws(k, model.sensor.noise),
-        noise_bound_sigmas=bound, bias_only=bias_only)
+        noise_bound_sigmas=_noise_bound_sigmas(model.sensor), bias_only=bias_only)
 
 
 def shared_terms(result, index, model):
@@ -406,7 +487,7 @@ def shared_terms(result, index, model):
     return shared
 
 
-def worst_expanded_uncertainty(result, candidates, model=None):
+def worst_expanded_uncertainty(result, candidates, model=None, left_out=None):
     """(worst index, U = k * the combined worst_terms, competing points)."""
-    worst, terms, n = worst_terms(result, candidates, model)
+    worst, terms, n = worst_terms(result, candidates, model, left_out)
     return worst, COVERAGE_FACTOR * float(np.sqrt(sum(t ** 2 for t in terms.values()))), n

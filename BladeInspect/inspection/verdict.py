@@ -81,15 +81,14 @@ def decided(value, U, tolerance, rule):
             not np.isfinite(d.test_uncertainty_ratio) else float(d.test_uncertainty_ratio)}
 
 
-def _larger_not_fitted(result, dev, worst, isolated):
-    """The readings the fit gave no weight (not the isolated outliers) whose |deviation|
-    exceeds the part's worst inlier: {n, worst_deviation_mm, xyz}, None when there are none.
-    Where a defect straddles the robust fit's cut-off, the worst inlier is pinned under it and
-    which readings are inliers follows their measured deviations (docs/fits.md, "Why the part's
-    worst is over-stated"): the part's largest deviation is then not that row's; those
-    readings are judged where a section's band or a spot holds them."""
-    left_out = np.flatnonzero(~np.asarray(result.inlier, dtype=bool))
-    left_out = left_out[~np.isin(left_out, isolated)]
+def _larger_not_fitted(result, dev, worst, left_out):
+    """The readings ``left_out`` (those the fit gave no weight, not the isolated outliers)
+    whose |deviation| exceeds the part's worst inlier: {n, worst_deviation_mm, xyz}, None when
+    there are none. Where a defect straddles the robust fit's cut-off, the worst inlier is
+    pinned under it and which readings are inliers follows their measured deviations
+    (docs/fits.md, "The part's worst inlier: a censored maximum"): the part's largest
+    deviation is then not that row's; those readings are judged where a section's band or a
+    spot holds them."""
     larger = left_out[np.abs(dev[left_out]) > abs(dev[worst])]
     if not len(larger):
         return None
@@ -180,16 +179,21 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
     # The part's largest deviation among the fit's inliers (what minimax minimises), with its
     # own U and verdict: reported beside the sections'; the part's verdict is theirs and the
     # spots' (a defect the robust fit rejected is a spot, not an inlier).
-    judged = np.flatnonzero(np.asarray(result.inlier, dtype=bool))
+    inlier = np.asarray(result.inlier, dtype=bool)
+    judged = np.flatnonzero(inlier)
     judged = judged[~np.isin(judged, isolated)]
+    left_out = np.flatnonzero(~inlier)
+    left_out = left_out[~np.isin(left_out, isolated)]
     part = None
     if len(judged):
         worst = judged[np.argmax(np.abs(dev[judged]))]
         part = {"worst_deviation_mm": float(dev[worst]), "of": "the fit's inliers",
                 "xyz": result.points_cad[worst].tolist()}
+        # the fit chose its inliers by their measured deviations: U of a censored maximum
+        # where it left out readings it could have kept (uncertainty.censored_worst_terms)
         part.update(decided(dev[worst], uncertainty_mod.worst_expanded_uncertainty(
-            result, judged, measurement_model)[1], tolerance, decision_rule))
-        part["larger_not_fitted"] = _larger_not_fitted(result, dev, worst, isolated)
+            result, judged, measurement_model, left_out)[1], tolerance, decision_rule))
+        part["larger_not_fitted"] = _larger_not_fitted(result, dev, worst, left_out)
     decision = decision_mod.combine([s["verdict"] for s in sections_out if "verdict" in s]
                                     + [s["verdict"] for s in spot_out])
     passed = bool(not spots and all(s["pass"] is not False for s in sections_out)
