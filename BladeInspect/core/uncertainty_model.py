@@ -165,7 +165,7 @@ def censored_max_error(level, sigma, cutoff, unit_noise=uniform_unit_noise, shar
     draws = int(np.clip(_MAX_SAMPLES // max(n, 1), _MIN_DRAWS, draws))
     measured = level + unit_noise(rng, (draws, n)) * sigma
     terms, total, bias = {}, 0.0, 0.0
-    for k, term in enumerate([None] + list(shared)):
+    for term in [None] + list(shared):
         if term is not None:
             measured = measured + term.moves(term.sample(rng, draws))
         kept = measured <= cutoff

@@ -415,7 +415,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     noise = normal_noise(result, pool, model.sensor)
     pool, noise = pool[np.isfinite(noise)], noise[np.isfinite(noise)]
     cutoff = side * dev[worst]
-    sigma_worst = float(normal_noise(result, [worst], model.sensor)[0])
+    sigma_worst = float(noise[pool == worst][0])
     below = COMPETING_SIGMAS * np.sqrt(sigma_worst ** 2 + noise ** 2)
     # Above the cut-off, a reading competes when its noise, or its noise and the shared
     # terms' push (a bias that lowers every reading keeps a higher band of the defect), could

@@ -180,10 +180,10 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
     # own U and verdict: reported beside the sections'; the part's verdict is theirs and the
     # spots' (a defect the robust fit rejected is a spot, not an inlier).
     inlier = np.asarray(result.inlier, dtype=bool)
-    judged = np.flatnonzero(inlier)
-    judged = judged[~np.isin(judged, isolated)]
-    left_out = np.flatnonzero(~inlier)
-    left_out = left_out[~np.isin(left_out, isolated)]
+    not_isolated = np.ones(len(dev), dtype=bool)
+    not_isolated[isolated] = False
+    judged = np.flatnonzero(inlier & not_isolated)
+    left_out = np.flatnonzero(~inlier & not_isolated)
     part = None
     if len(judged):
         worst = judged[np.argmax(np.abs(dev[judged]))]
