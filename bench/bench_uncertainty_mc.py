@@ -206,7 +206,7 @@ def registered(nominal, xyz, snr, init, rng, angles, kinematics):
         measured_to_cad=fit.transform, points_cad=points_cad, deviation=dist.distance,
         inlier=inlier, closest=dist.closest, normal=dist.normal, face=dist.face, snr=snr,
         columns={"angle_deg": np.asarray(angles, dtype=float)}, n_rows_skipped=0,
-        icp_weights=fit.weights,
+        icp_weights=fit.weights, inlier_cut=fit.cut,
         rms_mm=float(np.sqrt(np.mean(dist.distance[inlier] ** 2))),
         pose_covariance=covariance, center=fit.center, pose_uncertainty_mm=float(statistical),
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse={})

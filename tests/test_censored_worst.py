@@ -7,6 +7,7 @@ import unittest
 
 import numpy as np
 
+from BladeInspect.core import icp as core_icp
 from BladeInspect.core import uncertainty_model as UM
 from BladeInspect.inspection import uncertainty as U
 from BladeInspect.rig.sensor import SensorModel
@@ -43,6 +44,34 @@ class OneReadingUnderACutOffTest(unittest.TestCase):
                 self.assertAlmostEqual(terms["noise_mm"], sigma * np.hypot(mean, sd),
                                        delta=0.04 * sigma)
                 self.assertAlmostEqual(bias, sigma * mean, delta=0.1 * sigma)
+
+
+class ReplayedSelectionTest(unittest.TestCase):
+    """core.icp.InlierCut.kept, given the fit's own neighbourhoods (its windows along the
+    Morton curve), keeps exactly the readings robust_selection's tapered weights keep: random
+    fields with a defect, a sensor's bias response and low-SNR readings."""
+
+    def test_the_cut_keeps_what_the_weights_keep(self):
+        rng = np.random.default_rng(2)
+        for trial in range(20):
+            n = 3000
+            points = rng.uniform(-20.0, 20.0, (n, 3)) * [1.0, 1.0, 0.05]
+            d = rng.normal(0.0, 0.002, n)
+            centre = points[rng.integers(n)]
+            d += 0.02 * np.exp(-np.sum((points - centre) ** 2, axis=1) / 9.0)
+            d[rng.integers(n, size=5)] += 0.3
+            a = rng.uniform(0.3, 1.5, n)
+            response = rng.uniform(-1.0, 1.0) * np.cos(points[:, 0] / 7.0)
+            options = core_icp.ICPOptions(systematic_mm=0.004 * (trial % 2))
+            hoods = core_icp.Neighbourhoods(points, options.defect_neighbours)
+            rho, _, cut = core_icp.robust_selection(d, a, options, hoods, response)
+            position = np.empty(n, dtype=int)
+            position[hoods.order] = np.arange(n)
+            windows = hoods.order[hoods._start[position][:, None] + np.arange(hoods.size)]
+            kept = cut.kept(d[None, :], np.arange(n), np.arange(n), windows)[0]
+            with self.subTest(trial=trial):
+                self.assertGreater(np.count_nonzero(rho == 0), 10)
+                np.testing.assert_array_equal(kept, rho > 0)
 
 
 class StraddlingDefectTest(unittest.TestCase):
@@ -95,6 +124,43 @@ class StraddlingDefectTest(unittest.TestCase):
               % (rms * 1e3, np.mean(stated) * 1e3, np.mean(plain) * 1e3))
         self.assertLess(abs(np.mean(stated) / rms - 1.0), 0.1)
         self.assertGreater(np.mean(plain) / rms, 1.2)
+
+    def fit_selection(self, measured):
+        """core.icp's robust weights at a fixed pose, granting each neighbourhood the bias a
+        reading error of the sensor's accuracy leaves (here all of it: no fit takes it up):
+        (kept, their InlierCut)."""
+        n = len(measured)
+        rho, _, cut = core_icp.robust_selection(
+            measured, np.ones(n), core_icp.ICPOptions(systematic_mm=self.a), self.hoods,
+            np.ones(n))
+        return rho > 0, cut
+
+    def test_noise_term_against_the_fit_s_own_selection(self):
+        # the fit's two tests (per reading beyond 4.5 robust scales, by neighbourhood means
+        # beyond 4.5 of their spread) decide which readings are kept, not a cut-off; the model
+        # replays them from the scan's InlierCut. Noise alone, against the stated noise term
+        # (the model's error with its shared terms left out).
+        self.hoods = core_icp.Neighbourhoods(self.on, 16)
+        rng = np.random.default_rng(11)
+        error = []
+        for _ in range(self.SCANS // 4):
+            measured = self.field + rng.uniform(-self.a, self.a, len(self.field))
+            kept, _ = self.fit_selection(measured)
+            error.append(measured[kept].max() - self.field[kept].max())
+        rms = float(np.sqrt(np.mean(np.square(error))))
+        stated = []
+        for _ in range(6):
+            measured = self.field + rng.uniform(-self.a, self.a, len(self.field))
+            kept, cut = self.fit_selection(measured)
+            r = fx.make_result(self.nominal, fx.displaced(self.nominal, self.on, measured),
+                               inlier=kept)
+            r = dataclasses.replace(r, pose_covariance=np.zeros((6, 6)), inlier_cut=cut)
+            _, terms, _ = U.worst_terms(r, np.flatnonzero(kept), self.model,
+                                        np.flatnonzero(~kept))
+            stated.append(terms["noise_mm"])
+        print("censored worst, the fit's selection, noise alone: simulated RMS %.2f um, "
+              "stated %.2f um" % (rms * 1e3, np.mean(stated) * 1e3))
+        self.assertLess(abs(np.mean(stated) / rms - 1.0), 0.1)
 
     def test_a_gross_error_left_out_is_no_cut_off(self):
         # the part within its noise and one gross error the fit left out: nothing the fit cut

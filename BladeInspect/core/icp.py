@@ -92,6 +92,7 @@ class ICPResult:
     # the distances, when that was applied linearly; see ICPOptions.linear_update_mm).
     closest: np.ndarray = None  # (N,3)
     normals: np.ndarray = None  # (N,3)
+    cut: "InlierCut" = None     # where the final weights reach 0 (robust_selection)
 
 
 def horn(target, source, weights=None):
@@ -152,7 +153,17 @@ def _robust_deviation(values, usable, options):
 
 
 def robust_weights(distances, a, options, neighbourhoods=None, bias_response=None):
-    """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point).
+    """rho_i of the module docstring, and the robust scale s (mm, for a unit-weight point):
+    robust_selection's first two.
+    """
+    rho, scale, _ = robust_selection(distances, a, options, neighbourhoods, bias_response)
+    return rho, scale
+
+
+def robust_selection(distances, a, options, neighbourhoods=None, bias_response=None):
+    """(rho_i of the module docstring, the robust scale s (mm, for a unit-weight point), the
+    InlierCut of these weights: where each of the two tests gives no weight, None where no
+    point is usable).
 
     `neighbourhoods` (of the measured points) switches on the defect test: the mean of the
     standardised residuals, clipped, over a point's neighbourhood is judged against the robust
@@ -176,7 +187,7 @@ def robust_weights(distances, a, options, neighbourhoods=None, bias_response=Non
     """
     usable = (a > 0) & np.isfinite(distances)
     if not usable.any():
-        return np.zeros(len(distances)), np.nan
+        return np.zeros(len(distances)), np.nan, None
     # The noise model grants a point of low SNR a noise of sigma0 / sqrt(a_i), without bound;
     # but gross errors are what low SNRs bring (docs/contracts.md), so when judging outliers no
     # point is granted more than max_noise_ratio times a typical point's noise (by default none: the
@@ -185,6 +196,7 @@ def robust_weights(distances, a, options, neighbourhoods=None, bias_response=Non
     z = np.where(usable, distances * root, np.inf)
     u, scale = _robust_deviation(z, usable, options)
     rho = _taper(u, options)
+    cut = InlierCut(root=root, point_cut=options.k_zero * scale)
     if neighbourhoods is not None:
         granted = (0.0 if bias_response is None or options.systematic_mm <= 0 else
                    options.systematic_mm * np.abs(np.nan_to_num(bias_response)) * root)
@@ -197,7 +209,46 @@ def robust_weights(distances, a, options, neighbourhoods=None, bias_response=Non
                          else neighbourhoods.means(np.where(usable, granted, 0.0), usable))
             excess = np.where(finite, np.maximum(np.abs(local) - allowance, 0.0), np.inf)
             rho = rho * _taper(excess / spread, options)
-    return rho, scale
+            n = len(distances)
+            cut.limit = np.broadcast_to(limit, (n,)).copy()
+            cut.allowance = np.broadcast_to(allowance, (n,)).copy()
+            cut.neighbourhood_cut = options.k_zero * spread
+    return rho, scale, cut
+
+
+@dataclass
+class InlierCut:
+    """Where robust_selection's weights reach 0, for a model to replay which readings a fit
+    keeps (inspection.uncertainty.censored_worst_terms): reading i, of residual d_i, has
+    z_i = d_i root_i and is kept (rho_i > 0) when |z_i| < point_cut and, with the defect test,
+    when |mean of clip(z_j, +-limit_j) over its neighbourhood| - allowance_i < neighbourhood_cut
+    (limit, allowance None: no defect test)."""
+    root: np.ndarray                   # (N,)
+    point_cut: float
+    limit: np.ndarray = None           # (N,)
+    allowance: np.ndarray = None       # (N,)
+    neighbourhood_cut: float = np.inf
+
+    def rows(self, rows):
+        """The cut of some readings only (their neighbourhoods' tests stay as fitted)."""
+        pick = (lambda v: None if v is None else v[rows])
+        return InlierCut(self.root[rows], self.point_cut, pick(self.limit),
+                         pick(self.allowance), self.neighbourhood_cut)
+
+    def kept(self, values, index, judged, neighbours):
+        """(draws, len(judged)) bool: which readings the fit would keep, for ``values`` (draws,
+        m) residuals of its readings ``index`` (m,); ``judged``: the positions (in m) of the
+        readings to decide, ``neighbours`` (len(judged), k) the positions of each one's
+        neighbourhood (with the defect test)."""
+        index = np.asarray(index)
+        z = values * self.root[index]
+        keep = np.abs(z[:, judged]) < self.point_cut
+        if self.limit is not None:
+            limit = self.limit[index]
+            local = np.clip(z, -limit, limit)[:, neighbours].mean(axis=2)
+            excess = np.maximum(np.abs(local) - self.allowance[index][judged], 0.0)
+            keep &= excess < self.neighbourhood_cut
+        return keep
 
 
 def _bias_response(moved, normals, beams_cad, a, max_incidence_rad=None):
@@ -514,8 +565,8 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         closest, normals, distances = closest_fn(moved)
     if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
         a = normalised_weights(weight_model, T, normals, len(points))
-    rho, _ = robust_weights(distances, a, options, neighbourhoods,
-                            bias_response(T, moved, normals))
+    rho, _, cut = robust_selection(distances, a, options, neighbourhoods,
+                                   bias_response(T, moved, normals))
     w = a * rho
     inlier = rho > 0
     center = w @ moved / w.sum() if w.sum() > 0 else moved.mean(axis=0)
@@ -529,4 +580,4 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         rms=float(np.sqrt(np.mean(distances[inlier] ** 2))) if inlier.any() else float("nan"),
         sigma0=float(np.sqrt(np.sum(w[keep] * distances[keep] ** 2) / dof)),
         iterations=iterations, converged=converged, covariance=cov, center=center,
-        split=split, stopped=stopped, closest=closest, normals=normals)
+        split=split, stopped=stopped, closest=closest, normals=normals, cut=cut)

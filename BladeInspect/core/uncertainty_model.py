@@ -24,7 +24,9 @@ defect's top no weight and keeps its flanks), the largest kept reading is a cens
 (``censored_max_error``): a reading that noise pushes above the cut-off is left out rather than
 reported, and one whose true level lies above it is kept when its noise pulls it below. The
 upward bias of max_error is then gone and the truth itself (the largest true level among the
-kept readings) follows the noise; there the readings' own levels, not a plateau, decide.
+kept readings) follows the noise; there the readings' own levels, not a plateau, decide. The
+selection may be given as a replay of the fit's own tests (``kept``: core.icp.InlierCut), which
+judge a reading by its neighbourhood's readings as well as its own.
 """
 
 import numpy as np
@@ -148,19 +150,25 @@ def max_error(deviation, sigma, unit_noise=uniform_unit_noise, shared=(),
 
 
 def censored_max_error(level, sigma, cutoff, unit_noise=uniform_unit_noise, shared=(),
-                       draws=DRAWS, seed=0):
+                       draws=DRAWS, seed=0, kept=None, judged=None):
     """The error of the largest reading a selection kept, the selection keeping a reading
-    only when its measured value is at most ``cutoff`` (module notes): (terms {name: mm},
-    bias, number of readings). ``level``: the readings' true levels, signed so that the
-    maximum is the largest (the caller turns the measured side up); ``sigma``: each one's
-    noise 1 sigma. Each draw measures every reading afresh (noise in ``unit_noise``, and the
-    ``shared`` terms' pushes), keeps those at most ``cutoff``, and errs by the largest kept
+    only when its measured value is at most ``cutoff`` (module notes), or as ``kept`` decides:
+    (terms {name: mm}, bias, number of readings judged). ``level``: the readings' true levels,
+    signed so that the maximum is the largest (the caller turns the measured side up);
+    ``sigma``: each one's noise 1 sigma. Each draw measures every reading afresh (noise in
+    ``unit_noise``, and the ``shared`` terms' pushes), keeps some, and errs by the largest kept
     measured value less the largest kept true level; a draw that keeps none is not counted.
+    ``judged``: the positions of the readings the maximum is over (default all; the others
+    only take part in ``kept``); ``kept(measured (draws, n)) -> (draws, len(judged)) bool``,
+    default measured <= cutoff (a selection by neighbourhoods reads the others).
     Terms as max_error's: "noise_mm" that of the noise alone, then what each shared term adds
     (root sum of squares: the RMS error, bias included)."""
     level = np.asarray(level, dtype=float).reshape(-1)
     sigma = np.asarray(sigma, dtype=float).reshape(-1)
     n = len(level)
+    judged = np.arange(n) if judged is None else np.asarray(judged, dtype=int)
+    if kept is None:
+        kept = (lambda measured: measured[:, judged] <= cutoff)
     rng = np.random.default_rng(seed)
     draws = int(np.clip(_MAX_SAMPLES // max(n, 1), _MIN_DRAWS, draws))
     measured = level + unit_noise(rng, (draws, n)) * sigma
@@ -168,13 +176,14 @@ def censored_max_error(level, sigma, cutoff, unit_noise=uniform_unit_noise, shar
     for term in [None] + list(shared):
         if term is not None:
             measured = measured + term.moves(term.sample(rng, draws))
-        kept = measured <= cutoff
-        some = kept.any(axis=1)
-        error = (np.where(kept, measured, -np.inf).max(axis=1)
-                 - np.where(kept, level, -np.inf).max(axis=1))[some]
+        keep = kept(measured)
+        some = keep.any(axis=1)
+        keep = keep[some]
+        error = (np.where(keep, measured[some][:, judged], -np.inf).max(axis=1)
+                 - np.where(keep, level[judged], -np.inf).max(axis=1))
         rms = float(np.sqrt(np.mean(error ** 2))) if len(error) else float("inf")
         terms["noise_mm" if term is None else term.name] = float(
             np.sqrt(max(rms ** 2 - total ** 2, 0.0)))
         total = rms
         bias = float(error.mean()) if len(error) else float("nan")
-    return terms, bias, n
+    return terms, bias, len(judged)

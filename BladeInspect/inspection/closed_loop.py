@@ -171,7 +171,8 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
         deviation_stats=stats_mod.deviation_statistics(dist.distance), coarse=coarse,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
         pose_unmeasured=unmeasured, pose_uncertainty_statistical_mm=float(statistical),
-        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights)
+        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights,
+        inlier_cut=fit.cut)
 
 
 def _sections_json(table, plan):

@@ -566,7 +566,8 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         timing_s=timing, warnings=warnings, source=pointset.source, cad_faces=nominal.cad_faces,
         pose_unmeasured=unmeasured, surface_fit=fit_record,
         pose_uncertainty_statistical_mm=float(statistical),
-        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights)
+        pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights,
+        inlier_cut=fit.cut)
     result.weights = weights_record   # hook: issue 16 item 3
     if fit_choice is not None:   # hook: inspection.fitting (issue 16)
         from . import fitting

@@ -46,6 +46,9 @@ class RegistrationResult:
     fit: Optional[dict] = None
     fit_sensitivity: Optional[dict] = None
     weights: Optional[dict] = None   # the fine ICP's weight model (inspection.weighting)
+    # Where the fine ICP's robust weights reach 0 (core.icp.InlierCut), for the censored
+    # model of the part's worst inlier (inspection.uncertainty); not written to files.
+    inlier_cut: Optional[object] = None
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind
@@ -58,6 +61,7 @@ class RegistrationResult:
             inlier=self.inlier[rows], closest=self.closest[rows], normal=self.normal[rows],
             face=self.face[rows], snr=None if self.snr is None else self.snr[rows],
             icp_weights=None if self.icp_weights is None else self.icp_weights[rows],
+            inlier_cut=None if self.inlier_cut is None else self.inlier_cut.rows(rows),
             columns=columns, deviation_stats=stats.deviation_statistics(self.deviation[rows]))
 
     @property

@@ -396,18 +396,18 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
 
     Where a defect straddles the robust fit's cut-off, the fit keeps its flanks and gives its
     top no weight, and which flank readings it keeps follows their measured deviations; the
-    worst inlier is then pinned under the cut-off and so is its truth (docs/fits.md, "The
-    part's worst inlier: a censored maximum"). The cut-off is taken at the reported worst
-    (every kept reading lies at or under it); each reading's true level is the mean of the
-    measured deviations of its LEVEL_NEIGHBOURS nearest readings (kept or left out), turned
-    to the worst's side. The competitors are the readings whose level lies within
-    COMPETING_SIGMAS combined noise sigmas under the cut-off, and at most the reach of the
-    noise and the shared terms above it (they could have brought it under); the model applies
-    when a left-out competitor's level lies above the cut-off. The systematic bias and the
-    pose are sampled with the noise, since they move which readings the cut-off keeps. Each
-    reading's own noise decides the cut here, where core.icp's defect test decides it by
-    neighbourhood means (noise averaged down): on Rotor 67 the noise term is over-stated
-    (docs/fits.md, same section)."""
+    worst inlier's truth then follows the noise too (docs/fits.md, "The part's worst inlier: a
+    censored maximum"). Each reading's true level is the mean of the measured deviations of
+    its LEVEL_NEIGHBOURS nearest readings (kept or left out), turned to the worst's side. The
+    competitors are the readings whose level lies within COMPETING_SIGMAS combined noise sigmas
+    under the reported worst, and at most the reach of the noise and the shared terms above
+    the fit's per-reading cut (above the reported worst when the cut is not known); the model
+    applies when a left-out competitor's level lies above the reported worst. The systematic
+    bias and the pose are sampled with the noise, since they move which readings are kept.
+    Which are kept: with ``result.inlier_cut`` (core.icp.InlierCut) the fit's own two tests
+    replayed in every draw, a reading against its cut and its neighbourhood's mean (its k
+    nearest readings, drawn with it) against the defect test's; without it, a cut-off at the
+    reported worst on each reading's own value."""
     from scipy.spatial import cKDTree
     dev = np.asarray(result.deviation, dtype=float)
     side = -1.0 if dev[worst] < 0 else 1.0
@@ -417,35 +417,54 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     cutoff = side * dev[worst]
     sigma_worst = float(noise[pool == worst][0])
     below = COMPETING_SIGMAS * np.sqrt(sigma_worst ** 2 + noise ** 2)
+    cut = getattr(result, "inlier_cut", None)
     # Above the cut-off, a reading competes when its noise, or its noise and the shared
     # terms' push (a bias that lowers every reading keeps a higher band of the defect), could
-    # bring it under the cut-off.
+    # bring it under the cut-off -- under the fit's own per-reading cut, when known, which
+    # may lie above the reported worst where the neighbourhoods decided.
     shared = shared_terms(result, pool, model)
     rng = np.random.default_rng(0)
     above = _noise_bound_sigmas(model.sensor) * noise + sum(
         np.abs(t.moves(t.sample(rng, _PUSH_PROBES))).max(axis=0) for t in shared)
+    ceiling = (cutoff if cut is None
+               else np.maximum(cutoff, cut.point_cut / cut.root[pool]))
     # a level is a mean over neighbours: a reading whose own value lies further from the
     # cut-off than the band plus its own noise's reach is not worth a neighbour search
     near = side * dev[pool] >= cutoff - below - 2.0 * above
     points = np.asarray(result.points_cad, dtype=float)
+    tree = cKDTree(points[pool])
     k = min(LEVEL_NEIGHBOURS, len(pool))
-    _, neighbours = cKDTree(points[pool]).query(points[pool[near]], k)
-    level = (side * dev[pool])[np.asarray(neighbours).reshape(int(near.sum()), k)].mean(axis=1)
-    competes = np.zeros(len(pool), dtype=bool)
-    competes[near] = ((level >= cutoff - below[near]) & (level <= cutoff + above[near]))
-    competes |= pool == worst
+
+    def levels_of(rows):
+        _, hood = tree.query(points[pool[rows]], k)
+        return (side * dev[pool])[np.asarray(hood).reshape(len(rows), k)].mean(axis=1)
     levels = np.full(len(pool), -np.inf)
-    levels[near] = level
+    levels[near] = levels_of(np.flatnonzero(near))
+    competes = (levels >= cutoff - below) & (levels <= ceiling + above)
+    competes |= pool == worst
     # the cut-off decided where the fit left out a competitor whose level lies above it (the
     # defect's top beyond the kept flank); a worst inlier with no such reading beside it (the
     # part in its noise, a rejected gross error) is a plain maximum
     if not (competes & np.isin(pool, left_out) & (levels >= cutoff)).any():
         return None
+    kept, judged, drawn = None, None, np.flatnonzero(competes)
+    if cut is not None:
+        # the fit's two tests replayed: each competitor's neighbourhood (its k nearest
+        # readings, where the fit took a window along a space-filling curve) is drawn with it
+        _, hood = tree.query(points[pool[drawn]], k)
+        hood = np.asarray(hood).reshape(len(drawn), k)
+        drawn = np.union1d(drawn, hood.ravel())
+        missing = drawn[~np.isfinite(levels[drawn])]
+        if len(missing):
+            levels[missing] = levels_of(missing)
+        judged = np.searchsorted(drawn, np.flatnonzero(competes))
+        neighbours = np.searchsorted(drawn, hood)
+        kept = (lambda measured: cut.kept(measured, pool[drawn], judged, neighbours))
     # the shared terms' draws are symmetric about zero: their pushes need no turning to the side
     return uncertainty_model.censored_max_error(
-        levels[competes], noise[competes], cutoff, unit_noise(model.sensor),
-        [uncertainty_model.SharedTerm(t.name, t.coefficients[competes], t.sample)
-         for t in shared])
+        levels[drawn], noise[drawn], cutoff, unit_noise(model.sensor),
+        [uncertainty_model.SharedTerm(t.name, t.coefficients[drawn], t.sample)
+         for t in shared], kept=kept, judged=judged)
 
 
 def _noise_bound_sigmas(sensor):
