@@ -2,6 +2,7 @@
 (numpy transforms, the colour map applied point by point, bounding boxes, files parsed with
 numpy), they survive save and reopen, recompute when an input changes, and an error leaves no
 half-built objects. Packaging files are checked here too."""
+import dataclasses
 import os
 import shutil
 import subprocess
@@ -13,7 +14,8 @@ import numpy as np
 
 import FreeCAD
 
-from BladeInspect.app import objects
+from BladeInspect.app import objects, registration_fit
+from BladeInspect.core import icp
 from BladeInspect.core.errors import InputError
 from tests.helpers import REPO
 
@@ -206,6 +208,10 @@ class TestRegistration(DocumentCase):
         rng = np.random.default_rng(3)
         for trial in range(3):
             measured, result = synthetic_result(rng)
+            n = len(result.deviation)
+            result.inlier_cut = icp.InlierCut(
+                rng.uniform(0.5, 1.5, n), 0.0123, rng.uniform(0.01, 0.02, n),
+                rng.uniform(0.0, 0.004, n), 0.0031) if trial else None
             obj = objects.make_registration(self.doc, result, name="Reg%d" % trial)
             name = obj.Name
             obj = self.reopen().getObject(name)
@@ -230,6 +236,15 @@ class TestRegistration(DocumentCase):
             np.testing.assert_allclose(points, measured @ T[:3, :3].T + T[:3, 3], atol=1e-9)
             np.testing.assert_array_equal(dev, result.deviation)
             self.assertEqual(list(obj.Warnings), ["a warning"])
+            # the fit's zero-weight boundaries come back to the bit (none stored: none)
+            restored = dataclasses.replace(result, inlier_cut=None)
+            registration_fit.restore(obj, restored)
+            if result.inlier_cut is None:
+                self.assertIsNone(restored.inlier_cut)
+            for field in ("root", "limit", "allowance", "point_cut", "neighbourhood_cut"):
+                if result.inlier_cut is not None:
+                    np.testing.assert_array_equal(getattr(restored.inlier_cut, field),
+                                                  getattr(result.inlier_cut, field))
 
     def test_re_registers_only_when_an_input_changes(self):
         """The pipeline is replaced by a stand-in whose answer is known (identity pose,

@@ -8,7 +8,10 @@ signature, so opening an older document does not register it again."""
 
 import json
 
+import numpy as np
+
 from ..core.contracts import json_default
+from ..core.icp import InlierCut
 from ..inspection import fitting, weighting
 from ..inspection.fit_report import weights_text
 
@@ -45,6 +48,18 @@ def add_properties(obj, add):
             ("FitSensitivityJson", "Each judged value and the verdict under each fit "
              "objective (fit_sensitivity)", "hidden")):
         add(obj, "App::PropertyString", prop, GROUP, tip, **{mode: True})
+    # Where the fine ICP's weights reach 0 (core.icp.InlierCut), so that a reopened document
+    # states the part's worst as the run did (inspection.uncertainty.censored_worst_terms).
+    for prop in CUT_ARRAYS:
+        add(obj, "App::PropertyFloatList", prop, GROUP,
+            "The fine ICP's zero-weight boundaries, per point (core.icp.InlierCut)", hidden=True)
+    add(obj, "App::PropertyString", "InlierCutJson", GROUP,
+        "The fine ICP's per-point and neighbourhood cuts (core.icp.InlierCut)", hidden=True)
+
+
+# InlierCut's per-point arrays as FloatList properties
+CUT_ARRAYS = {"InlierCutRoot": "root", "InlierCutLimit": "limit",
+              "InlierCutAllowance": "allowance"}
 
 
 def choice_of(obj):
@@ -103,6 +118,13 @@ def store(obj, result):
     obj.WeightsJson = (json.dumps(result.weights, default=json_default)
                        if result.weights else "")
     obj.WeightsUsed = weights_text(result.weights)
+    cut = getattr(result, "inlier_cut", None)
+    for prop, field in CUT_ARRAYS.items():
+        values = None if cut is None else getattr(cut, field)
+        setattr(obj, prop, [] if values is None else np.asarray(values, dtype=float).tolist())
+    obj.InlierCutJson = ("" if cut is None else json.dumps(
+        {"point_cut": cut.point_cut, "neighbourhood_cut": (
+            None if not np.isfinite(cut.neighbourhood_cut) else cut.neighbourhood_cut)}))
 
 
 def weights_record(obj):
@@ -114,6 +136,22 @@ def restore(obj, result):
     """Give a RegistrationResult rebuilt from the document (app.objects.registration_result)
     the records it was stored with, so a report of it names the weights used."""
     result.weights = weights_record(obj)
+    result.inlier_cut = inlier_cut_of(obj, len(result.deviation))
+
+
+def inlier_cut_of(obj, n):
+    """The core.icp.InlierCut a Registration stored for its ``n`` points, or None (a document
+    from before it was stored, or a result without one)."""
+    record = json.loads(getattr(obj, "InlierCutJson", "") or "null")
+    if not record or len(getattr(obj, "InlierCutRoot", ())) != n:
+        return None
+    arrays = {field: np.asarray(getattr(obj, prop), dtype=float)
+              for prop, field in CUT_ARRAYS.items()}
+    with_test = record["neighbourhood_cut"] is not None and len(arrays["limit"]) == n
+    return InlierCut(arrays["root"], float(record["point_cut"]),
+                     arrays["limit"] if with_test else None,
+                     arrays["allowance"] if with_test else None,
+                     float(record["neighbourhood_cut"]) if with_test else np.inf)
 
 
 def fit_record(obj):
