@@ -211,7 +211,8 @@ class TestRegistration(DocumentCase):
             n = len(result.deviation)
             result.inlier_cut = icp.InlierCut(
                 rng.uniform(0.5, 1.5, n), 0.0123, rng.uniform(0.01, 0.02, n),
-                rng.uniform(0.0, 0.004, n), 0.0031) if trial else None
+                rng.uniform(0.0, 0.004, n), 0.0031,
+                icp.Neighbourhoods(result.points_cad, 16)) if trial else None
             obj = objects.make_registration(self.doc, result, name="Reg%d" % trial)
             name = obj.Name
             obj = self.reopen().getObject(name)
@@ -245,6 +246,10 @@ class TestRegistration(DocumentCase):
                 if result.inlier_cut is not None:
                     np.testing.assert_array_equal(getattr(restored.inlier_cut, field),
                                                   getattr(result.inlier_cut, field))
+            if result.inlier_cut is not None:
+                np.testing.assert_array_equal(
+                    restored.inlier_cut.neighbourhoods.members(np.arange(n)),
+                    result.inlier_cut.neighbourhoods.members(np.arange(n)))
 
     def test_re_registers_only_when_an_input_changes(self):
         """The pipeline is replaced by a stand-in whose answer is known (identity pose,

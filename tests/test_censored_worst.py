@@ -65,9 +65,13 @@ class ReplayedSelectionTest(unittest.TestCase):
             options = core_icp.ICPOptions(systematic_mm=0.004 * (trial % 2))
             hoods = core_icp.Neighbourhoods(points, options.defect_neighbours)
             rho, _, cut = core_icp.robust_selection(d, a, options, hoods, response)
-            position = np.empty(n, dtype=int)
-            position[hoods.order] = np.arange(n)
-            windows = hoods.order[hoods._start[position][:, None] + np.arange(hoods.size)]
+            # the windows as the sliding sums take them: the size points from each one's start
+            # along the curve (clipped at its ends), independently of Neighbourhoods.members
+            rank = np.argsort(hoods.order)
+            start = np.clip(rank - hoods.size // 2, 0, n - hoods.size)
+            windows = hoods.order[start[:, None] + np.arange(hoods.size)]
+            np.testing.assert_array_equal(hoods.members(np.arange(n)), windows)
+            self.assertIs(cut.neighbourhoods, hoods)
             kept = cut.kept(d[None, :], np.arange(n), np.arange(n), windows)[0]
             with self.subTest(trial=trial):
                 self.assertGreater(np.count_nonzero(rho == 0), 10)

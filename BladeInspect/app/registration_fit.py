@@ -11,7 +11,7 @@ import json
 import numpy as np
 
 from ..core.contracts import json_default
-from ..core.icp import InlierCut
+from ..core.icp import InlierCut, Neighbourhoods
 from ..inspection import fitting, weighting
 from ..inspection.fit_report import weights_text
 
@@ -53,6 +53,9 @@ def add_properties(obj, add):
     for prop in CUT_ARRAYS:
         add(obj, "App::PropertyFloatList", prop, GROUP,
             "The fine ICP's zero-weight boundaries, per point (core.icp.InlierCut)", hidden=True)
+    add(obj, "App::PropertyIntegerList", "InlierCutOrder", GROUP,
+        "The fine ICP's defect-test neighbourhoods: the points' order along its curve",
+        hidden=True)
     add(obj, "App::PropertyString", "InlierCutJson", GROUP,
         "The fine ICP's per-point and neighbourhood cuts (core.icp.InlierCut)", hidden=True)
 
@@ -122,9 +125,12 @@ def store(obj, result):
     for prop, field in CUT_ARRAYS.items():
         values = None if cut is None else getattr(cut, field)
         setattr(obj, prop, [] if values is None else np.asarray(values, dtype=float).tolist())
+    hoods = None if cut is None else cut.neighbourhoods
+    obj.InlierCutOrder = [] if hoods is None else np.asarray(hoods.order).tolist()
     obj.InlierCutJson = ("" if cut is None else json.dumps(
         {"point_cut": cut.point_cut, "neighbourhood_cut": (
-            None if not np.isfinite(cut.neighbourhood_cut) else cut.neighbourhood_cut)}))
+            None if not np.isfinite(cut.neighbourhood_cut) else cut.neighbourhood_cut),
+         "neighbourhood_size": None if hoods is None else hoods.size}))
 
 
 def weights_record(obj):
@@ -148,10 +154,13 @@ def inlier_cut_of(obj, n):
     arrays = {field: np.asarray(getattr(obj, prop), dtype=float)
               for prop, field in CUT_ARRAYS.items()}
     with_test = record["neighbourhood_cut"] is not None and len(arrays["limit"]) == n
+    order = getattr(obj, "InlierCutOrder", ())
+    hoods = (Neighbourhoods.from_order(order, record["neighbourhood_size"])
+             if with_test and record.get("neighbourhood_size") and len(order) == n else None)
     return InlierCut(arrays["root"], float(record["point_cut"]),
                      arrays["limit"] if with_test else None,
                      arrays["allowance"] if with_test else None,
-                     float(record["neighbourhood_cut"]) if with_test else np.inf)
+                     float(record["neighbourhood_cut"]) if with_test else np.inf, hoods)
 
 
 def fit_record(obj):

@@ -213,6 +213,7 @@ def robust_selection(distances, a, options, neighbourhoods=None, bias_response=N
             cut.limit = np.broadcast_to(limit, (n,)).copy()
             cut.allowance = np.broadcast_to(allowance, (n,)).copy()
             cut.neighbourhood_cut = options.k_zero * spread
+            cut.neighbourhoods = neighbourhoods
     return rho, scale, cut
 
 
@@ -222,15 +223,18 @@ class InlierCut:
     keeps (inspection.uncertainty.censored_worst_terms): reading i, of residual d_i, has
     z_i = d_i root_i and is kept (rho_i > 0) when |z_i| < point_cut and, with the defect test,
     when |mean of clip(z_j, +-limit_j) over its neighbourhood| - allowance_i < neighbourhood_cut
-    (limit, allowance None: no defect test)."""
+    (limit, allowance None: no defect test; ``neighbourhoods``: the test's own, from which
+    Neighbourhoods.members gives each reading's, or None where they are not known)."""
     root: np.ndarray                   # (N,)
     point_cut: float
     limit: np.ndarray = None           # (N,)
     allowance: np.ndarray = None       # (N,)
     neighbourhood_cut: float = np.inf
+    neighbourhoods: "Neighbourhoods" = None   # the defect test's own
 
     def rows(self, rows):
-        """The cut of some readings only (their neighbourhoods' tests stay as fitted)."""
+        """The cut of some readings only (their neighbourhoods' tests stay as fitted; the
+        neighbourhoods themselves, windows of the whole cloud, are not kept)."""
         pick = (lambda v: None if v is None else v[rows])
         return InlierCut(self.root[rows], self.point_cut, pick(self.limit),
                          pick(self.allowance), self.neighbourhood_cut)
@@ -287,11 +291,29 @@ class Neighbourhoods:
         ijk = np.minimum(((points - lo) / step).astype(np.int64), self.LEVELS - 1)
         code = (self._spread(ijk[:, 0]) << 2) | (self._spread(ijk[:, 1]) << 1) \
             | self._spread(ijk[:, 2])
-        self.order = np.argsort(code, kind="stable")
-        n = len(points)
+        self._along(np.argsort(code, kind="stable"), size)
+
+    @classmethod
+    def from_order(cls, order, size):
+        """The neighbourhoods of a cloud whose curve order is known (``order``, as kept by
+        InlierCut), without its points."""
+        hoods = cls.__new__(cls)
+        hoods._along(np.asarray(order, dtype=np.int64), size)
+        return hoods
+
+    def _along(self, order, size):
+        self.order = order
+        n = len(order)
         self.size = min(size, n)
         # Window start of each position along the curve, the window centred where possible.
         self._start = np.clip(np.arange(n) - self.size // 2, 0, n - self.size)
+
+    def members(self, index):
+        """(len(index), size) the points of each point's neighbourhood (``means``' window)."""
+        position = np.empty(len(self.order), dtype=np.int64)
+        position[self.order] = np.arange(len(self.order))
+        start = self._start[position[np.asarray(index, dtype=np.int64)]]
+        return self.order[start[:, None] + np.arange(self.size)]
 
     @staticmethod
     def _spread(v):

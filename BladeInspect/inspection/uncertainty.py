@@ -405,9 +405,9 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     applies when a left-out competitor's level lies above the reported worst. The systematic
     bias and the pose are sampled with the noise, since they move which readings are kept.
     Which are kept: with ``result.inlier_cut`` (core.icp.InlierCut) the fit's own two tests
-    replayed in every draw, a reading against its cut and its neighbourhood's mean (its k
-    nearest readings, drawn with it) against the defect test's; without it, a cut-off at the
-    reported worst on each reading's own value."""
+    replayed in every draw, a reading against its cut and its neighbourhood's mean (the fit's
+    own window where known, else its nearest readings; drawn with it) against the defect
+    test's; without it, a cut-off at the reported worst on each reading's own value."""
     from scipy.spatial import cKDTree
     dev = np.asarray(result.deviation, dtype=float)
     side = -1.0 if dev[worst] < 0 else 1.0
@@ -435,11 +435,12 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     tree = cKDTree(points[pool])
     k = min(LEVEL_NEIGHBOURS, len(pool))
 
-    def levels_of(rows):
-        _, hood = tree.query(points[pool[rows]], k)
-        return (side * dev[pool])[np.asarray(hood).reshape(len(rows), k)].mean(axis=1)
+    def levels_at(index):
+        """Each reading's (of result's ``index``) level: the mean of its k nearest in pool."""
+        _, hood = tree.query(points[index], k)
+        return (side * dev[pool])[np.asarray(hood).reshape(len(index), k)].mean(axis=1)
     levels = np.full(len(pool), -np.inf)
-    levels[near] = levels_of(np.flatnonzero(near))
+    levels[near] = levels_at(pool[near])
     competes = (levels >= cutoff - below) & (levels <= ceiling + above)
     competes |= pool == worst
     # the cut-off decided where the fit left out a competitor whose level lies above it (the
@@ -447,24 +448,31 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     # part in its noise, a rejected gross error) is a plain maximum
     if not (competes & np.isin(pool, left_out) & (levels >= cutoff)).any():
         return None
-    kept, judged, drawn = None, None, np.flatnonzero(competes)
-    if cut is not None:
-        # the fit's two tests replayed: each competitor's neighbourhood (its k nearest
-        # readings, where the fit took a window along a space-filling curve) is drawn with it
-        _, hood = tree.query(points[pool[drawn]], k)
-        hood = np.asarray(hood).reshape(len(drawn), k)
-        drawn = np.union1d(drawn, hood.ravel())
-        missing = drawn[~np.isfinite(levels[drawn])]
-        if len(missing):
-            levels[missing] = levels_of(missing)
-        judged = np.searchsorted(drawn, np.flatnonzero(competes))
-        neighbours = np.searchsorted(drawn, hood)
-        kept = (lambda measured: cut.kept(measured, pool[drawn], judged, neighbours))
+    if cut is None:
+        return uncertainty_model.censored_max_error(
+            levels[competes], noise[competes], cutoff, unit_noise(model.sensor),
+            [uncertainty_model.SharedTerm(t.name, t.coefficients[competes], t.sample)
+             for t in shared])
+    # the fit's two tests replayed: each competitor's neighbourhood is drawn with it, the
+    # fit's own window along its space-filling curve where known, else its nearest readings
+    rivals = pool[competes]
+    if cut.neighbourhoods is not None and len(cut.neighbourhoods.order) == len(dev):
+        hood = cut.neighbourhoods.members(rivals)
+    else:
+        size = min(core_icp.ICPOptions().defect_neighbours, len(pool))
+        _, hood = tree.query(points[rivals], size)
+        hood = pool[np.asarray(hood).reshape(len(rivals), size)]
+    drawn = np.union1d(rivals, hood.ravel())
+    sigma = normal_noise(result, drawn, model.sensor)
+    # a window may hold a reading without a noise figure (no usable normal): the typical one
+    sigma = np.where(np.isfinite(sigma), sigma, np.median(noise))
+    judged = np.searchsorted(drawn, rivals)
+    neighbours = np.searchsorted(drawn, hood)
     # the shared terms' draws are symmetric about zero: their pushes need no turning to the side
     return uncertainty_model.censored_max_error(
-        levels[drawn], noise[drawn], cutoff, unit_noise(model.sensor),
-        [uncertainty_model.SharedTerm(t.name, t.coefficients[drawn], t.sample)
-         for t in shared], kept=kept, judged=judged)
+        levels_at(drawn), sigma, cutoff, unit_noise(model.sensor),
+        shared_terms(result, drawn, model), judged=judged,
+        kept=lambda measured: cut.kept(measured, drawn, judged, neighbours))
 
 
 def _noise_bound_sigmas(sensor):
