@@ -57,7 +57,7 @@ def linear_take_up(fit, xyz, nominal, beams_measured):
     return np.linalg.lstsq(JW @ J, JW @ beta, rcond=1e-12)[0], fit.center
 
 
-original_robust_weights = icp_mod.robust_weights
+original_robust_selection = icp_mod.robust_selection
 
 
 def bias_signature(chain, xyz, snr, angles, beams, truth):
@@ -73,13 +73,13 @@ def bias_signature(chain, xyz, snr, angles, beams, truth):
 
 
 def signature_removed_weights(signature, accuracy):
-    """core.icp.robust_weights with the defect test's neighbourhood means judged after the
+    """core.icp.robust_selection with the defect test's neighbourhood means judged after the
     best-fitting b^ signature (|b^| <= accuracy) is taken out; the whole cloud's fits only
-    (the subsample levels keep the test as it is)."""
-    def robust_weights(distances, a, options, neighbourhoods=None, bias_response=None):
+    (the subsample levels keep the test as it is). No InlierCut: this rule has none."""
+    def robust_selection(distances, a, options, neighbourhoods=None, bias_response=None):
         # bias_response (core.icp's allowance) left unused: the prototype is the rule before it
         if neighbourhoods is None or len(distances) != len(signature):
-            return original_robust_weights(distances, a, options, neighbourhoods)
+            return original_robust_selection(distances, a, options, neighbourhoods)
         usable = (a > 0) & np.isfinite(distances)
         root = np.sqrt(np.maximum(a, options.max_noise_ratio ** -2))
         z = np.where(usable, distances * root, np.inf)
@@ -92,8 +92,8 @@ def signature_removed_weights(signature, accuracy):
         b = float(np.clip(local[f] @ g[f] / (g[f] @ g[f]), -accuracy, accuracy))
         local = local - b * g
         return rho * icp_mod._taper(icp_mod._robust_deviation(
-            local, np.isfinite(local), options)[0], options), scale
-    return robust_weights
+            local, np.isfinite(local), options)[0], options), scale, None
+    return robust_selection
 
 
 def main():
@@ -135,8 +135,8 @@ def main():
     for weights in ("sensor", "snr"):
         for defect in ("on", "off", "bias out")[:3 if weights == "sensor" else 2]:
             icp_mod.icp = original if defect != "off" else without_defect_test
-            icp_mod.robust_weights = (with_signature_removed if defect == "bias out"
-                                      else original_robust_weights)
+            icp_mod.robust_selection = (with_signature_removed if defect == "bias out"
+                                        else original_robust_selection)
             response = None
             for b_um in (BIASES_UM if weights == "sensor" else (0.0, 6.0)):
                 xyz = cloud(1e-3 * b_um)
@@ -159,7 +159,7 @@ def main():
                     " ".join("%+6.2f" % x for x in err[3:]),
                     " ".join("%+6.2f" % x for x in predicted)), flush=True)
     icp_mod.icp = original
-    icp_mod.robust_weights = original_robust_weights
+    icp_mod.robust_selection = original_robust_selection
 
 
 if __name__ == "__main__":

@@ -242,14 +242,13 @@ class TestRegistration(DocumentCase):
             registration_fit.restore(obj, restored)
             if result.inlier_cut is None:
                 self.assertIsNone(restored.inlier_cut)
+                continue
             for field in ("root", "limit", "allowance", "point_cut", "neighbourhood_cut"):
-                if result.inlier_cut is not None:
-                    np.testing.assert_array_equal(getattr(restored.inlier_cut, field),
-                                                  getattr(result.inlier_cut, field))
-            if result.inlier_cut is not None:
-                np.testing.assert_array_equal(
-                    restored.inlier_cut.neighbourhoods.members(np.arange(n)),
-                    result.inlier_cut.neighbourhoods.members(np.arange(n)))
+                np.testing.assert_array_equal(getattr(restored.inlier_cut, field),
+                                              getattr(result.inlier_cut, field))
+            np.testing.assert_array_equal(
+                restored.inlier_cut.neighbourhoods.members(np.arange(n)),
+                result.inlier_cut.neighbourhoods.members(np.arange(n)))
 
     def test_re_registers_only_when_an_input_changes(self):
         """The pipeline is replaced by a stand-in whose answer is known (identity pose,

@@ -14,7 +14,7 @@ w_i = a_i * rho_i:
   u <= k_full, a biweight-shaped taper to 0 at k_zero, 0 beyond.
   Flat in the core, so the good points are fitted by plain weighted least squares (the
   efficient estimator, and the covariance formula below is exact for them); gross outliers and
-  real defects (many sigma away) weigh exactly 0. Two refinements (see robust_weights): a_i is
+  real defects (many sigma away) weigh exactly 0. Two refinements (see robust_selection): a_i is
   floored at 1 / max_noise_ratio^2 inside z (a low SNR lowers the weight, it does not excuse
   a gross error), and rho_i is multiplied by the same taper applied to the mean of the
   (clipped) z over the point's measured neighbourhood (a defect's low flanks are coherent,
@@ -56,7 +56,7 @@ class ICPOptions:
     defect_neighbours: int = 16    # neighbourhood size of the defect test; 0 switches it off
     # mm: the sensor's stated accuracy, the bound of its systematic reading error. Where the
     # beams are known the defect test grants each neighbourhood's mean the field a bias of
-    # this size can leave after the fit (robust_weights): that is the sensor's error, not a
+    # this size can leave after the fit (robust_selection): that is the sensor's error, not a
     # defect. 0: no sensor known.
     systematic_mm: float = 0.0
     # A last Gauss-Newton step below both is applied to the residuals linearly, without a new
@@ -500,7 +500,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
     ``weight_model(T, normals) -> (N,)`` (core.weights.SensorWeights), when given, replaces the
     SNR weights a_i and is re-evaluated at every closest-point evaluation. ``beams`` (N,3):
     each reading's beam in the measured frame (default: the weight model's, if it has them),
-    from which the defect test grants the field the sensor's bias can leave (robust_weights)."""
+    from which the defect test grants the field the sensor's bias can leave (robust_selection)."""
     options = options or ICPOptions()
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 7:
@@ -539,8 +539,8 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         iterations += 1
         if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
             a = normalised_weights(weight_model, T, normals, len(points))
-        rho, _ = robust_weights(distances, a, options, neighbourhoods,
-                                bias_response(T, moved, normals))
+        rho, _, _ = robust_selection(distances, a, options, neighbourhoods,
+                                     bias_response(T, moved, normals))
         w = a * rho
         if np.count_nonzero(w) < 7:
             last_step = None

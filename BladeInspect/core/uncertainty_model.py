@@ -68,6 +68,10 @@ class SharedTerm:
             self.coefficients = self.coefficients[:, None]
         self.sample = sample
 
+    def take(self, index):
+        """The same term over the readings ``index`` only (the same draws move them alike)."""
+        return SharedTerm(self.name, self.coefficients[index], self.sample)
+
     def moves(self, z, index=slice(None)):
         """(draws, n) displacement of the readings ``index`` for the draws z."""
         return z @ self.coefficients[index].T

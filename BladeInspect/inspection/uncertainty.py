@@ -411,9 +411,13 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     from scipy.spatial import cKDTree
     dev = np.asarray(result.deviation, dtype=float)
     side = -1.0 if dev[worst] < 0 else 1.0
+    # the noise and the shared terms of every reading at once: the pool's, and then the
+    # readings drawn with its competitors, are taken from them
+    noise_all = normal_noise(result, None, model.sensor)
+    shared_all = shared_terms(result, np.arange(len(dev)), model)
     pool = np.union1d(candidates, np.asarray(left_out, dtype=int))
-    noise = normal_noise(result, pool, model.sensor)
-    pool, noise = pool[np.isfinite(noise)], noise[np.isfinite(noise)]
+    pool = pool[np.isfinite(noise_all[pool])]
+    noise = noise_all[pool]
     cutoff = side * dev[worst]
     sigma_worst = float(noise[pool == worst][0])
     below = COMPETING_SIGMAS * np.sqrt(sigma_worst ** 2 + noise ** 2)
@@ -422,7 +426,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     # terms' push (a bias that lowers every reading keeps a higher band of the defect), could
     # bring it under the cut-off -- under the fit's own per-reading cut, when known, which
     # may lie above the reported worst where the neighbourhoods decided.
-    shared = shared_terms(result, pool, model)
+    shared = [t.take(pool) for t in shared_all]
     rng = np.random.default_rng(0)
     above = _noise_bound_sigmas(model.sensor) * noise + sum(
         np.abs(t.moves(t.sample(rng, _PUSH_PROBES))).max(axis=0) for t in shared)
@@ -451,8 +455,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     if cut is None:
         return uncertainty_model.censored_max_error(
             levels[competes], noise[competes], cutoff, unit_noise(model.sensor),
-            [uncertainty_model.SharedTerm(t.name, t.coefficients[competes], t.sample)
-             for t in shared])
+            [t.take(competes) for t in shared])
     # the fit's two tests replayed: each competitor's neighbourhood is drawn with it, the
     # fit's own window along its space-filling curve where known, else its nearest readings
     rivals = pool[competes]
@@ -463,7 +466,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
         _, hood = tree.query(points[rivals], size)
         hood = pool[np.asarray(hood).reshape(len(rivals), size)]
     drawn = np.union1d(rivals, hood.ravel())
-    sigma = normal_noise(result, drawn, model.sensor)
+    sigma = noise_all[drawn]
     # a window may hold a reading without a noise figure (no usable normal): the typical one
     sigma = np.where(np.isfinite(sigma), sigma, np.median(noise))
     judged = np.searchsorted(drawn, rivals)
@@ -471,7 +474,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
     # the shared terms' draws are symmetric about zero: their pushes need no turning to the side
     return uncertainty_model.censored_max_error(
         levels_at(drawn), sigma, cutoff, unit_noise(model.sensor),
-        shared_terms(result, drawn, model), judged=judged,
+        [t.take(drawn) for t in shared_all], judged=judged,
         kept=lambda measured: cut.kept(measured, drawn, judged, neighbours))
 
 
