@@ -46,6 +46,16 @@ def commands(quick):
         ("scan", ["scan", "--out", "scan", "--sections", "2", "--seed", "5"]),
         ("calibrate", ["calibrate", "--out", "rig.json", "--seed", "2"]),
         ("inspect", ["inspect", "--out", "insp", "--seed", "4"]),
+        ("airfoil nominal", ["airfoil", "--out", "af_nominal", "--cad", "../blade.step",
+                             "--chord-method", "caliper", "--engine-axis", "z"]),
+        # The first writes the task's draws, the second reads them back.
+        ("airfoil", ["airfoil", "--out", "af", "--cad", "../blade.step", "--points",
+                     "sim/points.csv", "--uncertainty-task", "task.json", "--chord-method",
+                     "tangent", "--le-rule", "larger-radius", "--edge-offsets", "0.3,1"]),
+        ("airfoil again", ["airfoil", "--out", "af_again", "--cad", "../blade.step",
+                           "--points", "sim/points.csv", "--uncertainty-task", "task.json",
+                           "--chord-method", "tangent", "--le-rule", "larger-radius",
+                           "--edge-offsets", "0.3,1"]),
     ]
     if not quick:
         runs += [("inspect --complete", ["inspect", "--out", "insp_complete", "--complete",
