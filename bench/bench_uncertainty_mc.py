@@ -36,8 +36,6 @@ maximum (a worst deviation, form_mm, form_location_mm; marked *) with its RMS er
 value with its scatter. Trials more than 5 robust sigmas from the median are counted (column
 "out"), not averaged in. `--sensitivity` prints instead what the systematic term really does
 to each value through the chain (noise-free scans with a bias of +-accuracy).
-bench/bench_bias_take_up.py shows how the fit takes up the bias against the model's linear
-take-up.
 
     scripts/fcpython bench/bench_uncertainty_mc.py [--blade demo|rotor67|both] [--trials 40]
         [--seed 2026] [--stated 2] [--errors noise,systematic,calibration] [--sensitivity]

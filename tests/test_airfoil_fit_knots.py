@@ -6,7 +6,7 @@ beyond, so the stations 1 and 2 mm from the edges lie where the points thin out.
 blade's planned 70 % section, read in the rig's true pose by the simulated rig's own sensor
 (its stated noise: a perfect part, no registration), several noise draws: the mean of each
 edge thickness must be the CAD's -- the nominal cut's, independent of any measured fit. The
-smoothing spline alone read them 3-10 um off, scan after scan (bench/bench_airfoil_fit_bias.py:
+smoothing spline alone read them 3-10 um off, scan after scan (docs/validation.md:
 -7.6, +8.1, -9.7 um at 1 and 2 mm, 15-45 standard errors over 24 scans).
 """
 import unittest
