@@ -30,7 +30,7 @@ import zipfile
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOLERANCE = 1e-12
 # Wall-clock figures, different on every run of the same code.
-IGNORED_KEYS = {"timing_s", "simulated_s", "wall_s", "elapsed_s", "created", "date"}
+IGNORED_KEYS = {"timing_s", "simulated_s", "wall_s", "elapsed_s", "created", "date", "made_utc"}
 
 
 def commands(quick):
