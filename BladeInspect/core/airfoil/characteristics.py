@@ -93,13 +93,26 @@ class Characteristics:
 def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
                     stations_pct=(), edge_offsets_mm=DEFAULT_EDGE_OFFSETS_MM,
                     edge_zone_deg=DEFAULT_EDGE_ZONE_DEG, le_hint=None, noise_mm=0.0,
-                    le_upstream=None, metal_angle_window_pct=DEFAULT_METAL_ANGLE_WINDOW_PCT):
+                    le_upstream=None, metal_angle_window_pct=DEFAULT_METAL_ANGLE_WINDOW_PCT,
+                    definition=None):
     """All characteristics of one section. ``profile``: a Profile or an ordered (N, 2) array;
     ``engine_axis``: a 2D direction in the section plane, pointing downstream; ``le_hint``: a
     point near the leading edge (e.g. on the CAD's named LE face); ``le_upstream``: a 2D
     direction pointing upstream (the LE is the end furthest along it); with neither, the LE is
     the blunter end, or the end upstream along the engine axis when the two edge radii agree
-    within their uncertainty (``le_rule`` says which rule decided, docs/airfoil.md)."""
+    within their uncertainty (``le_rule`` says which rule decided, docs/airfoil.md).
+    ``definition``: an AirfoilDefinition whose fields take the place of chord_method,
+    stations_pct, edge_offsets_mm, edge_zone_deg and metal_angle_window_pct (given with it,
+    those must keep their defaults), and set the LE rule used when neither le_hint nor
+    le_upstream is given and the radii's sigmas of the blunter-end rule."""
+    le_radius_sigmas = LE_RADIUS_SIGMAS
+    if definition is not None:
+        _check_no_parameter_beside(chord_method, stations_pct, edge_offsets_mm, edge_zone_deg,
+                                   metal_angle_window_pct)
+        chord_method, stations_pct = definition.chord_method, definition.stations_pct
+        edge_offsets_mm, edge_zone_deg = definition.edge_offsets_mm, definition.edge_zone_deg
+        metal_angle_window_pct = definition.metal_angle_window_pct
+        le_radius_sigmas = definition.le_radius_sigmas
     if not isinstance(profile, Profile):
         profile = Profile(profile, noise_mm)
     if chord_method not in CHORD_METHODS:
@@ -109,6 +122,9 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     if not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
         raise InputError("engine axis: %s must be a finite non-zero 2D direction" % axis)
     axis = unit(axis)
+    if definition is not None and definition.le_rule == "engine-axis" \
+            and le_hint is None and le_upstream is None:
+        le_upstream = -axis
     L = profile.length
     if not (np.isfinite(metal_angle_window_pct) and 0 < metal_angle_window_pct <= 100):
         raise InputError("metal angle window: %r %% of the camber line must be in (0, 100]"
@@ -143,7 +159,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     ub_end, end_b = edge_point(profile, circle_b, out_b, noise_mm, ub_end, end_b)
     t0, t1 = -out_a, out_b
     a_is_le, le_rule = leading_end(end_a[0], end_b[0], circle_a, circle_b, axis, le_hint,
-                                    le_upstream, noise_mm)
+                                   le_upstream, noise_mm, le_radius_sigmas)
     if a_is_le:
         le, te, le_u, te_u = end_a[0], end_b[0], ua_end[0], ub_end[0]
         le_circle, te_circle = circle_a, circle_b
@@ -229,3 +245,19 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
         profile=profile, suction_range=(suction.lo, suction.hi),
         pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
+
+
+def _check_no_parameter_beside(chord_method, stations_pct, edge_offsets_mm, edge_zone_deg,
+                               metal_angle_window_pct):
+    """InputError when a definition parameter is given beside the definition (one of the two
+    would be silently ignored)."""
+    given = [name for name, value, default in (
+        ("chord_method", chord_method, "nose-tail"),
+        ("stations_pct", tuple(stations_pct), ()),
+        ("edge_offsets_mm", tuple(edge_offsets_mm), DEFAULT_EDGE_OFFSETS_MM),
+        ("edge_zone_deg", edge_zone_deg, DEFAULT_EDGE_ZONE_DEG),
+        ("metal_angle_window_pct", metal_angle_window_pct, DEFAULT_METAL_ANGLE_WINDOW_PCT))
+        if value != default]
+    if given:
+        raise InputError("airfoil characteristics: %s given beside a definition; give them "
+                         "in the definition" % ", ".join(given))

@@ -225,7 +225,8 @@ def edge_point(profile, circle, outward, noise_mm, u_line, p_line):
         return u_line, p_line
 
 
-def leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, noise_mm):
+def leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, noise_mm,
+                le_radius_sigmas=LE_RADIUS_SIGMAS):
     """Whether end a is the LE, and the rule that decided (docs/airfoil.md)."""
     if le_hint is not None:
         hint = np.asarray(le_hint, dtype=float).reshape(2)
@@ -237,7 +238,7 @@ def leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, no
                              "direction" % up)
         return bool((end_a - end_b) @ up >= 0), "given upstream direction"
     sigma = np.hypot(edge_radius_sigma(circle_a, noise_mm), edge_radius_sigma(circle_b, noise_mm))
-    if abs(circle_a.radius - circle_b.radius) > LE_RADIUS_SIGMAS * sigma:
+    if abs(circle_a.radius - circle_b.radius) > le_radius_sigmas * sigma:
         return bool(circle_a.radius > circle_b.radius), "larger edge radius"
     return bool((end_a - end_b) @ axis <= 0), "upstream along the engine axis"
 
