@@ -119,11 +119,11 @@ def _arc_from_end(c):
 
 def _end_quartic(c, r, edge, window_pct):
     """The end window's quartic of the centres (ordered towards the end), the centres off the
-    locus dropped first: a centre refined onto a wrong foot (inscribed, but 0.13 mm off the
-    locus, once in 20 scans at sigma = 2 um) had tilted the end tangent by 49 mdeg. Returns the
+    locus dropped first: a centre refined onto a wrong foot (inscribed, but far off the locus)
+    would tilt the end tangent by tens of mdeg. Returns the
     kept centres and radii, their arc lengths, the window's selection of them and the
     quartic's coefficients (np.polyfit's, one column per axis). On the exact nominal no centre
-    is dropped: the fit, and so the angle, is the former rule's to the bit."""
+    is dropped."""
     s = _arc_from_end(c)
     # The last stretch of the locus bends towards the centre of curvature of the edge's
     # tightest point when the edge is not a circle: it is left out of the fit.

@@ -266,7 +266,7 @@ def circle_radius_factor(half_angle_rad):
 
 def edge_points_needed(noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_ZONE_DEG):
     """Points the edge zone (+-zone_deg) needs for the fitted radius's 1-sigma to be at most
-    radius_sigma_mm at the points' noise: n = (noise / sigma_R * f(alpha))^2 (issue 15 item 7)."""
+    radius_sigma_mm at the points' noise: n = (noise / sigma_R * f(alpha))^2."""
     f = circle_radius_factor(np.radians(zone_deg))
     return int(np.ceil((float(noise_mm) / float(radius_sigma_mm) * f) ** 2))
 
@@ -311,8 +311,7 @@ def withhold_corner_edges(measured, nominal):
     why. A corner has no edge circle and no camber-line end for a tangent; the nominal's
     value is its cut's, read at the corner's exact vertex, while a measured profile's smooth
     fit rounds the corner off over the points' spacing and noise, and the same rule then
-    reads the rounding (Rotor 67's 90 % TE, planned scans of a perfect part: 0.006-12 deg off,
-    1 sigma 2.6 deg over 22 scans). docs/airfoil.md, "Sharp edges"."""
+    reads the rounding, degrees off on a perfect part. docs/airfoil.md, "Sharp edges"."""
     corners = corner_edges(nominal.profile, nominal.le_point, nominal.te_point,
                             nominal.nose_tail_chord_mm)
     for name, angle, radius in (("LE", "inlet_angle_deg", "le_radius_mm"),

@@ -169,14 +169,12 @@ def medial_axis(profile, a, b):
     # (a degenerate bisector that slid onto the axis) does not start it.
     edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
     starts, stops = edges[::2], edges[1::2]
-    # metal-angle hook: a lone circle mid-locus that fails (a foot refined onto a wrong
-    # stationary point) must not cut the camber line in two -- its longer half alone put
-    # the metal angle's window on half the locus (28 mdeg on the demo blade's 90 % section
-    # under a 0.2 um deviation); two runs apart by at most _RUN_GAP failed circles are one
+    # A lone circle mid-locus that fails (a foot refined onto a wrong stationary point) must
+    # not cut the camber line in two -- its longer half alone would put the metal angle's
+    # window on half the locus; two runs apart by at most _RUN_GAP failed circles are one
     # when each is at least _RUN_MIN circles. Near a noisy edge circles fail here and there
-    # too: Rotor 67's 10 % TE, planned, one scan in 24 ended its locus 0.8 mm short of the
-    # edge when short runs were not joined (the outlet angle 0.30 deg off); a stray among
-    # them is the end window's to drop (_end_quartic).
+    # too, and unjoined short runs would end the locus short of the edge; a stray among them
+    # is the end window's to drop (camber._end_quartic).
     merged = []
     for first, stop in zip(starts, stops):
         left, right = merged[-1][1] - merged[-1][2] if merged else 0, stop - first

@@ -55,7 +55,7 @@ class Profile:
         smoothing = len(pts) * float(noise_mm) ** 2
         self._tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u, s=smoothing, per=1, k=3)
         if noise_mm > 0:
-            # metal-angle hook: noisy points fitted again in the first fit's arc length
+            # noisy points fitted again in the first fit's arc length (refit.py)
             self.points, self.point_params, self._tck = refit_in_arc_length(
                 pts, self._tck, u[-1], noise_mm, nominal)
             self.length = float(self._tck[0][len(self._tck[0]) - 4])
@@ -248,11 +248,10 @@ def ray_hit(profile, origin, direction, behind=False):
         lam = cross2(p - origin, direction) / den
     ok = (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau > 0)
     if not np.any(ok):
-        # metal-angle hook: an origin outside the profile (the camber locus's last centre in
-        # a sharp corner of a noisy profile, which the smooth fit rounds off) crosses it
-        # first just behind itself: that crossing, for the edge the circle is fitted about
-        # (Rotor 67's 90 % TE, planned: 2-7 scans in 24 lost the whole section, the centre
-        # 25-60 um outside the fit).
+        # An origin outside the profile (the camber locus's last centre in a sharp corner of
+        # a noisy profile, which the smooth fit rounds off) crosses it first just behind
+        # itself: that crossing, for the edge the circle is fitted about (else the whole
+        # section would be lost).
         ok = behind & (np.abs(den) > 1e-15) & (lam >= 0) & (lam <= 1) & (tau <= 0)
         tau = np.where(ok, -tau, tau)
     if not np.any(ok):

@@ -33,9 +33,9 @@ def refit_in_arc_length(pts, first, first_length, noise_mm, nominal=None):
     Why (docs/airfoil.md, "Input and representation"): where points lie closer than their noise
     (the planned edges: 2 um apart, 3.9 um noise) the chord length between consecutive points
     is mostly noise -- a parameter running at up to 3x the arc length, as a random walk -- and
-    a parametric fit in it reads the curve biased round the edges: Rotor 67's 10 % section
-    planned, a perfect part, metal angles +19 / +5 mdeg over 24 scans (one outlet 0.33 deg
-    off), -2.4 / -1.3 mdeg in this parameter with the budget below (bound ~6 mdeg)."""
+    a parametric fit in it reads the curve biased round the edges (metal angles off by
+    several times their bound on a perfect part; within it in this parameter with the budget
+    below)."""
     n_table = int(np.clip(first_length / _FOOT_TABLE_MM, 4 * len(pts), _FOOT_TABLE_MAX))
     table_u = np.linspace(0.0, first_length, n_table + 1)
     table = np.column_stack(splev(table_u, first))
@@ -68,9 +68,9 @@ def refit_in_arc_length(pts, first, first_length, noise_mm, nominal=None):
     # Of pure noise a least-squares spline with `free` coefficients leaves (N - free) sigma^2
     # and a smoothing one more (its penalty keeps part of them stiff): the budget is taken
     # between, (N - _FREE_SHARE free) sigma^2. The excess of a budget of N sigma^2 is what
-    # the fit spends on the edges (double-circular-arc section at 2 um, 40 scans: inlet +5.1
-    # mdeg at N, +4.1 here, +3.4 at N - free, where a rigidly moved demo section's max
-    # thickness moved by 0.17 um: too little smoothing follows the points' small changes).
+    # the fit spends on the edges (biasing the metal angles); at N - free too little
+    # smoothing follows the points' small changes (a rigidly moved section's max thickness
+    # moves).
     free = len(tck[0]) - 7
     tck, _ = splprep([closed[:, 0], closed[:, 1]], u=u,
                      s=(len(pts) - _FREE_SHARE * free) * sigma ** 2, per=1, k=3, quiet=1)
@@ -95,11 +95,10 @@ def _knots_from_nominal(pts, u, own_knots, nominal, noise_mm):
     Why (docs/airfoil.md, "Where the points thin out"): a planned section holds its points a
     few micrometres apart round the edges and 0.1 mm apart beyond; the smoothing spline
     spends its residual budget where the points are many and puts too few knots where they
-    thin out, 0.6-3 mm from the edges, and stays stiff there: the demo's 70 % section read its
-    edge thicknesses 1 and 2 mm from the edges 3-10 um off, 15-45 standard errors over 24 scans
-    at the rig's noise (least squares on its own knots the same). The nominal's knots
-    everywhere were tried too: 20 um spans round the edges let the noise bend the curve, and
-    a camber line looped (an edge thickness 0.98 mm over)."""
+    thin out, 0.6-3 mm from the edges, and stays stiff there: edge thicknesses 1 and 2 mm from
+    the edges read many standard errors off (least squares on its own knots the same). Not the
+    nominal's knots everywhere: their 20 um spans round the edges let the noise bend the curve
+    (a camber line can loop)."""
     gaps = np.diff(u)
     if len(gaps) < 4 * _SPACING_RUN:
         return None
