@@ -38,7 +38,9 @@ class Definition(unittest.TestCase):
         self.assertEqual(d.digest(), DEFAULT_DIGEST)
         code = ("from BladeInspect.core.airfoil import AirfoilDefinition as D; "
                 "print(D().digest(), D(chord_method='tangent', edge_zone_deg=30).digest())")
-        out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True,
+        # (a fresh plain Python: under FreeCADCmd sys.executable is not one)
+        python = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+        out = subprocess.run([python, "-c", code], cwd=ROOT, check=True,
                              capture_output=True, text=True,
                              env=dict(os.environ, PYTHONHASHSEED="123")).stdout.split()
         self.assertEqual(out, [d.digest(),
