@@ -1,4 +1,4 @@
-"""A planned section's edge thicknesses where its points thin out (core.airfoil
+"""A planned section's edge thicknesses where its points thin out (core.airfoil.refit
 ._knots_from_nominal).
 
 The planner takes a section's points a few micrometres apart round each edge and 0.1 mm apart

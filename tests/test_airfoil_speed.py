@@ -9,6 +9,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from BladeInspect.core import airfoil
+from BladeInspect.core.airfoil.edges import _zone_range
 
 
 class CircleFit(unittest.TestCase):
@@ -51,7 +52,7 @@ class EdgeZone(unittest.TestCase):
                 phi = rng.uniform(0.0, 2 * np.pi)
                 outward = np.array([np.cos(phi), np.sin(phi)])
                 u_edge = prof.closest(radius * outward)[0][0]
-                lo, hi = airfoil._zone_range(prof, np.zeros(2), outward, u_edge, zone_deg)
+                lo, hi = _zone_range(prof, np.zeros(2), outward, u_edge, zone_deg)
                 half = np.radians(zone_deg) * prof.length / (2 * np.pi)
                 # the parameter is the spline's chord length, the arc length to ~1e-7 r here
                 for got, want in ((lo, u_edge - half), (hi, u_edge + half)):
@@ -64,7 +65,7 @@ class EdgeZone(unittest.TestCase):
         prof = self._circle(1.0, 360)
         # seen from far behind, every point of the circle is within 60 deg of +x
         with self.assertRaises(Exception):
-            airfoil._zone_range(prof, np.array([-1e4, 0.0]), np.array([1.0, 0.0]), 0.0, 60.0)
+            _zone_range(prof, np.array([-1e4, 0.0]), np.array([1.0, 0.0]), 0.0, 60.0)
 
 
 if __name__ == "__main__":

@@ -42,7 +42,7 @@ def window_span_mm(chars, end, window_pct=airfoil.DEFAULT_METAL_ANGLE_WINDOW_PCT
     window's share of the camber line."""
     # the fitted circle (a corner edge reports no radius, but the window is still laid off)
     r = (chars.le_circle if end == "inlet" else chars.te_circle).radius
-    start = 0.5 * np.pi * r + airfoil._END_SKIP * r
+    start = 0.5 * np.pi * r + airfoil.END_SKIP * r
     return start, start + window_pct / 100.0 * chars.mcl.inner_length
 
 
