@@ -389,6 +389,7 @@ class TestProxyModules(DocumentCase):
         objects.make_cad_model(self.doc, brep)
         kinds = {type(o.Proxy) for o in self.doc.Objects if objects.proxy_type(o)}
         self.assertEqual(len(kinds), 6)
+        blade_name, reg_name = blade.Name, reg.Name
         recorded = self._saved_with_module("BladeInspect.app.objects")
         # new documents name each class's own module
         self.assertEqual(set(recorded), {cls.__module__ for cls in kinds})
@@ -397,11 +398,10 @@ class TestProxyModules(DocumentCase):
                 continue
             self.assertIn(type(obj.Proxy), kinds, obj.Name)
             self.assertIs(getattr(objects, type(obj.Proxy).__name__), type(obj.Proxy))
-        blade = self.doc.getObject(blade.Name)
-        blade.touch()
+        self.doc.getObject(blade_name).touch()
         self.doc.recompute()
         self.assertEqual([o.Name for o in self.doc.Objects if "Invalid" in o.State], [])
-        self.assertEqual(self.doc.getObject(reg.Name).NPoints, 36)
+        self.assertEqual(self.doc.getObject(reg_name).NPoints, 36)
 
     def test_proxies_store_no_state_of_their_own(self):
         for cls in (objects.DemoBlade, objects.CadModel, objects.Measurement,
