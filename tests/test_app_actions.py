@@ -95,8 +95,8 @@ class ActionLines(unittest.TestCase):
     def test_default_fit_keeps_the_older_signature(self):
         reg = self.registration
         m = reg.Measurement
-        older = objects._signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
-                                   objects._shape_signature(reg.Nominal.Shape), reg.Seed)
+        older = objects.signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
+                                  objects.shape_signature(reg.Nominal.Shape), reg.Seed)
         reg.Fit = "least-squares"
         try:
             self.assertEqual(reg.Proxy.signature(reg), older)

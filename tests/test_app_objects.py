@@ -15,6 +15,7 @@ import numpy as np
 import FreeCAD
 
 from BladeInspect.app import objects, registration_fit
+from BladeInspect.app.objects import reconstruction, registration
 from BladeInspect.core import icp
 from BladeInspect.core.errors import InputError
 from tests.helpers import REPO
@@ -185,9 +186,10 @@ class TestReconstruction(DocumentCase):
             return FakeReconstruction(second)
         from BladeInspect.cad import loft
         saved_reconstruct = loft.reconstruct
-        saved_pointset_of = objects.pointset_of
+        saved_pointset_of = reconstruction.pointset_of
         loft.reconstruct = fake_reconstruct
-        objects.pointset_of = lambda obj: FakePointSet(np.reshape(obj.Coordinates, (-1, 3)))
+        reconstruction.pointset_of = lambda obj: FakePointSet(
+            np.reshape(obj.Coordinates, (-1, 3)))
         try:
             meas = objects.make_measurement(self.doc, FakePointSet(np.vstack(first)))
             obj = objects.make_reconstruction(self.doc, meas, FakeReconstruction(first))
@@ -199,7 +201,7 @@ class TestReconstruction(DocumentCase):
             ys = [v.Y for v in obj.Shape.Edges[0].Vertexes]
             self.assertTrue(all(y > 2.5 for y in ys), ys)   # the shifted curves are stored
         finally:
-            objects.pointset_of = saved_pointset_of
+            reconstruction.pointset_of = saved_pointset_of
             loft.reconstruct = saved_reconstruct
 
 
@@ -266,10 +268,10 @@ class TestRegistration(DocumentCase):
             r.points_cad = xyz
             return r
 
-        saved = pipeline.register, objects.nominal_of, objects.pointset_of
+        saved = pipeline.register, registration.nominal_of, registration.pointset_of
         pipeline.register = fake_register
-        objects.nominal_of = lambda obj: "nominal"
-        objects.pointset_of = lambda obj: FakePointSet(np.reshape(obj.Coordinates, (-1, 3)))
+        registration.nominal_of = lambda obj: "nominal"
+        registration.pointset_of = lambda obj: FakePointSet(np.reshape(obj.Coordinates, (-1, 3)))
         try:
             box = self.doc.addObject("Part::Feature", "Box")
             import Part
@@ -295,7 +297,7 @@ class TestRegistration(DocumentCase):
             self.doc.recompute()
             self.assertEqual(calls, [0, 7])
         finally:
-            pipeline.register, objects.nominal_of, objects.pointset_of = saved
+            pipeline.register, registration.nominal_of, registration.pointset_of = saved
 
 
 class TestDeviationMap(DocumentCase):
@@ -345,13 +347,79 @@ class TestDeviationMap(DocumentCase):
         self.assertEqual([o.Name for o in self.doc.Objects], before)
 
 
+class TestProxyModules(DocumentCase):
+    """A document names each proxy's module and class; FreeCAD imports them when it opens."""
+
+    def _saved_with_module(self, module):
+        """This document saved, every BladeInspect proxy recorded as ``module``'s (what a
+        document made when one module held the six classes records), and reopened."""
+        import re
+        import zipfile
+        path = os.path.join(self.tmp, "doc.FCStd")
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+        older = os.path.join(self.tmp, "older.FCStd")
+        recorded = []
+
+        def rename(match):
+            recorded.append(match.group(1))
+            return 'module="%s" class=' % module
+        with zipfile.ZipFile(path) as src, zipfile.ZipFile(older, "w") as dst:
+            for item in src.infolist():
+                data = src.read(item.filename)
+                if item.filename == "Document.xml":
+                    data = re.sub(r'module="(BladeInspect\.app\.objects[\w.]*)" class=',
+                                  rename, data.decode()).encode()
+                dst.writestr(item, data)
+        self.doc = FreeCAD.openDocument(older)
+        return recorded
+
+    def test_documents_naming_app_objects_reopen_and_recompute(self):
+        rng = np.random.default_rng(11)
+        curves = TestReconstruction._curves(None, rng)
+        blade = objects.make_demo_blade(self.doc)
+        meas = objects.make_measurement(self.doc, FakePointSet(np.vstack(curves)))
+        objects.make_reconstruction(self.doc, meas, FakeReconstruction(curves))
+        _, result = synthetic_result(rng, n=36)
+        reg = objects.make_registration(self.doc, result, meas, blade)
+        objects.make_deviation_map(self.doc, reg, 0.05)
+        brep = os.path.join(self.tmp, "box.brep")
+        import Part
+        Part.makeBox(1, 2, 3).exportBrep(brep)
+        objects.make_cad_model(self.doc, brep)
+        kinds = {type(o.Proxy) for o in self.doc.Objects if objects.proxy_type(o)}
+        self.assertEqual(len(kinds), 6)
+        blade_name, reg_name = blade.Name, reg.Name
+        recorded = self._saved_with_module("BladeInspect.app.objects")
+        # new documents name each class's own module
+        self.assertEqual(set(recorded), {cls.__module__ for cls in kinds})
+        for obj in self.doc.Objects:
+            if objects.proxy_type(obj) is None:
+                continue
+            self.assertIn(type(obj.Proxy), kinds, obj.Name)
+            self.assertIs(getattr(objects, type(obj.Proxy).__name__), type(obj.Proxy))
+        self.doc.getObject(blade_name).touch()
+        self.doc.recompute()
+        self.assertEqual([o.Name for o in self.doc.Objects if "Invalid" in o.State], [])
+        self.assertEqual(self.doc.getObject(reg_name).NPoints, 36)
+
+    def test_proxies_store_no_state_of_their_own(self):
+        for cls in (objects.DemoBlade, objects.CadModel, objects.Measurement,
+                    objects.Reconstruction, objects.Registration, objects.DeviationMap):
+            proxy = cls.__new__(cls)
+            self.assertIsNone(proxy.dumps())
+            self.assertIsNone(proxy.__getstate__())
+            self.assertIsNone(proxy.loads(None))
+            self.assertIsNone(proxy.__setstate__(None))
+
+
 class TestDemoBlade(DocumentCase):
     def test_parameters_rebuild_the_blade_and_roles_are_kept(self):
         from BladeInspect.cad.demo_blade import BladeParams
         obj = objects.make_demo_blade(self.doc, BladeParams(span=60.0))
         self.assertTrue(obj.Shape.isValid())
         self.assertAlmostEqual(obj.Shape.BoundBox.ZLength, 60.0, delta=1e-6)
-        roles = objects._roles_from_map(obj.FaceRoles)
+        roles = objects.roles_from_map(obj.FaceRoles)
         self.assertTrue(roles.get("suction") and roles.get("pressure"))
         for faces in roles.values():
             self.assertTrue(all(0 <= i < len(obj.Shape.Faces) for i in faces))
@@ -361,7 +429,7 @@ class TestDemoBlade(DocumentCase):
         name = obj.Name
         obj = self.reopen().getObject(name)
         self.assertAlmostEqual(obj.Shape.BoundBox.ZLength, 45.0, delta=1e-6)
-        self.assertEqual(objects._roles_from_map(obj.FaceRoles), roles)
+        self.assertEqual(objects.roles_from_map(obj.FaceRoles), roles)
 
 
 class TestSettings(unittest.TestCase):
@@ -467,12 +535,47 @@ class TestPackaging(unittest.TestCase):
 
     def test_app_layer_never_imports_the_gui(self):
         app_dir = os.path.join(REPO, "BladeInspect", "app")
-        for name in os.listdir(app_dir):
-            if name.endswith(".py"):
-                with open(os.path.join(app_dir, name)) as fh:
-                    text = fh.read()
-                for banned in ("import FreeCADGui", "from PySide", "import PySide", "pivy"):
-                    self.assertNotIn(banned, text, name)
+        for folder, _, files in os.walk(app_dir):
+            for name in files:
+                if name.endswith(".py"):
+                    with open(os.path.join(folder, name)) as fh:
+                        text = fh.read()
+                    for banned in ("import FreeCADGui", "from PySide", "import PySide",
+                                   "pivy"):
+                        self.assertNotIn(banned, text, name)
+
+    def test_the_app_and_gui_modules_import_one_another_without_a_circle(self):
+        """Every import between app/ and gui/ modules, at module level or in a function,
+        read from the source: following them never comes back to where it started."""
+        import ast
+        from tests import test_layers
+        modules = {m: p for m, p in test_layers._modules(REPO)
+                   if m.split(".")[1:2] in (["app"], ["gui"])}
+        graph = {}
+        for module, path in modules.items():
+            with open(path, encoding="utf-8") as fh:
+                tree = ast.parse(fh.read(), path)
+            graph[module] = set()
+            for _, name in test_layers._imported(module, path, tree):
+                parts = name.split(".")
+                while parts and ".".join(parts) not in modules:
+                    parts.pop()
+                if parts and ".".join(parts) != module:
+                    graph[module].add(".".join(parts))
+        done, path = set(), []
+
+        def visit(module):
+            if module in path:
+                self.fail("import circle: " + " -> ".join(path[path.index(module):] + [module]))
+            if module in done:
+                return
+            path.append(module)
+            for imported in sorted(graph[module]):
+                visit(imported)
+            path.pop()
+            done.add(module)
+        for module in sorted(graph):
+            visit(module)
 
 
 if __name__ == "__main__":

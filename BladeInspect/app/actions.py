@@ -21,9 +21,9 @@ from ..core.errors import InputError
 from ..core.pointio import read_points
 from ..inspection import fitting
 from ..inspection import pipeline
-from ..inspection.judging import fit_and_judge
 from ..inspection.sections import section_table
 from . import objects, settings
+from .registration_fit import judge_fits
 
 MODULE = __name__          # "BladeInspect.app.actions": what a console line imports
 
@@ -93,14 +93,6 @@ def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
                              weights_by_zone=weights_by_zone or None,
                              decision_rule=decision_rule, datum_faces=datum_faces or None,
                              weights=weights or None)
-
-
-def judge_fits(result, nominal, choice, tolerance):
-    """Move ``result`` to the chosen fit's pose and record result.fit and result.fit_sensitivity,
-    as the `report` command does before it writes (inspection.report.write_result_report)."""
-    fit_and_judge(result, nominal, choice, tolerance,
-                  lambda fitted: section_table(fitted, nominal))
-    return result
 
 
 # ---------------------------------------------------------------- actions

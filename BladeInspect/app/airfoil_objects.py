@@ -18,6 +18,8 @@ from ..core.contracts import json_default
 from ..core.errors import InputError
 from ..inspection import airfoil as airfoil_mod
 from . import objects
+from .objects.base import (READ_ONLY, Proxy, add_property, add_table, building, finish,
+                           shape_signature, signature)
 
 GROUP_NAME = "Airfoil"
 PROFILES = ("nominal", "measured")
@@ -28,12 +30,12 @@ def _vector(v):
     return FreeCAD.Vector(*[float(c) for c in np.asarray(v, dtype=float).ravel()[:3]])
 
 
-class _SectionGeometry(objects._Proxy):
+class _SectionGeometry(Proxy):
     """What both kinds share: the section's plane and links, and the stage's result."""
     group = "Airfoil"
 
     def add_properties(self, obj):
-        add, g = objects._add, "Section"
+        add, g = add_property, "Section"
         add(obj, "App::PropertyLink", "Nominal", g, "Nominal CAD the section is cut from")
         add(obj, "App::PropertyLink", "Registration", g,
             "Registration whose points give the measured profile")
@@ -62,13 +64,13 @@ class _SectionGeometry(objects._Proxy):
     def signature(self, obj):
         if obj.Nominal is None:
             return ""
-        parts = [objects._shape_signature(obj.Nominal.Shape), tuple(obj.PlaneOrigin),
+        parts = [shape_signature(obj.Nominal.Shape), tuple(obj.PlaneOrigin),
                  tuple(obj.PlaneNormal), tuple(obj.EngineAxis), obj.ChordMethod, obj.Profile]
         if obj.Profile == "measured":
             if obj.Registration is None:
                 return ""
             parts += [np.asarray(obj.Registration.PointsCad), list(obj.PointIndex)]
-        return objects._signature(*parts)
+        return signature(*parts)
 
     def characteristics(self, obj):
         """(core.airfoil.Characteristics, PlaneFrame) of the object's profile, recomputed."""
@@ -105,8 +107,8 @@ class CamberLine(_SectionGeometry):
     Type = "BladeInspect::CamberLine"
 
     def add_results(self, obj):
-        ro = objects.READ_ONLY
-        objects._add_table(obj, "Camber line", (
+        ro = READ_ONLY
+        add_table(obj, "Camber line", (
             ("App::PropertyFloat", "LengthMm", "Length of the camber line, LE to TE point, mm",
              ro),
             ("App::PropertyFloat", "ChordMm", "Chord by ChordMethod, mm", ro),
@@ -139,8 +141,8 @@ class EdgeCircles(_SectionGeometry):
     Type = "BladeInspect::EdgeCircles"
 
     def add_results(self, obj):
-        ro = objects.READ_ONLY
-        objects._add_table(obj, "Edge circles", (
+        ro = READ_ONLY
+        add_table(obj, "Edge circles", (
             ("App::PropertyFloat", "LeRadiusMm", "Leading-edge radius, mm", ro),
             ("App::PropertyFloat", "TeRadiusMm", "Trailing-edge radius, mm", ro),
             ("App::PropertyVector", "LeCenter", "Leading-edge circle's centre, mm", ro),
@@ -188,7 +190,7 @@ def _make(doc, cls, name, section, profile, ch, registration, nominal_obj, opts)
     obj.Label = "%s %s (%s)" % ({"CamberLine": "MCL", "EdgeCircles": "Edge circles"}[
         cls.__name__], plane.label, profile)
     cls.store(obj.Proxy, obj, ch, section.frame)
-    objects._finish(obj)
+    finish(obj)
     return obj
 
 
@@ -197,7 +199,7 @@ def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
     an EdgeCircles of the nominal profile and, where the section was measured, of the measured
     one; the stage's blocks (result.json's ``airfoil``) kept on the group for the table."""
     made = []
-    with objects.building(doc, "Airfoil"):
+    with building(doc, "Airfoil"):
         group = doc.addObject("App::DocumentObjectGroup", name)
         group.addProperty("App::PropertyLink", "Registration", "Airfoil",
                           "Registration the characteristics were measured from")

@@ -14,6 +14,9 @@ from ..core.contracts import json_default
 from ..core.icp import InlierCut, Neighbourhoods
 from ..inspection import fitting, weighting
 from ..inspection.fit_report import weights_text
+from ..inspection.judging import fit_and_judge
+from ..inspection.sections import section_table
+from . import settings
 
 GROUP = "Fit"
 # (property, FitChoice field, tooltip); the enumerations list their choices.
@@ -26,7 +29,7 @@ WEIGHT_CHOICES = (DEFAULT_WEIGHTS,) + weighting.WEIGHT_MODELS
 
 
 def add_properties(obj, add):
-    """``add``: app.objects._add."""
+    """``add``: app.objects.add_property."""
     for prop, choices, tip in (
             ("Fit", fitting.OBJECTIVE_NAMES, "Fit objective after the robust ICP (--fit)"),
             ("DecisionRule", ("iso14253", "simple"),
@@ -109,9 +112,15 @@ def refit(obj, result, nominal):
     choice = choice_of(obj)
     if choice == fitting.FitChoice():
         return
-    from . import settings
-    from .actions import judge_fits   # actions imports app.objects, which imports this
     judge_fits(result, nominal, choice, settings.value("ToleranceMm"))
+
+
+def judge_fits(result, nominal, choice, tolerance):
+    """Move ``result`` to the chosen fit's pose and record result.fit and result.fit_sensitivity,
+    as the `report` command does before it writes (inspection.report.write_result_report)."""
+    fit_and_judge(result, nominal, choice, tolerance,
+                  lambda fitted: section_table(fitted, nominal))
+    return result
 
 
 def store(obj, result):

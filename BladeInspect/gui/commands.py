@@ -17,6 +17,7 @@ from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
 from ..measurement.scan import open_rig
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
+from .command_base import Command, find_measurement, find_nominal, find_registration
 from .i18n import QT_TRANSLATE_NOOP, translate
 from .preferences import PreferencesPage
 from .session import RIG
@@ -52,37 +53,6 @@ def active_document(create=True):
     if doc is None and create:
         doc = FreeCAD.newDocument("Inspection")
     return doc
-
-
-def _selected():
-    return [s for s in FreeCADGui.Selection.getSelection()] if FreeCAD.GuiUp else []
-
-
-def find_input(type_names):
-    """The selected object of one of these BladeInspect types, else the newest in the active
-    document, else None."""
-    doc = FreeCAD.ActiveDocument
-    if doc is None:
-        return None
-    for obj in _selected():
-        if objects.proxy_type(obj) in type_names:
-            return obj
-    for obj in reversed(doc.Objects):
-        if objects.proxy_type(obj) in type_names:
-            return obj
-    return None
-
-
-def find_nominal():
-    """A nominal: a DemoBlade or CadModel object, else a selected Part feature with faces."""
-    obj = find_input((objects.DemoBlade.Type, objects.CadModel.Type))
-    if obj is not None:
-        return obj
-    for sel in _selected():
-        shape = getattr(sel, "Shape", None)
-        if shape is not None and not shape.isNull() and shape.Faces:
-            return sel
-    return None
 
 
 def do_command(imports, call):
@@ -138,27 +108,7 @@ def _recompute_gui(doc):
 
 # ---------------------------------------------------------------- commands
 
-class _Command:
-    name = ""
-    menu = ""
-    tip = ""
-    panel = None       # a task panel class: Activated shows panel(self.start)
-
-    def GetResources(self):
-        return {"Pixmap": resources.icon_path(self.name), "MenuText": self.menu,
-                "ToolTip": self.tip}
-
-    def IsActive(self):
-        return not progress.busy() and self.ready()
-
-    def ready(self):
-        return True
-
-    def Activated(self):
-        FreeCADGui.Control.showDialog(self.panel(self.start))
-
-
-class _OpenFileCommand(_Command):
+class _OpenFileCommand(Command):
     """A command that reads one file the user picks and makes an object of it (self.load)."""
     dialog_title = ""
     file_filter = ""
@@ -169,7 +119,7 @@ class _OpenFileCommand(_Command):
             self.load(path)
 
 
-class DemoBlade(_Command):
+class DemoBlade(Command):
     name = "BladeInspect_DemoBlade"
     menu = QT_TRANSLATE_NOOP("BladeInspect_DemoBlade", "Demo blade")
     tip = QT_TRANSLATE_NOOP(
@@ -209,7 +159,7 @@ class LoadCad(_OpenFileCommand):
         return obj
 
 
-class ConnectRig(_Command):
+class ConnectRig(Command):
     name = "BladeInspect_ConnectRig"
     menu = QT_TRANSLATE_NOOP("BladeInspect_ConnectRig", "Connect rig...")
     tip = QT_TRANSLATE_NOOP(
@@ -239,15 +189,14 @@ class ConnectRig(_Command):
         return rig
 
 
-class Scan(_Command):
+class Scan(Command):
     name = "BladeInspect_Scan"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Scan", "Scan...")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_Scan",
         "Scan the blade section by section with the connected rig (progress and abort)")
 
-    def ready(self):
-        return RIG.connected
+    is_active = "with_rig"
 
     panel = taskpanels.ScanPanel
 
@@ -303,18 +252,17 @@ class ImportPoints(_OpenFileCommand):
         return obj
 
 
-class Reconstruct(_Command):
+class Reconstruct(Command):
     name = "BladeInspect_Reconstruct"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Reconstruct", "Reconstruct")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_Reconstruct",
         "Fit cubic B-spline section curves to the measurement and loft them into surfaces")
 
-    def ready(self):
-        return find_input((objects.Measurement.Type,)) is not None
+    is_active = "with_measurement"
 
     def Activated(self):
-        self.reconstruct(find_input((objects.Measurement.Type,)))
+        self.reconstruct(find_measurement())
 
     def reconstruct(self, measurement):
         """app.actions.reconstruct of the measurement."""
@@ -326,7 +274,7 @@ class Reconstruct(_Command):
         return obj
 
 
-class Register(_Command):
+class Register(Command):
     name = "BladeInspect_Register"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Register", "Register")
     tip = QT_TRANSLATE_NOOP(
@@ -336,11 +284,10 @@ class Register(_Command):
         "the fit-sensitivity table")
     panel = taskpanels.RegisterPanel
 
-    def ready(self):
-        return find_input((objects.Measurement.Type,)) is not None and find_nominal() is not None
+    is_active = "with_measurement_and_nominal"
 
     def start(self, seed, **fit):
-        obj = self.register(find_input((objects.Measurement.Type,)), find_nominal(), seed,
+        obj = self.register(find_measurement(), find_nominal(), seed,
                             **fit)
         if obj is not None:
             self.show(obj)
@@ -364,18 +311,17 @@ class Register(_Command):
         taskpanels.show_panel(taskpanels.RegistrationPanel(obj))
 
 
-class DeviationMap(_Command):
+class DeviationMap(Command):
     name = "BladeInspect_DeviationMap"
     menu = QT_TRANSLATE_NOOP("BladeInspect_DeviationMap", "Deviation map")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_DeviationMap",
         "Colour the registered points by signed deviation (limits from the preferences)")
 
-    def ready(self):
-        return find_input((objects.Registration.Type,)) is not None
+    is_active = "with_registration"
 
     def Activated(self):
-        self.make(find_input((objects.Registration.Type,)))
+        self.make(find_registration())
 
     def make(self, registration, limit=None):
         doc = registration.Document
@@ -397,19 +343,17 @@ class DeviationMap(_Command):
         return obj
 
 
-class SectionAnalysis(_Command):
+class SectionAnalysis(Command):
     name = "BladeInspect_SectionAnalysis"
     menu = QT_TRANSLATE_NOOP("BladeInspect_SectionAnalysis", "Section analysis")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_SectionAnalysis",
         "Profile errors per section (Table 2): RMS, worst deviation, leading/trailing edge")
 
-    def ready(self):
-        reg = find_input((objects.Registration.Type,))
-        return reg is not None and reg.Nominal is not None
+    is_active = "with_registered_nominal"
 
     def Activated(self):
-        table = self.analyse(find_input((objects.Registration.Type,)))
+        table = self.analyse(find_registration())
         if table is not None:
             self.show(table)
 
@@ -433,21 +377,19 @@ class SectionAnalysis(_Command):
             "; ".join(table.warnings)))
 
 
-class Report(_Command):
+class Report(Command):
     name = "BladeInspect_Report"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Report", "Report...")
     tip = QT_TRANSLATE_NOOP(
         "BladeInspect_Report",
         "Write the inspection report (HTML and PDF, result.json, deviations.csv) to a folder")
 
-    def ready(self):
-        reg = find_input((objects.Registration.Type,))
-        return reg is not None and reg.Measurement is not None and reg.Nominal is not None
+    is_active = "with_registered_inputs"
 
     def Activated(self):
         out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
-            registration = find_input((objects.Registration.Type,))
+            registration = find_registration()
             summary = self.report(registration, out_dir)
             html = os.path.join(out_dir, "report.html")
             if summary is not None:
@@ -486,7 +428,7 @@ class Report(_Command):
             FreeCADGui.setActiveDocument(doc.Name)
 
 
-class Airfoil(_Command):
+class Airfoil(Command):
     name = "BladeInspect_Airfoil"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Airfoil", "Airfoil analysis...")
     tip = QT_TRANSLATE_NOOP(
@@ -496,12 +438,10 @@ class Airfoil(_Command):
         "camber lines and edge circles added to the document")
     panel = taskpanels.AirfoilOptionsPanel
 
-    def ready(self):
-        reg = find_input((objects.Registration.Type,))
-        return reg is not None and reg.Nominal is not None
+    is_active = "with_registered_nominal"
 
     def start(self, **options):
-        stage = self.analyse(find_input((objects.Registration.Type,)), **options)
+        stage = self.analyse(find_registration(), **options)
         if stage is not None:
             self.show(stage.extras())
         return stage
@@ -521,7 +461,7 @@ class Airfoil(_Command):
         taskpanels.show_panel(taskpanels.AirfoilPanel(analysis))
 
 
-class Preferences(_Command):
+class Preferences(Command):
     name = "BladeInspect_Preferences"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Preferences", "Preferences...")
     tip = QT_TRANSLATE_NOOP(

@@ -15,13 +15,14 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from ..app import actions, loop, objects, settings
+from ..app import actions, loop, settings
 from ..core import contracts
 from ..core.errors import InputError
 from ..inspection import characteristic_names as names
 from ..inspection.report import section_rows
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from . import commands, progress, tables, taskpanels
+from .command_base import Command, find_nominal, find_registration
 from .i18n import QT_TRANSLATE_NOOP, translate
 from .session import RIG
 
@@ -210,7 +211,7 @@ class SimulatePanel(taskpanels.FormPanel):
 
 # ---------------------------------------------------------------- commands
 
-class Inspect(commands._Command):
+class Inspect(Command):
     name = "BladeInspect_Inspect"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Inspect", "Inspect...")
     tip = QT_TRANSLATE_NOOP(
@@ -218,8 +219,7 @@ class Inspect(commands._Command):
         "The whole loop: blind section scan, registration, paths planned from the CAD at its "
         "nominal sections (drawn before they run), their scan, Table 2 and verdict")
 
-    def ready(self):
-        return commands.find_nominal() is not None
+    is_active = "with_nominal"
 
     panel = InspectPanel
 
@@ -229,7 +229,7 @@ class Inspect(commands._Command):
         except InputError as exc:
             progress.report_error(translate("BladeInspect", "Inspect"), str(exc))
             return None
-        summary = self.inspect(commands.find_nominal(), heights, tolerance, seed, rig_file,
+        summary = self.inspect(find_nominal(), heights, tolerance, seed, rig_file,
                                **fit)
         if summary is not None:
             self.show(summary)
@@ -297,7 +297,7 @@ class Inspect(commands._Command):
             summary["sections"], note, summary["result"].fit_sensitivity)
 
 
-class Calibrate(commands._Command):
+class Calibrate(Command):
     name = "BladeInspect_Calibrate"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Calibrate", "Calibrate rig...")
     tip = QT_TRANSLATE_NOOP(
@@ -348,7 +348,7 @@ def calibration_text(result, out_path):
     return "\n".join(lines)
 
 
-class AddCmm(commands._Command):
+class AddCmm(Command):
     name = "BladeInspect_AddCmm"
     menu = QT_TRANSLATE_NOOP("BladeInspect_AddCmm", "Add CMM file...")
     tip = QT_TRANSLATE_NOOP(
@@ -356,14 +356,12 @@ class AddCmm(commands._Command):
         "Compare a CMM file's sections with the optical ones (Table 2): for an inspection, at"
         " its nominal sections")
 
-    def ready(self):
-        reg = commands.find_input((objects.Registration.Type,))
-        return reg is not None and reg.Nominal is not None
+    is_active = "with_registered_nominal"
 
     def Activated(self):
         path = commands.ask_open_file(translate("BladeInspect", "CMM file"), CMM_FILTER)
         if path:
-            table = self.add(commands.find_input((objects.Registration.Type,)), path)
+            table = self.add(find_registration(), path)
             if table is not None:
                 self.show(table)
 
@@ -381,7 +379,7 @@ class AddCmm(commands._Command):
                     translate("BladeInspect", "CMM: %s") % table.cmm_source)
 
 
-class Simulate(commands._Command):
+class Simulate(Command):
     name = "BladeInspect_Simulate"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Simulate", "Simulation test bed...")
     tip = QT_TRANSLATE_NOOP(
@@ -400,7 +398,7 @@ class Simulate(commands._Command):
         registration)."""
         doc = commands.active_document()
         title = translate("BladeInspect", "Simulation test bed")
-        nominal_obj = commands.find_nominal()
+        nominal_obj = find_nominal()
         outcome = commands.run_action(title, "simulate", doc.Name, int(seed),
                                       nominal=nominal_obj.Name if nominal_obj else None,
                                       **options)

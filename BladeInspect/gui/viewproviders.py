@@ -24,11 +24,19 @@ class ViewProvider:
     def getIcon(self):
         return resources.icon_path(self.icon)
 
-    def __getstate__(self):
+    # Nothing of the view provider is saved: it is made again from the object's type. FreeCAD
+    # 1.0 asks through dumps/loads, FreeCAD 0.20 through __getstate__/__setstate__.
+    def dumps(self):
         return None
 
-    def __setstate__(self, state):
+    def loads(self, state):
         return None
+
+    def __getstate__(self):
+        return self.dumps()
+
+    def __setstate__(self, state):
+        self.loads(state)
 
 
 class ViewProviderNominal(ViewProvider):

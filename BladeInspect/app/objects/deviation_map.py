@@ -1,0 +1,58 @@
+"""DeviationMap: the registered points coloured by deviation, with a legend, as a document
+object."""
+
+from ...core import colourmap
+from ...core.errors import InputError
+from .base import Proxy, add_property, attach_view, building, points_kernel, proxy_type
+from .registration import Registration, make_registration, registration_points
+
+
+class DeviationMap(Proxy):
+    """The registered points coloured by signed deviation (saturating at +-Limit), shown per
+    point through the `Color` list, with the legend's values and colours for the view."""
+    Type = "BladeInspect::DeviationMap"
+
+    def add_properties(self, obj):
+        add = add_property
+        g = "Deviation map"
+        add(obj, "App::PropertyLink", "Registration", g, "Registration whose deviations are shown")
+        add(obj, "App::PropertyFloat", "Limit", g,
+            "Deviation at which the colours saturate (blue -Limit, green 0, red +Limit), mm")
+        add(obj, "App::PropertyColorList", "Color", g, "Colour of every point", hidden=True)
+        add(obj, "App::PropertyFloatList", "Deviation", g, "Signed deviation of every point, mm",
+            hidden=True)
+        add(obj, "App::PropertyFloatList", "LegendValues", g, "Legend tick values, mm",
+            read_only=True)
+        add(obj, "App::PropertyColorList", "LegendColors", g, "Colour at each legend tick",
+            hidden=True)
+        add(obj, "App::PropertyInteger", "NPoints", g, "Points shown", read_only=True)
+
+    def execute(self, obj):
+        if obj.Registration is None:
+            raise InputError("%s: no registration linked" % obj.Label)
+        if obj.Limit <= 0:
+            raise InputError("%s: Limit must be positive, got %g" % (obj.Label, obj.Limit))
+        points, deviation, _ = registration_points(obj.Registration)
+        obj.Points = points_kernel(points)
+        obj.Deviation = deviation.tolist()
+        obj.Color = [tuple(c) for c in colourmap.deviation_colours(deviation, obj.Limit).tolist()]
+        values, colours = colourmap.legend_ticks(obj.Limit)
+        obj.LegendValues = values.tolist()
+        obj.LegendColors = [tuple(c) for c in colours.tolist()]
+        obj.NPoints = len(deviation)
+
+
+def make_deviation_map(doc, registration, limit, name="DeviationMap"):
+    """A DeviationMap of `registration`: a Registration document object, or a
+    RegistrationResult (a Registration object holding it is made first)."""
+    with building(doc, "Deviation map"):
+        if proxy_type(registration) != Registration.Type:
+            registration = make_registration(doc, registration)
+        obj = doc.addObject("Points::FeaturePython", name)
+        DeviationMap(obj)
+        obj.Registration = registration
+        obj.Limit = float(limit)
+        obj.Proxy.execute(obj)
+        obj.purgeTouched()
+        attach_view(obj)
+    return obj
