@@ -57,6 +57,7 @@ _ZONE_WINDOW = 512            # dense samples either side of the edge point scan
 # it is settled when its bounds move by less than this (a nanometre; the radius moves far less).
 _ZONE_SETTLED_MM = 1e-6
 _ZONE_MIN_POINTS = 12
+ZONE_MIN_POINTS = _ZONE_MIN_POINTS
 _END_SKIP = 0.5
 # Metal angles: the camber line's end tangent is the slope at its end of a quartic in arc
 # length fitted to the inscribed-circle centres over this % of the locus back from the end
