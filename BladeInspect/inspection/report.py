@@ -19,7 +19,7 @@ import numpy as np
 
 from ..core import colourmap, contracts
 from ..core import stats as stats_mod
-from . import airfoil as airfoil_mod
+from . import airfoil_stage as airfoil_mod
 from . import airfoil_report
 from . import characteristic_names
 from . import pipeline
