@@ -424,7 +424,7 @@ def report_rows(sensitivity_doc):
     header = ["Characteristic", "Unit"] + ["%s (verdict)" % o for o in objectives] + ["Change"]
     rows = []
     for row in sensitivity_doc["rows"]:
-        # airfoil rows (inspection.airfoil.add_to_sensitivity) carry value and unit
+        # airfoil rows (inspection.airfoil_verdicts.add_to_sensitivity) carry value and unit
         _, key = names.sensitivity_row_parts(row)
         unit = names.unit(key) if key else "mm"
         value = [row["by_fit"][o].get("value_mm", row["by_fit"][o].get("value"))
