@@ -167,7 +167,8 @@ def add_pages(pdf, parts, table):
         pages += 2
     if stage.lean_bow is not None:
         fig = figure_span(stage)
-        parts += ["<h3>Shift and twist along the span</h3>", img_tag(png_bytes(fig), "shift and twist")]
+        parts += ["<h3>Shift and twist along the span</h3>",
+                  img_tag(png_bytes(fig), "shift and twist")]
         pdf.savefig(fig)
         plt.close(fig)
         pages += 1

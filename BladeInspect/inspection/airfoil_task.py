@@ -6,7 +6,6 @@ does not is re-fitted afresh and says why. The file is written once, atomically;
 not a task file or was made for another task is refused with a one-line InputError naming it.
 """
 
-
 import datetime
 import hashlib
 import json
@@ -23,13 +22,12 @@ from .airfoil_uncertainty import (maxima_bias, point_noise_model, refit_uncertai
                                   sensor_of)
 from .airfoil_values import flat, unflat
 
-
 # Raise whenever the re-fit draws' model (inspection.airfoil_uncertainty.refit_uncertainty,
-# point_noise_model, inspection.airfoil_measure.measure) changes: files of another version are refused. 2: the measured
-# profile's fit takes the nominal's knots where the points thin out (core.airfoil
-# ._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is each
-# reading's beam where it meets the smooth fit (inspection.airfoil_uncertainty.beam_feet), and their pose
-# the covariance's random part (inspection.uncertainty.random_pose_covariance).
+# point_noise_model, inspection.airfoil_measure.measure) changes: files of another version are
+# refused. 2: the measured profile's fit takes the nominal's knots where the points thin out
+# (core.airfoil._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is
+# each reading's beam where it meets the smooth fit (inspection.airfoil_uncertainty.beam_feet),
+# and their pose the covariance's random part (inspection.uncertainty.random_pose_covariance).
 TASK_MODEL_VERSION = 3
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48

@@ -74,7 +74,7 @@ def _beams_in_plane(beams, surface_normal, frame):
 
 
 def refit_uncertainty(m, opts, rng, draws_sd=None):
-    """1 sigma of each measured characteristic of the section ``m`` (a
+    """1 sigma of each measured characteristic of the section ``m`` (an
     airfoil_measure.SectionMeasurement) by re-fitting perturbed points (module notes);
     ``draws_sd``, a dict, is given the draws' own 1 sigma before the maxima's bias."""
     result, idx, frame, nom, ch, fit = m.result, m.idx, m.frame, m.nominal, m.measured, m.fit
