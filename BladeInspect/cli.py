@@ -285,7 +285,7 @@ def cmd_demo(args):
     scan, reconstruction, PCA, SNR-weighted ICP, CAD-planned scan of the nominal sections,
     report with the airfoil characteristics (as `inspect` makes by default); then the pose
     judged against the simulator's truth."""
-    from .inspection.airfoil import options_from_args
+    from .inspection.airfoil_stage import options_from_args
     from .inspection.closed_loop import run_inspect
     summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress(),
                           document=_document_writer(),
@@ -367,12 +367,12 @@ def _airfoil_options(args):
                              "options (--engine-axis, --characteristics, --chord-method, "
                              "--edge-offsets, --le-rule, --uncertainty-task)")
         return None
-    from .inspection.airfoil import options_from_args
+    from .inspection.airfoil_stage import options_from_args
     return options_from_args(*given)
 
 
 def cmd_airfoil(args):
-    from .inspection.airfoil import run_airfoil
+    from .inspection.airfoil_stage import run_airfoil
     summary = run_airfoil(args.cad, args.out, points_path=args.points,
                           heights_pct=args.section_heights, opts=_airfoil_options(args),
                           seed=args.seed, progress=Progress())

@@ -7,7 +7,7 @@ Each scan: the sections planned from the CAD at the part's TRUE pose on the simu
 sensor model's noise, incidence-dependent SNR and missing readings), the readings mapped into
 the CAD by the true pose -- or, with --loop, the whole `inspect` loop (blind scan,
 registration, plan, scan, ICP) -- then Table 2's section assignment and the airfoil stage
-(inspection.airfoil.run_stage), as `inspect --airfoil` runs it. Also printed per edge: planned
+(inspection.airfoil_stage.run_stage), as `inspect --airfoil` runs it. Also printed per edge: planned
 points in the +-45 deg edge zone, how many of them returned a reading, and their incidence.
 
     scripts/fcpython bench/bench_airfoil_loop_edges.py [--scans 5] [--blades demo,rotor67]
@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
+from BladeInspect.inspection import airfoil_stage as stage_mod  # noqa: E402
 from BladeInspect.inspection import sections as sections_mod  # noqa: E402
 from BladeInspect.measurement.planning import plan_sections  # noqa: E402
 from BladeInspect.rig.sensor import SensorModel  # noqa: E402

@@ -10,7 +10,7 @@ point count, spacing or noise the bound says would reach 0.005 deg.
    tests/test_airfoil_metal_angle_bound.py) beside the module's.
 2. The demo blade and NASA Rotor 67, the CAD-planned sections (measurement.planning, the
    rig's sensor model and the default edge-density rule, as bench_airfoil_loop_edges.py and
-   `inspect` plan them) read at the part's true pose; the stage (inspection.airfoil) measures.
+   `inspect` plan them) read at the part's true pose; the stage (inspection.airfoil_stage) measures.
 
     scripts/fcpython bench/bench_airfoil_metal_angle.py [--scans 20] [--windows 50,90]
         [--blades demo,rotor67] [--degrees 2,4] [--no-dca] [--no-planned]
@@ -94,7 +94,7 @@ def angle_of(v):
 
 def planned(args, degrees):
     from bench_airfoil_loop_edges import load, truth_pose
-    from BladeInspect.inspection import airfoil as stage_mod
+    from BladeInspect.inspection import airfoil_stage as stage_mod
     from BladeInspect.inspection import sections as sections_mod
     from BladeInspect.measurement.planning import DEFAULT_EDGE_RADIUS_SIGMA_MM, plan_sections
     from BladeInspect.rig.simulated import SimulatedRig

@@ -11,7 +11,7 @@ uncertainty re-fits, on the demo blade:
 Prints the CPU seconds of run_stage for draws 0 and the default draws, of the kernel alone
 (core.airfoil.characteristics on the five nominal cuts), and of one kernel run a measured
 section (what every uncertainty re-fit repeats). With the task-specific uncertainty
-(inspection.airfoil_task_u) on the planned case: the first blade of the task making the task
+(inspection.airfoil_task) on the planned case: the first blade of the task making the task
 file (``--task-draws``, default the product's 48), and a second blade of the same task (fresh
 noise) reusing it -- the figure issue 15's "five sections in under 1 s" is about. BLAS is held
 to one thread (core.blas_threads.limit_blas_threads, as the command line does: its spinning
@@ -20,7 +20,7 @@ threads double a CPU figure on a shared machine).
 The figure: blade 2's run_stage (nominal and measured characteristics of the five sections and
 their U from the task file) ``--repeats`` times (default 5), each beside a draws-0 run of the
 same blade (interleaved), in CPU seconds of this process, with the nominal cuts' remembered
-characteristics (inspection.airfoil.nominal_characteristics) forgotten first, as in a
+characteristics (inspection.airfoil_stage.nominal_characteristics) forgotten first, as in a
 one-blade process (report, inspect), and for blade 3 with them remembered (a batch worker's
 next blade; another blade, so that no foot of blade 2's points on a nominal profile serves
 it); the last line states the medians, the range and the load average (os.getloadavg,
@@ -39,7 +39,7 @@ import numpy as np
 
 from BladeInspect.core import airfoil as kernel
 from BladeInspect.core.blas_threads import limit_blas_threads
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.inspection.pipeline import load_nominal, load_points, register
 

@@ -1,4 +1,4 @@
-"""The airfoil stage's stated uncertainty (inspection/airfoil.py: re-fits of perturbed points)
+"""The airfoil stage's stated uncertainty (inspection/airfoil_uncertainty.py: re-fits of perturbed points)
 against the scatter over repeated simulated scans of the demo blade's planned sections.
 
 Each simulated scan: the CAD's exact section points (OCC's cut, SPACING apart) with normal
@@ -24,7 +24,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from BladeInspect.core import stats  # noqa: E402
 from BladeInspect.core import transforms as tf  # noqa: E402
-from BladeInspect.inspection import airfoil as stage_mod  # noqa: E402
+from BladeInspect.inspection import airfoil_stage as stage_mod  # noqa: E402
+from BladeInspect.inspection import airfoil_values as values_mod  # noqa: E402
 from BladeInspect.inspection import sections as sections_mod  # noqa: E402
 from BladeInspect.inspection.pipeline import load_nominal  # noqa: E402
 from BladeInspect.inspection.result import RegistrationResult  # noqa: E402
@@ -80,7 +81,7 @@ def main():
     for k in range(args.scans):
         st = stage_of(nominal, scan(nominal, readings, cov, rng), 0, k)
         for b in st.blocks:
-            for key, v in stage_mod._flat(b["measured"]).items():
+            for key, v in values_mod.flat(b["measured"]).items():
                 values.setdefault((b["label"], key), []).append(v)
     t_scatter = time.process_time() - t0
     t0 = time.process_time()
@@ -88,7 +89,7 @@ def main():
     for k in range(args.stated):
         st = stage_of(nominal, scan(nominal, readings, cov, rng), args.draws, 100 + k)
         for b in st.blocks:
-            for key, v in stage_mod._flat(b["uncertainty"]).items():
+            for key, v in values_mod.flat(b["uncertainty"]).items():
                 stated.setdefault((b["label"], key), []).append(v)
     t_stated = time.process_time() - t0
     print("demo blade, sections at %s %% span, %.2f mm spacing, sigma %.1f um, pose 1 sigma "

@@ -1,7 +1,7 @@
 """The fit-sensitivity table (inspection.fitting.sensitivity) on the demo blade's CAD-planned
 scan: time of each fit objective from the ICP pose, of judging every objective's deviations,
 of re-measuring the airfoil characteristics under every objective (their rows of the table,
-inspection.airfoil.add_to_sensitivity), and of the whole table, with the table itself.
+inspection.airfoil_verdicts.add_to_sensitivity), and of the whole table, with the table itself.
 
     scripts/fcpython bench/bench_fit_sensitivity.py [--trials 3] [--seed 0]
 
@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from BladeInspect.inspection import airfoil, fitting
+from BladeInspect.inspection import airfoil_stage as airfoil, fitting
 from BladeInspect.inspection.closed_loop import run_inspect
 from BladeInspect.inspection.pipeline import load_nominal
 

@@ -87,9 +87,10 @@ def synthetic(n_points, trials):
 
 def demo(n_points, trials):
     from BladeInspect.inspection import pipeline
+    from BladeInspect.inspection.closest_fn import exact_closest_fn
     from BladeInspect.inspection.simulate import simulate_measurement
     nominal = pipeline.load_nominal(None)
-    closest = pipeline.exact_closest_fn(nominal)
+    closest = exact_closest_fn(nominal)
     print("demo blade, simulated scan of %d points (+-6 um uniform, 2 %% outliers), ICP "
           "inliers and weights" % n_points)
     for k in range(trials):

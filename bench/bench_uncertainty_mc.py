@@ -1,5 +1,5 @@
 """Monte Carlo over the whole measurement chain against the stated expanded uncertainty U (issue
-16 item 5): does inspection/uncertainty.py's model (and inspection/airfoil.py's airfoil u) state
+16 item 5): does inspection/uncertainty.py's model (and inspection/airfoil_uncertainty.py's airfoil u) state
 the scatter that the chain really has?
 
 One `inspect` loop on the blade (simulated rig, default sensor, a 30 um bump on the suction side
@@ -63,7 +63,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from BladeInspect.core import mc_sampling  # noqa: E402
 from BladeInspect.core import stats as stats_mod  # noqa: E402
 from BladeInspect.core import transforms as tf  # noqa: E402
-from BladeInspect.inspection import airfoil as airfoil_mod  # noqa: E402
+from BladeInspect.inspection import airfoil_stage as airfoil_mod  # noqa: E402
+from BladeInspect.inspection import airfoil_values as values  # noqa: E402
 from BladeInspect.inspection import pipeline  # noqa: E402
 from BladeInspect.inspection import sections as sections_mod  # noqa: E402
 from BladeInspect.inspection import uncertainty as uncertainty_mod  # noqa: E402
@@ -305,9 +306,9 @@ class Chain:
         stage = airfoil_mod.run_stage(self.nominal, airfoil_mod.planes_of_table(table), opts,
                                       result, table.span_axis)
         for b in stage.blocks:
-            for k, v in airfoil_mod._flat(b["measured"] or {}).items():
+            for k, v in values.flat(b["measured"] or {}).items():
                 values["%s %s" % (b["label"], k)] = v
-            for k, v in airfoil_mod._flat(b["uncertainty"] or {}).items():
+            for k, v in values.flat(b["uncertainty"] or {}).items():
                 stated["%s %s" % (b["label"], k)] = v
         return values, stated, truth, result
 
@@ -315,7 +316,7 @@ class Chain:
 def is_maximum(key):
     """A judged value that is a maximum over points: a worst deviation, a contour's form."""
     return key.startswith("worst deviation") or any(
-        key.endswith(" " + m) for m in airfoil_mod.MAXIMA)
+        key.endswith(" " + m) for m in values.MAXIMA)
 
 
 def run(name, trials, seed, n_stated, errors=ERRORS, record_seed=31):

@@ -8,8 +8,8 @@ import unittest
 
 import numpy as np
 
-from BladeInspect.inspection import airfoil as stage_mod
-from BladeInspect.inspection import airfoil_task_u
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_task
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement.planning import nominal_section
 from tests.helpers import demo_nominal
@@ -82,15 +82,15 @@ class CalibrationInTheAirfoilU(unittest.TestCase):
                 self.assertLess(shift_u, 0.2 * CALIBRATION_MM)
 
     def test_the_task_key_holds_the_term_only_when_given(self):
-        plain = airfoil_task_u.task_key(self.nominal, stage_mod.Options(), self.result)
-        given = airfoil_task_u.task_key(self.nominal,
+        plain = airfoil_task.task_key(self.nominal, stage_mod.Options(), self.result)
+        given = airfoil_task.task_key(self.nominal,
                                         stage_mod.Options(calibration_mm=CALIBRATION_MM),
                                         self.result)
         self.assertNotIn("calibration_mm", plain)      # files made without one stay valid
         self.assertEqual(given.pop("calibration_mm"), CALIBRATION_MM)
         self.assertEqual(given, plain)
-        self.assertNotEqual(airfoil_task_u.digest(plain),
-                            airfoil_task_u.digest(airfoil_task_u.task_key(
+        self.assertNotEqual(airfoil_task.digest(plain),
+                            airfoil_task.digest(airfoil_task.task_key(
                                 self.nominal, stage_mod.Options(calibration_mm=0.001),
                                 self.result)))
 

@@ -5,7 +5,9 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_verdicts as verdicts
+from BladeInspect.inspection import airfoil_values as values
 from tests.helpers import demo_nominal
 from tests.test_airfoil_pipeline import QUIET_SIGMA, Readings, _noisy, _stage
 
@@ -16,18 +18,18 @@ class DecisionOfOneCharacteristic(unittest.TestCase):
         U = 2 * u
         t = stage_mod.Tolerance("max_thickness_mm", "all", -T, T)
         values = (T - 2 * U, T - U / 2, T + U / 2, T + 2 * U)
-        iso = [stage_mod._decision(v, u, t, "iso14253") for v in values]
+        iso = [verdicts.decision(v, u, t, "iso14253") for v in values]
         self.assertEqual([d["verdict"] for d in iso], ["pass", "not proven", "not proven",
                                                        "fail"])
         self.assertTrue(all(d["U"] == U and d["k"] == 2 and d["rule"] == "iso14253"
                             for d in iso))
         self.assertAlmostEqual(iso[0]["tur"], T / U)
-        simple = [stage_mod._decision(v, u, t, "simple")["verdict"] for v in values]
+        simple = [verdicts.decision(v, u, t, "simple")["verdict"] for v in values]
         self.assertEqual(simple, ["pass", "pass", "fail", "fail"])
 
     def test_without_a_stated_u_the_rule_used_is_named(self):
         t = stage_mod.Tolerance("chord_mm", "all", None, 0.01)
-        d = stage_mod._decision(0.0099, None, t, "iso14253")
+        d = verdicts.decision(0.0099, None, t, "iso14253")
         self.assertEqual((d["verdict"], d["rule"], d["U"]), ("pass", "simple", None))
 
 
@@ -44,10 +46,10 @@ class StageDecisions(unittest.TestCase):
 
     def _judged(self, key, upper_from_dev):
         block = dict(self.stage.blocks[0])
-        dev = stage_mod._flat(block["deviation"])[key]
-        u = stage_mod._flat(block["uncertainty"])[key]
+        dev = values.flat(block["deviation"])[key]
+        u = values.flat(block["uncertainty"])[key]
         t = stage_mod.Tolerance(key, "all", None, upper_from_dev(dev, 2 * u))
-        failed, unproven = stage_mod._judge(block, [t], True, "iso14253")
+        failed, unproven = verdicts.judge(block, [t], True, "iso14253")
         return block, failed, unproven
 
     def test_verdicts_from_the_stated_u(self):
@@ -63,8 +65,8 @@ class StageDecisions(unittest.TestCase):
 
     def test_a_not_proven_characteristic_leaves_the_part_not_proven(self):
         key = "max_thickness_mm"
-        dev = stage_mod._flat(self.stage.blocks[0]["deviation"])[key]
-        u = stage_mod._flat(self.stage.blocks[0]["uncertainty"])[key]
+        dev = values.flat(self.stage.blocks[0]["deviation"])[key]
+        u = values.flat(self.stage.blocks[0]["uncertainty"])[key]
         opts = stage_mod.Options(draws=4, tolerances=[
             stage_mod.Tolerance(key, "1", None, dev + u)])
         verdict = {"pass": True, "verdict": "pass", "summary": "PASS: within +-0.040 mm",
@@ -115,7 +117,7 @@ class FitSensitivityRows(unittest.TestCase):
 
 class FailedDrawsAreNotScatter(unittest.TestCase):
     def test_a_failed_draw_is_left_out_and_normal_scatter_kept_whole(self):
-        from BladeInspect.inspection.airfoil import _draws_sd
+        from BladeInspect.inspection.airfoil_uncertainty import _draws_sd
         rng = np.random.default_rng(15)
         for _ in range(20):
             draws = rng.normal(1.0, 0.003, 12)

@@ -1,5 +1,5 @@
 """The airfoil characteristics see a defect the robust fit rejected, and not the isolated
-readings it rejected (inspection.airfoil.measured_surface).
+readings it rejected (inspection.airfoil_stage.measured_surface).
 
 A quiet sensor reads the demo blade's planned sections in the rig's true pose, with a 30 um
 bump on the suction side at the first section and a few isolated gross readings of +0.2 mm.
@@ -13,7 +13,7 @@ import unittest
 
 import numpy as np
 
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
 from BladeInspect.rig.sensor import SensorModel

@@ -1,7 +1,7 @@
-"""The airfoil draws' sensor noise (inspection.airfoil._point_noise_model) against the
+"""The airfoil draws' sensor noise (inspection.airfoil_uncertainty.point_noise_model) against the
 simulated sensor's own readings (rig.sensor.SensorModel.read): a reading errs along its beam
 by sigma_beam(SNR), so the draws lay it there, not along the profile's normal. And the draws'
-base (inspection.airfoil.beam_feet): each reading's beam where it meets a profile, against the
+base (inspection.airfoil_uncertainty.beam_feet): each reading's beam where it meets a profile, against the
 line-circle intersection in closed form."""
 import dataclasses
 import unittest
@@ -9,7 +9,8 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import airfoil as kernel
-from BladeInspect.inspection import airfoil
+from BladeInspect.inspection import airfoil_measure as measure_mod
+from BladeInspect.inspection import airfoil_uncertainty as draws_mod
 from BladeInspect.rig.sensor import SensorModel
 from tests import inspection_fixtures as fx
 from tests.test_worst_uncertainty import head_on_readings
@@ -27,7 +28,7 @@ class DrawNoiseAlongTheBeam(unittest.TestCase):
         result = dataclasses.replace(
             fx.make_result(nominal, on, columns={"angle_deg": angles[pick]}), snr=snr)
         idx = np.arange(0, len(on), 60)
-        sigma, spread, along, unit = airfoil._point_noise_model(result, idx, sensor, 0.003,
+        sigma, spread, along, unit = draws_mod.point_noise_model(result, idx, sensor, 0.003,
                                                                 normal[idx])
         np.testing.assert_allclose(along, beams[pick][idx], atol=1e-9)
         rng = np.random.default_rng(3)
@@ -88,7 +89,7 @@ class DrawsBaseAlongTheBeam(unittest.TestCase):
             rng = np.random.default_rng(seed)
             true, read, beams = readings_on_circle(rng, 300, 0.02)
             _, closest = profile.closest(read)
-            feet = airfoil.beam_feet(profile, read, closest, beams, np.full(300, 1.0))
+            feet = draws_mod.beam_feet(profile, read, closest, beams, np.full(300, 1.0))
             with self.subTest(seed=seed):
                 np.testing.assert_allclose(feet, line_circle_hit(read, beams), atol=2e-7)
                 np.testing.assert_allclose(feet, true, atol=2e-7)
@@ -97,11 +98,11 @@ class DrawsBaseAlongTheBeam(unittest.TestCase):
         profile = circle_profile()
         true, read, beams = readings_on_circle(np.random.default_rng(7), 50, 0.02)
         _, closest = profile.closest(read)
-        feet = airfoil.beam_feet(profile, read, closest, beams, np.full(50, 1e-9))
+        feet = draws_mod.beam_feet(profile, read, closest, beams, np.full(50, 1e-9))
         np.testing.assert_array_equal(feet, closest)
         # a beam along the tangent never meets the circle near the point
         tangent = np.column_stack([-read[:, 1], read[:, 0]]) / RADIUS
-        feet = airfoil.beam_feet(profile, read, closest, tangent, np.full(50, 0.05))
+        feet = draws_mod.beam_feet(profile, read, closest, tangent, np.full(50, 0.05))
         np.testing.assert_allclose(feet, closest, atol=1e-12)
 
     def test_the_scans_noise_along_the_surface_is_taken_out(self):
@@ -116,7 +117,7 @@ class DrawsBaseAlongTheBeam(unittest.TestCase):
         read = true + rng.uniform(-0.006, 0.006, len(a))[:, None] * beams
         smooth = kernel.Profile(read, 0.006 / np.sqrt(3.0))     # sigma_beam: >= the normal noise
         _, closest = smooth.closest(read)
-        feet = airfoil.beam_feet(smooth, read, closest, beams, np.full(len(a), 0.1))
+        feet = draws_mod.beam_feet(smooth, read, closest, beams, np.full(len(a), 0.1))
 
         def white_along_surface(points):
             e = RADIUS * np.angle(np.exp(1j * (np.arctan2(points[:, 1], points[:, 0]) - a)))
@@ -144,12 +145,12 @@ class BeamsCarriedIntoThePlane(unittest.TestCase):
             x0 = frame.to_3d(rng.uniform(-5, 5, (n, 2))) + 0.01 * rng.standard_normal((n, 1)) \
                 * frame.normal
             eps = 1e-3
-            moved = frame.to_2d(airfoil._into_plane(x0 + eps * beams, surface, frame.origin,
+            moved = frame.to_2d(measure_mod.into_plane(x0 + eps * beams, surface, frame.origin,
                                                     frame.normal))
-            still = frame.to_2d(airfoil._into_plane(x0, surface, frame.origin, frame.normal))
+            still = frame.to_2d(measure_mod.into_plane(x0, surface, frame.origin, frame.normal))
             with self.subTest(plane_normal=normal):
                 np.testing.assert_allclose(moved - still,
-                                           eps * airfoil._beams_in_plane(beams, surface, frame),
+                                           eps * draws_mod._beams_in_plane(beams, surface, frame),
                                            atol=1e-12)
 
 

@@ -14,7 +14,7 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import airfoil as kernel
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
 from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of

@@ -7,7 +7,7 @@ import unittest
 import numpy as np
 
 from BladeInspect.cad import rotor67 as r67
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
 from tests.helpers import ROTOR67_SECTIONS
 from tests.test_rotor67_loop import rotor67_nominal
 

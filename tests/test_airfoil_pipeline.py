@@ -1,4 +1,4 @@
-"""The airfoil characteristics stage (inspection/airfoil.py, issue 15) on the demo blade, against
+"""The airfoil characteristics stage (inspection/airfoil_stage.py, issue 15) on the demo blade, against
 truths made independently of the kernel: readings simulated on the CAD's own section points
 (OCC's cut, exact on the CAD and the plane), a part made as the CAD offset outward, one section
 turned or shifted by a known amount, and OCC's centre of mass of a section face."""
@@ -14,7 +14,8 @@ import numpy as np
 
 from BladeInspect.core import stats
 from BladeInspect.core import transforms as tf
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_values as values
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.inspection.result import RegistrationResult
 from BladeInspect.measurement.planning import nominal_section
@@ -128,7 +129,7 @@ class PerfectPart(unittest.TestCase):
 
     def test_what_the_kernel_reaches_on_noisy_points(self):
         for b in self.stage.blocks:
-            d = stage_mod._flat(b["deviation"])
+            d = values.flat(b["deviation"])
             for name, limit in KERNEL_LIMITS.items():
                 self.assertLess(abs(d[name]), limit, "%s %s" % (b["label"], name))
 

@@ -12,7 +12,9 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import airfoil
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_values as values
+from BladeInspect.inspection import airfoil_measure as measure_mod
 from tests.airfoil_shapes import ArcSection
 
 SIGMA, SPACING = 0.002, 0.02
@@ -58,7 +60,7 @@ class SharpTrailingEdge(unittest.TestCase):
         cls.measured = []
         for _ in range(3):
             noisy = cls.pts + rng.normal(0.0, SIGMA, len(cls.pts))[:, None] * normal
-            cls.measured.append(stage_mod._measure(noisy, cls.nominal, stage_mod.Options(draws=0),
+            cls.measured.append(measure_mod.measure(noisy, cls.nominal, stage_mod.Options(draws=0),
                                                    SIGMA, cls.nominal.le_point)[0])
 
     def test_the_nominal_says_its_te_is_a_corner(self):
@@ -70,7 +72,7 @@ class SharpTrailingEdge(unittest.TestCase):
             self.assertIsNone(ch.outlet_angle_deg)
             self.assertIsNone(ch.te_radius_mm)
             self.assertTrue(any("TE" in w and "not measurable" in w for w in ch.warnings))
-            block = stage_mod._flat(stage_mod._char_values(ch, _PlaneFrame()))
+            block = values.flat(values.char_values(ch, _PlaneFrame()))
             self.assertNotIn("outlet_angle_deg", block)
             self.assertNotIn("te_radius_mm", block)
 

@@ -1,4 +1,4 @@
-"""inspection.airfoil.nominal_characteristics remembers a nominal cut's characteristics (a batch
+"""inspection.airfoil_stage.nominal_characteristics remembers a nominal cut's characteristics (a batch
 worker's next blade, issue 15's "five sections in under 1 s") against independent truth: a
 profile of exact circular arcs (tests/airfoil_shapes.ArcSection), its edge radii in closed
 form, read afresh and from the memory; the same cut scaled by 2 (radii doubled, so not served
@@ -14,7 +14,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from airfoil_shapes import ArcSection  # noqa: E402
 
-from BladeInspect.inspection import airfoil as stage  # noqa: E402
+from BladeInspect.inspection import airfoil_stage as stage  # noqa: E402
 
 UM = 1e-3
 

@@ -4,7 +4,8 @@ a fresh cut of the CAD, to the bit."""
 import dataclasses
 import unittest
 
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_values as values
 from tests.helpers import demo_nominal
 from tests.test_airfoil_pipeline import Readings, _noisy, _stage
 
@@ -20,8 +21,8 @@ class NominalCutReused(unittest.TestCase):
                                               for p in planes],
                                     stage_mod.Options(draws=0), result, table.span_axis)
         for a, b in zip(stage.blocks, fresh.blocks):
-            self.assertEqual(stage_mod._flat(a["nominal"]), stage_mod._flat(b["nominal"]))
-            self.assertEqual(stage_mod._flat(a["measured"]), stage_mod._flat(b["measured"]))
+            self.assertEqual(values.flat(a["nominal"]), values.flat(b["nominal"]))
+            self.assertEqual(values.flat(a["measured"]), values.flat(b["measured"]))
 
 
 if __name__ == "__main__":

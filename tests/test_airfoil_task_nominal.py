@@ -1,11 +1,11 @@
-"""The nominal cuts kept in an uncertainty task file (inspection/airfoil_task_u.py,
+"""The nominal cuts kept in an uncertainty task file (inspection/airfoil_task.py,
 core.airfoil.characteristics_state): a later blade of the task reads the nominal
 characteristics back instead of computing them, and gets every value, nominal and measured,
 to the bit of a run that computed them; a kept cut is used only for the very points and
 arguments it was computed from; a file whose kept cuts were changed is refused.
 
 The truth is a fresh computation of the same cut in a process that has remembered nothing
-(inspection.airfoil.clear_nominal_cache) and a JSON round trip through text, on shapes with
+(inspection.airfoil_stage.clear_nominal_cache) and a JSON round trip through text, on shapes with
 the awkward values a state must carry: a corner edge's withheld radius (None), a thickness
 station off the profile (NaN), a profile's tuples and circles."""
 import dataclasses
@@ -20,8 +20,8 @@ import numpy as np
 
 from BladeInspect.core import airfoil as kernel
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspection import airfoil as stage_mod
-from BladeInspect.inspection import airfoil_task_u as task_u
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_task as task_u
 from tests.airfoil_shapes import ArcSection, NacaSection
 from tests.helpers import demo_nominal
 from tests.test_airfoil_task_u import _measurement, _readings, _run

@@ -1,4 +1,4 @@
-"""Task-specific uncertainty of the airfoil characteristics (inspection/airfoil_task_u.py): a
+"""Task-specific uncertainty of the airfoil characteristics (inspection/airfoil_task.py): a
 second blade of the same task reuses the first one's stored re-fit draws and gets the u a fresh
 re-fit of its own points gives (within the two estimates' statistical spread); a measurement
 outside the task's conditions, another task, a corrupt file are never reused silently; the
@@ -18,8 +18,10 @@ from unittest import mock
 import numpy as np
 
 from BladeInspect.core.errors import InputError
-from BladeInspect.inspection import airfoil as stage_mod
-from BladeInspect.inspection import airfoil_task_u as task_u
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_values as values
+from BladeInspect.inspection import airfoil_measure as measure_mod
+from BladeInspect.inspection import airfoil_task as task_u
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement.planning import nominal_section
 from tests.helpers import demo_nominal
@@ -34,11 +36,11 @@ FEW_DRAWS = 2        # a re-fit whose value is not looked at, only that it happe
 
 
 class Counter:
-    """Counts the kernel runs of the stage (inspection.airfoil._measure)."""
+    """Counts the kernel runs of the stage (inspection.airfoil_measure.measure)."""
 
     def __init__(self):
         self.calls = 0
-        self.real = stage_mod._measure
+        self.real = measure_mod.measure
 
     def __call__(self, *a, **k):
         self.calls += 1
@@ -74,7 +76,7 @@ def _run(nominal, measurement, opts, planes=None, first=False):
     if first:
         planes = stage_mod.planes_of_table(table)[:1]
     counter = Counter()
-    with mock.patch.object(stage_mod, "_measure", counter):
+    with mock.patch.object(measure_mod, "measure", counter):
         stage = stage_mod.run_stage(nominal, planes or stage_mod.planes_of_table(table), opts,
                                     result, table.span_axis)
     return stage, counter.calls
@@ -117,8 +119,8 @@ class TaskFile(unittest.TestCase):
         for reused, fresh in zip(self.reused.blocks, self.fresh.blocks):
             self.assertEqual(reused["uncertainty_method"], "task-specific")
             self.assertEqual(fresh.get("uncertainty_method"), None)
-            ur, uf = (stage_mod._flat(reused["uncertainty"]),
-                      stage_mod._flat(fresh["uncertainty"]))
+            ur, uf = (values.flat(reused["uncertainty"]),
+                      values.flat(fresh["uncertainty"]))
             self.assertEqual(set(ur), set(uf))
             for key in uf:
                 if uf[key] < 1e-12 and ur[key] < 1e-12:    # the plane's own coordinate
@@ -138,7 +140,7 @@ class TaskFile(unittest.TestCase):
                             stage_mod.Options(task_uncertainty=self.path))
         self.assertEqual(calls, 2)
         for made, reused in zip(self.made.blocks, again.blocks):
-            um, ur = stage_mod._flat(made["uncertainty"]), stage_mod._flat(reused["uncertainty"])
+            um, ur = values.flat(made["uncertainty"]), values.flat(reused["uncertainty"])
             for key in um:
                 self.assertAlmostEqual(ur[key], um[key], delta=1e-12 + 1e-9 * um[key], msg=key)
         # the bias differs between the blades (B has a bump): it is not stored with the draws

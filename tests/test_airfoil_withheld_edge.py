@@ -15,7 +15,10 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import airfoil
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_verdicts as verdicts
+from BladeInspect.inspection import airfoil_values as values
+from BladeInspect.inspection import airfoil_measure as measure_mod
 from tests.test_airfoil_sharp_edge import SIGMA, sharp_te_section
 
 EDGE_GREEN = "#2ca02c"   # inspection.airfoil_report's colour of the edge circles
@@ -28,7 +31,7 @@ def _measured_sharp_section():
     normal = prof.outward_normal(prof.point_params)
     rng = np.random.default_rng(20261203)
     noisy = pts + rng.normal(0.0, SIGMA, len(pts))[:, None] * normal
-    measured = stage_mod._measure(noisy, nominal, stage_mod.Options(draws=0), SIGMA,
+    measured = measure_mod.measure(noisy, nominal, stage_mod.Options(draws=0), SIGMA,
                                   nominal.le_point)[0]
     return nominal, measured, sec, corner
 
@@ -82,8 +85,8 @@ class WithheldEdgeHasNoCircle(unittest.TestCase):
 
     def _edge_lines(self, ch):
         from BladeInspect.inspection import airfoil_report
-        from BladeInspect.inspection.report import _mpl
-        plt, _, _ = _mpl()
+        from BladeInspect.inspection.report_table import mpl
+        plt, _, _ = mpl()
         section = types.SimpleNamespace(
             nominal=ch, points_2d=None,
             plane=types.SimpleNamespace(label="sharp", height_pct=50.0))
@@ -128,14 +131,14 @@ class WithheldEdgeJudged(unittest.TestCase):
         cls.nominal, cls.measured, _, _ = _measured_sharp_section()
         frame = types.SimpleNamespace(to_3d=lambda p: np.column_stack(
             [np.atleast_2d(p), np.zeros((len(np.atleast_2d(p)), 1))]))
-        cls.values = (stage_mod._char_values(cls.nominal, frame),
-                      stage_mod._char_values(cls.measured, frame))
+        cls.values = (values.char_values(cls.nominal, frame),
+                      values.char_values(cls.measured, frame))
 
     def _judge(self, drawing_nominal):
         block = {"label": "sharp", "nominal": dict(self.values[0]),
                  "measured": dict(self.values[1]), "uncertainty": None}
         row = stage_mod.Tolerance("te_radius_mm", "all", -0.01, 0.01, drawing_nominal, 2)
-        failed, _ = stage_mod._judge(block, [row], True, "simple")
+        failed, _ = verdicts.judge(block, [row], True, "simple")
         return block, failed
 
     def test_without_a_drawing_nominal_it_is_not_measured(self):
@@ -166,7 +169,7 @@ class WithheldEdgeJudged(unittest.TestCase):
         block = {"label": "sharp", "nominal": dict(self.values[0]), "measured": None,
                  "uncertainty": None}
         row = stage_mod.Tolerance("te_radius_mm", "all", -0.01, 0.01, None, 2)
-        failed, _ = stage_mod._judge(block, [row], False, "simple")
+        failed, _ = verdicts.judge(block, [row], False, "simple")
         self.assertEqual(block["verdicts"]["te_radius_mm"], "not judged")
         self.assertEqual(failed, [])
 

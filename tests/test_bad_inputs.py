@@ -247,7 +247,7 @@ class TestTimeLimit(unittest.TestCase):
 
     def test_icp_stops_at_its_time_limit(self):
         from BladeInspect.core import icp
-        from BladeInspect.inspection.pipeline import exact_closest_fn
+        from BladeInspect.inspection.closest_fn import exact_closest_fn
         from BladeInspect.inspection.simulate import simulate_measurement
         scan, truth, _, _ = simulate_measurement(demo_nominal(), n_points=300, seed=2,
                                                  section_heights=())

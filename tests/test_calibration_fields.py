@@ -159,7 +159,7 @@ class InTheAirfoilDraws(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        from BladeInspect.inspection import airfoil as stage_mod
+        from BladeInspect.inspection import airfoil_stage as stage_mod
         from BladeInspect.inspection import sections as sections_mod
         from BladeInspect.measurement.planning import nominal_section
         from tests.helpers import demo_nominal
@@ -221,18 +221,18 @@ class InTheAirfoilDraws(unittest.TestCase):
         self.assertGreater(min(stage.blocks[0]["uncertainty"]["shift_mm"]), 0.01)
 
     def test_the_task_key_holds_the_axis_only_when_given(self):
-        from BladeInspect.inspection import airfoil_task_u
-        plain = airfoil_task_u.task_key(self.nominal, self.stage_mod.Options(), self.result)
-        given = airfoil_task_u.task_key(
+        from BladeInspect.inspection import airfoil_task
+        plain = airfoil_task.task_key(self.nominal, self.stage_mod.Options(), self.result)
+        given = airfoil_task.task_key(
             self.nominal, self.stage_mod.Options(calibration_axis=self.AXIS), self.result)
         self.assertNotIn("calibration_axis", plain)
         self.assertEqual(given.pop("calibration_axis"), self.AXIS)
         self.assertEqual(given, plain)
         other = dict(self.AXIS, covariance=(2.0 * np.asarray(self.AXIS["covariance"])).tolist())
         self.assertNotEqual(
-            airfoil_task_u.digest(airfoil_task_u.task_key(
+            airfoil_task.digest(airfoil_task.task_key(
                 self.nominal, self.stage_mod.Options(calibration_axis=self.AXIS), self.result)),
-            airfoil_task_u.digest(airfoil_task_u.task_key(
+            airfoil_task.digest(airfoil_task.task_key(
                 self.nominal, self.stage_mod.Options(calibration_axis=other), self.result)))
 
 

@@ -6,7 +6,8 @@ columns and the fit-sensitivity rows. The unit is checked against the field name
 import types
 import unittest
 
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
+from BladeInspect.inspection import airfoil_values as values
 from BladeInspect.inspection import characteristic_names as names
 from BladeInspect.inspection import report
 from tests.helpers import demo_nominal
@@ -29,7 +30,7 @@ class AirfoilBlockNames(unittest.TestCase):
         planes = stage_mod.nominal_planes(nominal, [50.0])
         stage = stage_mod.run_stage(nominal, planes, stage_mod.Options(draws=0))
         cls.values = stage.sections[0].block["nominal"]
-        cls.keys = list(stage_mod._flat(cls.values))
+        cls.keys = list(values.flat(cls.values))
 
     def test_every_numeric_field_of_the_block_is_a_named_characteristic(self):
         for field, value in self.values.items():
@@ -72,7 +73,7 @@ class AirfoilBlockNames(unittest.TestCase):
 
 class SensitivityRows(unittest.TestCase):
     """fit_sensitivity's rows are named "section L worst deviation", "part worst deviation"
-    (inspection.fitting) and "section L key" (inspection.airfoil.add_to_sensitivity)."""
+    (inspection.fitting) and "section L key" (inspection.airfoil_verdicts.add_to_sensitivity)."""
 
     def test_rows_split_into_section_and_characteristic(self):
         for row, parts in (({"characteristic": "section 2 worst deviation"}, ("2", None)),
@@ -136,7 +137,7 @@ class VerdictLines(unittest.TestCase):
                          "PASS: within +-0.040 mm")
 
     def test_the_stage_writes_what_the_line_reads(self):
-        """inspection.airfoil.stage_verdict's entries and summary, as the stage writes
+        """inspection.airfoil_verdicts.stage_verdict's entries and summary, as the stage writes
         them, read back in display names."""
         verdict = stage_mod.stage_verdict(
             [types.SimpleNamespace(block={"verdicts": {"a": "fail", "b": "pass"}})],

@@ -14,7 +14,7 @@ from scipy.optimize import least_squares
 from BladeInspect.cad.airfoil_sections import airfoil_section
 from BladeInspect.cad.sections import cut
 from BladeInspect.core import airfoil as kernel
-from BladeInspect.inspection import airfoil as stage_mod
+from BladeInspect.inspection import airfoil_stage as stage_mod
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.measurement import planning
 from BladeInspect.rig.sensor import SensorModel

@@ -388,7 +388,7 @@ class DemoBlade(unittest.TestCase):
     linear programme."""
 
     def test_minimax_on_the_demo_blade(self):
-        from BladeInspect.inspection.pipeline import exact_closest_fn
+        from BladeInspect.inspection.closest_fn import exact_closest_fn
         nominal = demo_nominal()
         closest = exact_closest_fn(nominal)
         rng = np.random.default_rng(41)

@@ -27,6 +27,7 @@ class FullCloudStop(unittest.TestCase):
 
     def check_case(self, seed):
         from BladeInspect.inspection import pipeline
+        from BladeInspect.inspection.closest_fn import exact_closest_fn
         from BladeInspect.inspection.simulate import simulate_measurement
         rng = np.random.default_rng(seed)
         ps, truth, _, _ = simulate_measurement(
@@ -41,7 +42,7 @@ class FullCloudStop(unittest.TestCase):
         self.assertTrue(fit.converged)
         # Gauss-Newton from the fit's pose to a step below 1e-9 mm (a millionth of sigma):
         # the optimum near it, whichever way the fit got there.
-        optimum = icp.icp(ps.xyz, ps.snr, pipeline.exact_closest_fn(self.nominal),
+        optimum = icp.icp(ps.xyz, ps.snr, exact_closest_fn(self.nominal),
                           fit.transform, icp.ICPOptions(horn_iters=0, uncertainty_fraction=0.0,
                                                         trans_tol=1e-9, rot_tol=1e-11,
                                                         max_iter=20))

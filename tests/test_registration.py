@@ -6,6 +6,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.inspection import pipeline
+from BladeInspect.inspection.closest_fn import exact_closest_fn
 from BladeInspect.inspection.simulate import pose_error, simulate_measurement
 from tests.helpers import demo_nominal, least_squares_pose_bound, sensor_pose_bound
 
@@ -73,7 +74,7 @@ class TestRegistrationFromAnyPose(AbsoluteBound, unittest.TestCase):
         ps, truth, info, good = simulate_measurement(nominal, n_points=n, outlier_fraction=0.02,
                                                      seed=21, section_heights=())
         result = pipeline.register(nominal, ps, seed=21)
-        tight = icp.icp(ps.xyz, ps.snr, pipeline.exact_closest_fn(nominal),
+        tight = icp.icp(ps.xyz, ps.snr, exact_closest_fn(nominal),
                         result.measured_to_cad, icp.ICPOptions(horn_iters=0))
         self.assertTrue(tight.converged)
         moved = pose_error(result.measured_to_cad, tight.transform, nominal.bbox_corners)

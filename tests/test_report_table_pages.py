@@ -32,7 +32,8 @@ class TablePages(unittest.TestCase):
         if first_rect is not None:
             figs.append(plt.figure(figsize=report_table.PORTRAIT))
             first = (figs[0], first_rect)
-        figs += report_table.pdf_table_pages(plt, header, rows, 6.5, "Long table", first=first)
+        figs += report_table.pdf_table_pages(plt, header, rows, report_table.TableStyle(6.5),
+                                             "Long table", first=first)
         try:
             seen = []
             for fig in figs:

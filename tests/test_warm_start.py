@@ -122,6 +122,7 @@ class WarmStartDemoBlade(unittest.TestCase):
     def test_multi_resolution_fit_is_the_full_resolution_fit(self):
         from BladeInspect.core import icp
         from BladeInspect.inspection import pipeline
+        from BladeInspect.inspection.closest_fn import exact_closest_fn
         from BladeInspect.inspection.simulate import pose_error, simulate_measurement
         n = pipeline.FINE_SUBSAMPLE + 10000
         ps, truth, _, good = simulate_measurement(self.nominal, n_points=n, seed=8,
@@ -131,7 +132,7 @@ class WarmStartDemoBlade(unittest.TestCase):
         levels = pipeline.fine_register(ps.xyz, ps.snr, self.nominal, start,
                                         rng=np.random.default_rng(10))
         # One level, every point, cold exact distances, iterated to the tight tolerances.
-        single = icp.icp(ps.xyz, ps.snr, pipeline.exact_closest_fn(self.nominal), start,
+        single = icp.icp(ps.xyz, ps.snr, exact_closest_fn(self.nominal), start,
                          icp.ICPOptions(uncertainty_fraction=0.0, max_iter=100))
         self.assertTrue(single.converged)
         bound = icp.pose_uncertainty(single.covariance, single.center,

@@ -234,7 +234,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
     command's default and its --no-airfoil); the points, registration, deviation map, section
     profiles and airfoil objects added. Returns run_inspect's summary with the new objects
     under "objects"."""
-    from ..inspection import airfoil as airfoil_mod
+    from ..inspection import airfoil_stage as airfoil_mod
     from ..inspection.closed_loop import run_inspect
     from . import airfoil_objects, loop
     airfoil_options = airfoil_mod.options_from_args() if airfoil else None
@@ -281,7 +281,7 @@ def airfoil(doc_name, registration, characteristics=None, chord_method=None,
     ``registration`` at its section table's planes, and the nominal and measured mean camber
     lines and edge circles of each section as document objects (app.airfoil_objects).
     Returns the stage (its ``blocks`` are result.json's ``airfoil``)."""
-    from ..inspection import airfoil as airfoil_mod
+    from ..inspection import airfoil_stage as airfoil_mod
     from . import airfoil_objects
     doc, reg = _registration(doc_name, registration)
     opts = airfoil_mod.options_from_args(engine_axis=engine_axis,

@@ -16,7 +16,7 @@ import FreeCAD
 
 from ..core.contracts import json_default
 from ..core.errors import InputError
-from ..inspection import airfoil as airfoil_mod
+from ..inspection import airfoil_stage as airfoil_mod
 from . import objects
 from .objects.base import (READ_ONLY, Proxy, add_property, add_table, building, finish,
                            shape_signature, signature)

@@ -9,7 +9,7 @@ tests/gui_airfoil_macro.py, where the unit and verdict columns wrap to leave the
 header its width: NamedRowsTable)."""
 from PySide import QtCore, QtGui
 
-from ..inspection import airfoil as airfoil_mod
+from ..inspection import airfoil_stage as airfoil_mod
 from ..inspection import characteristic_names as names
 from .i18n import QT_TRANSLATE_NOOP, translate
 

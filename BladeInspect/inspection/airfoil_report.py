@@ -1,15 +1,15 @@
 """The report's airfoil pages (issue 15): per section a characteristics table (nominal, actual,
 deviation, +-u, tolerance, verdict) and a figure of the profile with its mean camber line, a
 few inscribed circles, the LE/TE circles and the chord line; then shift and twist along the
-span. Drawn from the stage inspection.airfoil attached to the section table."""
+span. Drawn from the stage inspection.airfoil_stage attached to the section table."""
 
 import html
 
 import numpy as np
 
-from . import airfoil as stage_mod
+from . import airfoil_values as values
 from . import characteristic_names
-from .report_table import pdf_table
+from .report_table import TableStyle, html_table, img_tag, mpl, pdf_table, png_bytes
 
 # Inscribed circles drawn per profile besides the largest one.
 N_CIRCLES = 5
@@ -28,10 +28,10 @@ def characteristics_rows(block):
     """One row per characteristic of one section block, by its display name and unit."""
     if block["nominal"] is None:
         return []
-    nom = stage_mod._flat(block["nominal"])
-    mea = stage_mod._flat(block["measured"]) if block["measured"] else {}
-    dev = stage_mod._flat(block["deviation"]) if block.get("deviation") else {}
-    unc = stage_mod._flat(block["uncertainty"]) if block.get("uncertainty") else {}
+    nom = values.flat(block["nominal"])
+    mea = values.flat(block["measured"]) if block["measured"] else {}
+    dev = values.flat(block["deviation"]) if block.get("deviation") else {}
+    unc = values.flat(block["uncertainty"]) if block.get("uncertainty") else {}
     rows = []
     for key in list(nom) + [k for k in block["verdicts"] if k not in nom]:   # as csv_rows
         t = block["tolerance"].get(key)
@@ -55,8 +55,7 @@ def _circle(ax, centre, radius, **style):
 def figure_profile(section):
     """The nominal profile in its plane frame (x along the engine axis), the measured points
     when there are any, the camber line, inscribed circles, edge circles and the chord."""
-    from .report import _mpl
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     ch = section.nominal
     loop = np.vstack([ch.profile.dense, ch.profile.dense[:1]])
     # the figure takes the profile's proportions, so equal axes leave no empty band
@@ -94,8 +93,7 @@ def figure_profile(section):
 
 def figure_span(stage):
     """Shift (both components, um) and twist (mdeg) of each measured section along the span."""
-    from .report import _mpl
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     measured = [s for s in stage.sections if s.fit is not None]
     h = [s.plane.height_pct for s in measured]
     shift = np.array([s.fit.shift_mm for s in measured]).reshape(-1, 2) * 1000.0
@@ -129,8 +127,7 @@ def add_pages(pdf, parts, table):
     stage = getattr(table, "airfoil", None)
     if stage is None:
         return 0
-    from .report import _html_table, _img, _mpl, _png
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     pages = 0
     parts += ["<h2>Airfoil characteristics</h2>",
               "<p>%s</p>" % html.escape(characteristic_names.airfoil_verdict_text(
@@ -151,26 +148,27 @@ def add_pages(pdf, parts, table):
         parts += ["<h3>Section %s (%.1f %% span): %s</h3>"
                   % (html.escape(block["label"]), block["height_pct"],
                      html.escape(block.get("verdict", "-"))),
-                  _html_table(TABLE_HEADER, rows)]
+                  html_table(TABLE_HEADER, rows)]
         parts += ["<p class='note'>%s</p>" % html.escape(n) for n in block.get("notes", [])]
         if section.nominal is None:
             continue
         fig = plt.figure(figsize=(8.27, 11.69))
         pdf_table(fig, [0.04, 0.04, 0.92, 0.9], TABLE_HEADER,
-                  rows or [["-"] * len(TABLE_HEADER)], 6.5, col_widths=TABLE_WIDTHS,
+                  rows or [["-"] * len(TABLE_HEADER)],
+                  TableStyle(6.5, title_size=10, loc="upper center", col_widths=TABLE_WIDTHS),
                   title="Airfoil characteristics, section %s (%.1f %% span): %s"
-                  % (block["label"], block["height_pct"], block.get("verdict", "-")),
-                  title_size=10, loc="upper center")
+                  % (block["label"], block["height_pct"], block.get("verdict", "-")))
         pdf.savefig(fig)
         plt.close(fig)
         fig = figure_profile(section)
-        parts.append(_img(_png(fig), "section %s airfoil" % block["label"]))
+        parts.append(img_tag(png_bytes(fig), "section %s airfoil" % block["label"]))
         pdf.savefig(fig)
         plt.close(fig)
         pages += 2
     if stage.lean_bow is not None:
         fig = figure_span(stage)
-        parts += ["<h3>Shift and twist along the span</h3>", _img(_png(fig), "shift and twist")]
+        parts += ["<h3>Shift and twist along the span</h3>",
+                  img_tag(png_bytes(fig), "shift and twist")]
         pdf.savefig(fig)
         plt.close(fig)
         pages += 1

@@ -32,7 +32,7 @@ import time
 from ..core.atomic_file import atomic_write
 from ..core.contracts import BUILTIN_CADS, PROFILE_TOLERANCE_MM
 from ..core.errors import InputError
-from . import airfoil as airfoil_mod
+from . import airfoil_stage as airfoil_mod
 from .pipeline import load_nominal
 from .report import run_report
 

@@ -43,7 +43,7 @@ from ..measurement import scan as scan_mod
 from ..measurement.complete import check_step, plan_complete, scan_complete
 from ..measurement.planning import DEFAULT_EDGE_RADIUS_SIGMA_MM, edge_radius_sigma, plan_sections
 from ..rig.kinematics import RigKinematics
-from . import airfoil as airfoil_mod
+from . import airfoil_stage as airfoil_mod
 from . import pipeline
 from . import sections as sections_mod
 from . import weighting

@@ -5,7 +5,7 @@ import html
 
 from ..core import decision as decision_mod
 from . import characteristic_names, fitting
-from .report_table import PORTRAIT, pdf_table_pages, rows_that_fit
+from .report_table import PORTRAIT, TableStyle, pdf_table_pages, rows_that_fit
 
 VERDICT_WORD = {decision_mod.PASS: "PASS", decision_mod.NOT_PROVEN: "NOT PROVEN",
                 decision_mod.FAIL: "FAIL"}
@@ -124,12 +124,12 @@ def pdf_pages(plt, result, verdict):
     rect = [0.06, bottom, 0.88, max(0.05, y - bottom - 0.02)]
     pages = [fig]
     if rows:
-        pages += pdf_table_pages(plt, header, rows, 7, None, first=(fig, rect))
+        pages += pdf_table_pages(plt, header, rows, TableStyle(7), None, first=(fig, rect))
     if sensitivity:
         header, rows = sensitivity
         # the names (about 35 characters) a third of the width, the objectives share the rest
         n_fits = len(header) - 3
-        options = dict(col_widths=[0.32, 0.06] + [0.54 / n_fits] * n_fits + [0.08])
+        style = TableStyle(6.5, col_widths=[0.32, 0.06] + [0.54 / n_fits] * n_fits + [0.08])
         lower = [0.06, 0.05, 0.88, 0.4]
         # on the first page when it all fits there, else on pages of its own
         first = (pages[-1], lower) if len(pages) == 1 and \
@@ -139,5 +139,5 @@ def pdf_pages(plt, result, verdict):
                      "its size)")
         else:
             title = "Fit sensitivity"
-        pages += pdf_table_pages(plt, header, rows, 6.5, title, first=first, **options)
+        pages += pdf_table_pages(plt, header, rows, style, title, first=first)
     return pages

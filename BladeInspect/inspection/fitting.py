@@ -26,6 +26,7 @@ from ..core import stats as stats_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 from . import characteristic_names
+from .closest_fn import exact_closest_fn
 from . import sections as sections_mod
 from . import weighting
 
@@ -158,7 +159,7 @@ def zones_of(result, nominal, edge_fraction=sections_mod.EDGE_FRACTION):
             polylines = cut(nominal.shape, origin, axis)
         except InputError:
             continue
-        profile = sections_mod._build_profile(nominal, polylines, axis, foot[sel], origin)
+        profile = sections_mod.build_profile(nominal, polylines, axis, foot[sel], origin)
         labels[sel] = sections_mod.classify(profile, foot[sel], edge_fraction)
     return labels
 
@@ -270,7 +271,6 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
     """Move ``result`` (in place) to the pose of the chosen fit and record it in result.fit;
     with ``all_objectives`` also fit every other objective from the same start, for
     sensitivity(). Returns the FitRuns."""
-    from .pipeline import exact_closest_fn
     choice = choice or FitChoice()
     progress = progress or (lambda f, m: None)
     free = free_of(choice, nominal)
@@ -424,7 +424,7 @@ def report_rows(sensitivity_doc):
     header = ["Characteristic", "Unit"] + ["%s (verdict)" % o for o in objectives] + ["Change"]
     rows = []
     for row in sensitivity_doc["rows"]:
-        # airfoil rows (inspection.airfoil.add_to_sensitivity) carry value and unit
+        # airfoil rows (inspection.airfoil_verdicts.add_to_sensitivity) carry value and unit
         _, key = names.sensitivity_row_parts(row)
         unit = names.unit(key) if key else "mm"
         value = [row["by_fit"][o].get("value_mm", row["by_fit"][o].get("value"))

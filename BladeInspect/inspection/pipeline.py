@@ -336,13 +336,6 @@ def _search_steps(axes):
 
 # ---------------------------------------------------------------- fine
 
-def exact_closest_fn(nominal):
-    def closest(points):
-        res = nominal.signed_distance(points)
-        return res.closest, res.normal, res.distance
-    return closest
-
-
 class TrackedDistance:
     """An ICP closest_fn over one fixed set of points (rows in the same order at every call):
     each call is warm-started from the previous one (core.closest.FootStart), which saves

@@ -10,10 +10,8 @@ Figures are drawn once with matplotlib's Agg backend and saved to both files, so
 the PDF cannot disagree. ``run_report`` is the whole `report` command.
 """
 
-import base64
 import datetime
 import html
-import io
 import os
 import time
 
@@ -21,7 +19,7 @@ import numpy as np
 
 from ..core import colourmap, contracts
 from ..core import stats as stats_mod
-from . import airfoil as airfoil_mod
+from . import airfoil_stage as airfoil_mod
 from . import airfoil_report
 from . import characteristic_names
 from . import pipeline
@@ -30,29 +28,20 @@ from . import fit_report
 from . import judging
 from . import verdict as verdict_mod
 from .checks import check_out_dir
-from .report_table import pdf_table
+from .report_table import TableStyle, html_table, img_tag, mpl, pdf_table, png_bytes
 from .result import rival_lines
 
 # Enough points for a faithful picture; more only costs time and PDF size.
 MAX_VIEW_POINTS = 120000
 MAX_WHISKERS = 1500
-DPI = 110
 PDF_DPI = 150
 
 PAGE_TITLES = ("Summary", "Decision rule, uncertainty and fit", "Deviation map",
                "Deviation histogram (Table 3)", "Section profile errors (Table 2)")
 
 
-def _mpl():
-    import matplotlib
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import ListedColormap, Normalize
-    return plt, ListedColormap, Normalize
-
-
 def _cmap_and_norm(limit):
-    _, ListedColormap, Normalize = _mpl()
+    _, ListedColormap, Normalize = mpl()
     return ListedColormap(colourmap.colourmap_table(), name="bladeinspect"), \
         Normalize(-limit, limit)
 
@@ -134,7 +123,7 @@ def raster_view(xyz, colours, right, up, toward_viewer, px_per_mm, splat=1):
 
 def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
     """Three orthographic views of the points coloured by deviation, with the colour legend."""
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     xyz = result.points_cad
     dev = result.deviation
     if len(xyz) > max_points:
@@ -167,7 +156,7 @@ def figure_views(result, table, limit, max_points=MAX_VIEW_POINTS, seed=0):
 def figure_histogram(result, band_edges):
     """Histogram of the deviations with mean +-sigma and +-3 sigma (Fig. 12) and the tolerance
     bands' edges (tolerance_histogram)."""
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     dev = result.deviation
     stats = result.deviation_stats
     mean, sigma = stats["mean"], stats["std"]
@@ -218,7 +207,7 @@ def figure_section(sec, result, tolerance, magnification=None, max_whiskers=MAX_
     """Nominal profile with each point's deviation drawn from its closest CAD point along the
     outward normal, magnified (Figs 9-10); the tolerance band at the same magnification; CMM
     points, when given, as black whiskers with round ends."""
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     from matplotlib.collections import LineCollection
     chord = sec.profile.chord if sec.profile is not None else 50.0
     if magnification is None:
@@ -380,27 +369,6 @@ img{max-width:100%} .note{color:#555;font-size:0.9em}
 """
 
 
-def _html_table(header, rows):
-    out = ["<table>"]
-    if header:
-        out.append("<tr>" + "".join("<th>%s</th>" % html.escape(h) for h in header) + "</tr>")
-    for row in rows:
-        out.append("<tr>" + "".join("<td>%s</td>" % html.escape(str(c)) for c in row) + "</tr>")
-    out.append("</table>")
-    return "\n".join(out)
-
-
-def _png(fig):
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
-    return buf.getvalue()
-
-
-def _img(png, alt):
-    return '<img alt="%s" src="data:image/png;base64,%s">' % (
-        html.escape(alt), base64.b64encode(png).decode("ascii"))
-
-
 def _verdict_lines(verdict, table):
     stage = getattr(table, "airfoil", None)
     lines = [characteristic_names.part_summary_text(   # the airfoil clause in display names
@@ -415,7 +383,7 @@ def _verdict_lines(verdict, table):
                                                  None: "not measured"}[s["pass"]])
         if s.get("worst_deviation_mm") is not None:
             text += ", worst %+.4f mm at the %s" % (s["worst_deviation_mm"],
-                                                    verdict_mod._ZONE_TEXT[s["worst_zone"] or ""])
+                                                    verdict_mod.ZONE_TEXT[s["worst_zone"] or ""])
         if "cmm_pass" in s:
             text += "; CMM %s" % ("pass" if s["cmm_pass"] else "FAIL")
         lines.append(text)
@@ -433,7 +401,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         with pipeline.AtomicOutput(out_dir) as out:
             return write_report(out_dir, result, nominal, sections, verdict, tolerance,
                                 output=out, magnification=magnification, title=title)
-    plt, _, _ = _mpl()
+    plt, _, _ = mpl()
     from matplotlib.backends.backend_pdf import PdfPages
     table = sections
     tolerance = float(tolerance)
@@ -455,8 +423,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
                  "pass" if verdict["pass"] else "fail", fit_report.verdict_word(verdict),
                  tolerance),
              "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in verdict_lines) + "</ul>",
-             "<h2>Pose and its uncertainty</h2>", _html_table(["Quantity", "Value"], p_rows)]
-    parts += fit_report.html_parts(result, verdict, _html_table)   # hook: issue 16
+             "<h2>Pose and its uncertainty</h2>", html_table(["Quantity", "Value"], p_rows)]
+    parts += fit_report.html_parts(result, verdict, html_table)   # hook: issue 16
     for w in list(result.warnings) + list(table.warnings):
         parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
 
@@ -475,8 +443,8 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
             fig.text(0.06, y, line, fontsize=8, wrap=True)
             y -= 0.018
         pdf_table(fig, [0.06, 0.05, 0.88, max(0.1, y - 0.1)], ["Quantity", "Value"], p_rows,
-                  7.5, title="Pose and its uncertainty", cell_loc="left",
-                  col_widths=[0.45, 0.55])
+                  TableStyle(7.5, cell_loc="left", col_widths=[0.45, 0.55]),
+                  title="Pose and its uncertainty")
         pdf.savefig(fig, dpi=PDF_DPI)
         plt.close(fig)
         n_pages += 1
@@ -487,15 +455,15 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
             n_pages += 1
 
         fig = figure_views(result, table, tolerance)
-        parts += ["<h2>Deviation map</h2>", _img(_png(fig), "deviation map, three views")]
+        parts += ["<h2>Deviation map</h2>", img_tag(png_bytes(fig), "deviation map, three views")]
         pdf.savefig(fig, dpi=PDF_DPI)
         plt.close(fig)
         n_pages += 1
 
         fig = figure_histogram(result, band_edges)
-        png = _png(fig)
-        parts += ["<h2>Deviation histogram (Table 3)</h2>", _img(png, "deviation histogram"),
-                  _html_table(h_header, h_rows),
+        png = png_bytes(fig)
+        parts += ["<h2>Deviation histogram (Table 3)</h2>", img_tag(png, "deviation histogram"),
+                  html_table(h_header, h_rows),
                   "<p>Within +-1 sigma: %.3f %%; within +-3 sigma: %.3f %% (sigma = %.4f mm "
                   "about the mean %+.4f mm).</p>" % (
                       result.deviation_stats["pct_within_1sigma"],
@@ -507,10 +475,11 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
 
         fig = plt.figure(figsize=(11.69, 8.27))
         pdf_table(fig, [0.03, 0.52, 0.94, 0.42], s_header, s_rows or [["-"] * len(s_header)],
-                  7.5, title="Table 2: section profile errors (points within +-%.2f mm of each "
-                  "plane or of the section column)" % table.band, loc="upper center")
-        pdf_table(fig, [0.03, 0.05, 0.94, 0.42], h_header, h_rows, 8,
-                  title="Table 3: deviation bands", loc="upper center")
+                  TableStyle(7.5, loc="upper center"),
+                  title="Table 2: section profile errors (points within +-%.2f mm of each "
+                  "plane or of the section column)" % table.band)
+        pdf_table(fig, [0.03, 0.05, 0.94, 0.42], h_header, h_rows,
+                  TableStyle(8, loc="upper center"), title="Table 3: deviation bands")
         notes = ["LE/TE: points within %.0f %% of the chord of each end of the nominal profile."
                  % (100 * table.edge_fraction)]
         if table.cmm_source:
@@ -520,7 +489,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         plt.close(fig)
         n_pages += 1
 
-        parts += ["<h2>Section profile errors (Table 2)</h2>", _html_table(s_header, s_rows),
+        parts += ["<h2>Section profile errors (Table 2)</h2>", html_table(s_header, s_rows),
                   "<p class='note'>%s</p>" % html.escape(notes[0])]
         if table.cmm_source:
             parts.append("<p>CMM: %s. %s</p>" % (html.escape(table.cmm_source),
@@ -528,7 +497,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         for sec in table.sections:
             fig = figure_section(sec, result, tolerance, magnification=magnification)
             parts += ["<h3>Section %s</h3>" % html.escape(sec.label),
-                      _img(_png(fig), "section %s whisker plot" % sec.label)]
+                      img_tag(png_bytes(fig), "section %s whisker plot" % sec.label)]
             pdf.savefig(fig, dpi=PDF_DPI)
             plt.close(fig)
             n_pages += 1

@@ -250,7 +250,7 @@ def _halves(poly2d, i_le, i_te):
     return first, second
 
 
-def _build_profile(nominal, polylines, normal, fallback_xyz, origin):
+def build_profile(nominal, polylines, normal, fallback_xyz, origin):
     """Chord, leading edge and sides of a section from the CAD's cut (or, when the plane
     misses the CAD, from the section's own points: chord only)."""
     verts = [np.asarray(p, dtype=float) for p in polylines if len(p) >= 2]
@@ -505,7 +505,7 @@ def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, w
         except InputError:
             polylines = []
             warnings.append("section %s: the plane misses the CAD" % label)
-        profile = _build_profile(nominal, polylines, normal, result.points_cad[idx], origin)
+        profile = build_profile(nominal, polylines, normal, result.points_cad[idx], origin)
         zone = classify(profile, result.points_cad[idx], edge_fraction)
         sec = Section(label=label, source=source, origin=np.asarray(origin, dtype=float),
                       normal=np.asarray(normal, dtype=float), height_pct=float(height),

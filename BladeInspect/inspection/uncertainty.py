@@ -315,7 +315,7 @@ def max_of_draws(n, noise="uniform"):
     closed form of worst_terms' sampled error for n readings of one sigma on a plateau well
     away from zero (tests/test_worst_uncertainty.py holds the two together)."""
     from scipy.stats import norm
-    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, clipped_normal_std
     n = max(int(n), 1)
     if noise == "uniform":
         # max of n U(-1, 1): mean (n-1)/(n+1), variance 4n / ((n+1)^2 (n+2)); U(-1,1)*sqrt(3)
@@ -328,7 +328,7 @@ def max_of_draws(n, noise="uniform"):
     cdf = norm.cdf(z) ** n
     cdf[-1] = 1.0                     # the clipped tail piles up at +c
     p = np.diff(np.concatenate([[0.0], cdf]))
-    s = _clipped_normal_std(c)
+    s = clipped_normal_std(c)
     mean = float(p @ z)
     return mean / s, float(np.sqrt(max(p @ (z - mean) ** 2, 0.0))) / s
 
@@ -336,11 +336,11 @@ def max_of_draws(n, noise="uniform"):
 def unit_noise(sensor):
     """The sensor's noise distribution at unit variance, as core.uncertainty_model draws it:
     uniform, or normal clipped at NORMAL_CLIP_SIGMAS (rig.sensor)."""
-    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, clipped_normal_std
     if sensor.noise == "uniform":
         return uncertainty_model.uniform_unit_noise
     c = NORMAL_CLIP_SIGMAS
-    s = _clipped_normal_std(c)
+    s = clipped_normal_std(c)
     return lambda rng, shape: np.clip(rng.standard_normal(shape), -c, c) / s
 
 
@@ -481,9 +481,9 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
 def _noise_bound_sigmas(sensor):
     """The largest a reading's noise can be, in its sigmas: sqrt 3 for uniform noise, the
     clip over the clipped normal's sigma otherwise (rig.sensor)."""
-    from ..rig.sensor import NORMAL_CLIP_SIGMAS, _clipped_normal_std
+    from ..rig.sensor import NORMAL_CLIP_SIGMAS, clipped_normal_std
     return (np.sqrt(3.0) if sensor.noise == "uniform"
-            else NORMAL_CLIP_SIGMAS / _clipped_normal_std(NORMAL_CLIP_SIGMAS))
+            else NORMAL_CLIP_SIGMAS / clipped_normal_std(NORMAL_CLIP_SIGMAS))
 
 
 def maximum_error(values, noise, shared, model, bias_only=False):

@@ -25,7 +25,7 @@ from . import uncertainty as uncertainty_mod
 SPOT_NEIGHBOURS = 8
 MIN_SPOT_POINTS = 3
 
-_ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction side",
+ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction side",
               "pressure": "pressure side", "": "unknown side"}
 
 
@@ -136,7 +136,7 @@ def judge(result, table, tolerance=PROFILE_TOLERANCE_MM, spot_neighbours=SPOT_NE
     spot_out = []
     for r, (_, worst, members) in enumerate(spots[:n_worst]):
         sec = table.sections[k[r]] if table.sections else None
-        where = "%s at %.0f %% span" % (_ZONE_TEXT[zone[r] or ""], pct[r])
+        where = "%s at %.0f %% span" % (ZONE_TEXT[zone[r] or ""], pct[r])
         if sec is not None:
             where += " (near section %s)" % sec.label
         spot_out.append({

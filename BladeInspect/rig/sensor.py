@@ -21,7 +21,7 @@ NOISE_KINDS = ("uniform", "normal")
 NORMAL_CLIP_SIGMAS = 3.0
 
 
-def _clipped_normal_std(c):
+def clipped_normal_std(c):
     """Standard deviation of a unit normal clipped (not truncated) at +-c: the tails pile up
     at +-c, so the variance is the truncated part plus c^2 times the tail mass."""
     tail = norm.sf(c)
@@ -91,7 +91,7 @@ class SensorModel:
         """Standard deviation of the noise at SNR_ref."""
         if self.noise == "uniform":
             return self.accuracy / np.sqrt(3.0)
-        return self.accuracy / NORMAL_CLIP_SIGMAS * _clipped_normal_std(NORMAL_CLIP_SIGMAS)
+        return self.accuracy / NORMAL_CLIP_SIGMAS * clipped_normal_std(NORMAL_CLIP_SIGMAS)
 
     def snr(self, true_distance, incidence_rad):
         """Noise-free SNR of readings at these distances and incidences; 0 where none exists."""

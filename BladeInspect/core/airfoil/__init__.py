@@ -28,9 +28,6 @@ from .medial import MIN_CONTACT_ANGLE_DEG
 from .profile import Profile, area_centroid
 from .state import characteristics_from_state, characteristics_state
 
-# alias until inspection stops using it
-_ZONE_MIN_POINTS = ZONE_MIN_POINTS
-
 __all__ = [
     "AirfoilDefinition", "CHORD_METHODS", "CONTOUR_EDGE_FRACTION", "CamberLine",
     "Characteristics", "CircleFit2D", "DEFAULT_EDGE_OFFSETS_MM", "DEFAULT_EDGE_ZONE_DEG",

@@ -1,71 +1,9 @@
-"""Task-specific uncertainty of the airfoil characteristics (issue 15, "all characteristics of
-five sections in under 1 s"; ISO 15530-4 style, uncertainty by simulation of the task).
-
-The re-fit draws of inspection.airfoil (``_uncertainty``) state how much each characteristic
-scatters when the section's points are measured again: through the sensor's noise along the
-beams, its reading bias and the pose covariance, on this CAD, in these planes, with these
-options. That is a property of the measurement *task*, not of one blade. So the draws are made
-once per task (``DEFAULT_TASK_DRAWS`` = 48 of them, so that the u is known to
-1/sqrt(2 x 47) = 10 % rather than the 21 % of the 12 a blade's own re-fit takes) and stored in a
-JSON task file; every later blade of the same task reuses them while its measurement still
-matches the conditions they were made under. Only the draws' standard deviation is stored:
-the form values' maxima bias (``_maxima_bias``) depends on the blade's own deviations and is
-added afresh for every blade, as ``_uncertainty`` adds it.
-
-The task (the file's ``key``; a file made for another task is refused, never reused):
-
-- ``version``: TASK_MODEL_VERSION, raised whenever the draws' model in inspection.airfoil
-  changes, so that old files are refused;
-- ``cad``: sha256 of the nominal's dense samples (``nominal.samples``: points rounded to
-  0.1 um, outward normals to 1e-6, with their count) -- the samples are made from the CAD's
-  faces on a fixed grid, so the same file loads to the same fingerprint in every run, it costs
-  a hash of a few MB, and it changes with the CAD, the sample spacing and ``--flip-face``;
-  cheaper and steadier than a BREP string, whose text carries OCC's version;
-- the airfoil options that change the values: engine_axis, chord_method, edge_offsets_mm,
-  le_rule;
-- the sensor the draws use (every field of its rig.sensor.SensorModel, accuracy included);
-- the rig calibration's 1 sigma at the part (``calibration_mm``) and its axis parameters and
-  covariance (``calibration_axis``, which the draws propagate through each reading's angle),
-  each only when the run has it;
-- the registration's fit (result.fit's objective, free, weights_by_zone, datum_faces) and
-  weight model (result.weights' model), and which readings the draws lay noise along
-  (snr and beams known or not);
-
-Sections are not part of the key: a run of fewer or other sections is the same task, each
-section found by its label. Per section the file holds the plane (origin, normal), the draws' 1 sigma per flattened key
-(``_flat``'s names), and the conditions they were made under. A later blade's section uses
-them only when (MATCH_RULE):
-
-- its plane lies within PLANE_LEVEL_MM of the stored one along the normal and its normal within
-  PLANE_ANGLE_DEG (an `inspect`'s planes are fitted to each blade's points);
-- its point count is within +-10 %, its measured noise sigma (the point-to-point scatter,
-  ``noise`` of inspection.airfoil._section) within +-20 %, and sqrt(trace) of the pose
-  covariance's translation part (mm) and of its rotation part (rad) each within +-50 % of the
-  stored ones.
-
-A section that does not match is computed afresh with the blade's own re-fit
-(``Options.draws``) and its notes say why; nothing cached is used silently: the stage's
-``settings`` states the task file, when and from how many draws (and which seed) it was made,
-and per section which way its u was found (``uncertainty_task``); each block says it too
-(``uncertainty_method``, ``uncertainty_draws``).
-
-The file also keeps the task's nominal cuts (``nominal``: inspection.airfoil.
-nominal_characteristics' key, a sha256 of the cut's points and the kernel's arguments, ->
-core.airfoil.characteristics_state), made by the first blade: a later blade's nominal cut of
-the very same points is read back, to the bit, instead of computed (the cost of a nominal
-cut is as large as a measured one's); a cut of other points (an `inspect`'s planes fitted to
-its blade) is computed. ``nominal_digest`` guards them: a file whose kept cuts were changed is
-refused as damaged. Files made before the cuts were kept have none and stay valid.
-
-When the file named does not exist, the stage makes it: every measured section's u from
-``Options.task_draws`` re-fits (that blade's u is then the 48-draw one), written atomically
-(a temporary file in the same folder, then os.replace). The file is never changed afterwards.
-
-A file that cannot be read as a task file (corrupt JSON, another kind of file, another model
-version, or made for another task) gives a one-line InputError naming the file and why: it is
-not recomputed over, because the file was named for this task and something is wrong with it
-(a half-copied file, a changed CAD or option, an upgrade) that the user should see; deleting
-the file makes the next run compute it afresh.
+"""The airfoil uncertainty task file: the re-fit draws' 1 sigma of each section (and the
+task's nominal cuts), made once for a measurement task -- this CAD, these planes and options,
+this sensor, fit and calibration (``task_key``) -- and reused by every later blade of the task
+whose section still matches the conditions they were made under (MATCH_RULE); a section that
+does not is re-fitted afresh and says why. The file is written once, atomically; a file that is
+not a task file or was made for another task is refused with a one-line InputError naming it.
 """
 
 import datetime
@@ -79,13 +17,17 @@ import numpy as np
 from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
 from . import uncertainty as uncertainty_mod
+from .airfoil_measure import on_smooth_fit
+from .airfoil_uncertainty import (maxima_bias, point_noise_model, refit_uncertainty,
+                                  sensor_of)
+from .airfoil_values import flat, unflat
 
-# Raise whenever the re-fit draws' model (inspection.airfoil._uncertainty,
-# _point_noise_model, _measure) changes: files of another version are refused. 2: the measured
-# profile's fit takes the nominal's knots where the points thin out (core.airfoil
-# ._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is each
-# reading's beam where it meets the smooth fit (inspection.airfoil.beam_feet), and their pose
-# the covariance's random part (inspection.uncertainty.random_pose_covariance).
+# Raise whenever the re-fit draws' model (inspection.airfoil_uncertainty.refit_uncertainty,
+# point_noise_model, inspection.airfoil_measure.measure) changes: files of another version are
+# refused. 2: the measured profile's fit takes the nominal's knots where the points thin out
+# (core.airfoil._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is
+# each reading's beam where it meets the smooth fit (inspection.airfoil_uncertainty.beam_feet),
+# and their pose the covariance's random part (inspection.uncertainty.random_pose_covariance).
 TASK_MODEL_VERSION = 3
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48
@@ -108,7 +50,9 @@ MATCH_RULE_TEXT = ("a section reuses the task's draws when its plane is within %
 
 
 def cad_fingerprint(nominal):
-    """sha256 of the nominal's dense samples, rounded (module notes)."""
+    """sha256 of the nominal's dense samples (points to 0.1 um, outward normals to 1e-6, with
+    their count): the same CAD loads to the same fingerprint in every run, and it changes with
+    the CAD, the sample spacing and ``--flip-face``."""
     xyz = np.round(np.asarray(nominal.samples.xyz, dtype=float), 4) + 0.0   # no -0.0
     nrm = np.round(np.asarray(nominal.samples.normal, dtype=float), 6) + 0.0
     h = hashlib.sha256()
@@ -127,15 +71,18 @@ def _fit_of(result):
 
 
 def task_key(nominal, opts, result):
-    """The task's key (module notes): a JSON-able dict."""
-    from . import airfoil as stage
+    """The task's key, a JSON-able dict of what the draws depend on: the model version, the
+    CAD (cad_fingerprint), the airfoil options that change the values, the sensor, the rig
+    calibration (only when the run has it), the registration's fit and weight model, and which
+    readings carry SNR and beams. Sections are not part of it: a run of fewer or other
+    sections is the same task, each section found by its label."""
     key = {"version": TASK_MODEL_VERSION,
            "cad": cad_fingerprint(nominal),
            "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
            "chord_method": opts.chord_method,
            "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
            "le_rule": opts.le_rule,
-           "sensor": json.loads(json.dumps(asdict(stage.sensor_of(opts)))),
+           "sensor": json.loads(json.dumps(asdict(sensor_of(opts)))),
            "fit": _fit_of(result),
            "readings": {"snr": result.snr is not None,
                         "beams": uncertainty_mod.beam_directions(result) is not None}}
@@ -153,7 +100,7 @@ def digest(key):
 
 
 def conditions(result, n_points, noise):
-    """The conditions a section's draws hold for (module notes)."""
+    """The conditions a section's draws hold for (MATCH_RULE's quantities)."""
     cov = np.asarray(result.pose_covariance, dtype=float)
     cov = np.where(np.isfinite(cov), cov, 0.0)
     return {"n_points": int(n_points), "noise_mm": float(noise),
@@ -203,7 +150,7 @@ class TaskUncertainty:
     sections: dict = field(default_factory=dict)    # label -> {plane, conditions, sd}
     path: str = None
     made: bool = True
-    # the nominal cuts' characteristics (inspection.airfoil.nominal_characteristics' key ->
+    # the nominal cuts' characteristics (airfoil_stage.nominal_characteristics' key ->
     # kernel.characteristics_state): a task's nominal is the same for every blade of it
     nominal: dict = field(default_factory=dict)
 
@@ -238,7 +185,8 @@ class TaskUncertainty:
 
 
 def load(path):
-    """The task file at ``path``; a one-line InputError when it is not one (module notes)."""
+    """The task file at ``path``; a one-line InputError when it is not one (corrupt JSON,
+    another kind of file, another model version, a damaged key or nominal cuts)."""
     try:
         with open(path) as fh:
             doc = json.load(fh)
@@ -306,31 +254,30 @@ def open_task(spec, key, opts, result):
     return task
 
 
-def maxima_bias(result, idx, frame, nom, ch, fit, opts, noise):
-    """{form key: bias} of one blade's section, with the inputs inspection.airfoil._uncertainty
-    gives _maxima_bias (kept in step with it: tests/test_airfoil_task_u.py checks that the
-    task's u of the blade that made it is that blade's re-fit u)."""
-    from . import airfoil as stage
-    pts, _, out_normal = stage.on_smooth_fit(result, idx, frame, ch)
-    sensor = stage.sensor_of(opts)
-    sigma = stage._point_noise_model(result, idx, sensor, noise, out_normal)[0]
-    return stage._maxima_bias(result, idx, pts, nom, fit, sigma, sensor)
+def section_maxima_bias(m, opts):
+    """{form key: bias} of one blade's section ``m`` (an airfoil_measure.SectionMeasurement),
+    with the inputs airfoil_uncertainty.refit_uncertainty gives maxima_bias (kept in step with
+    it: tests/test_airfoil_task_u.py checks that the task's u of the blade that made it is that
+    blade's re-fit u)."""
+    pts, _, out_normal = on_smooth_fit(m.result, m.idx, m.frame, m.measured)
+    sensor = sensor_of(opts)
+    sigma = point_noise_model(m.result, m.idx, sensor, m.noise_mm, out_normal)[0]
+    return maxima_bias(m.result, m.idx, pts, m.nominal, m.fit, sigma, sensor)
 
 
-def section_uncertainty(task, sr, result, idx, frame, nom, ch, fit, opts, noise, rng,
-                        measured_values):
-    """The block's ``uncertainty`` of one measured section under a task: the task's draws when
-    the section matches, else made (a task being made) or re-fitted afresh; records how on the
-    block and in ``sr.notes``. Returns ("task" | "made" | "re-fit", reason)."""
-    from . import airfoil as stage
+def section_uncertainty(task, sr, m, opts, rng):
+    """The block's ``uncertainty`` of one measured section ``m`` (an
+    airfoil_measure.SectionMeasurement, ``sr`` its stage SectionResult) under a task: the
+    task's draws when the section matches, else made (a task being made) or re-fitted afresh;
+    records how on the block and in ``sr.notes``. Returns ("task" | "made" | "re-fit",
+    reason)."""
+    result, idx, noise, measured_values = m.result, m.idx, m.noise_mm, m.values
     label = sr.plane.label
     now = conditions(result, len(idx), noise)
     block = sr.block
     if not task.made:
         sd = {}
-        u = stage._uncertainty(result, idx, frame, nom, ch, fit,
-                               _with_draws(opts, task.draws), noise, rng, measured_values,
-                               draws_sd=sd)
+        u = refit_uncertainty(m, _with_draws(opts, task.draws), rng, draws_sd=sd)
         block["uncertainty"] = u
         if u is not None:
             task.sections[label] = {
@@ -348,18 +295,16 @@ def section_uncertainty(task, sr, result, idx, frame, nom, ch, fit, opts, noise,
     if why:
         sr.notes.append("uncertainty: the task's draws not used (%s): re-fitted afresh, "
                         "%d draws" % ("; ".join(why), opts.draws))
-        block["uncertainty"] = (stage._uncertainty(result, idx, frame, nom, ch, fit, opts,
-                                                   noise, rng, measured_values)
-                                if opts.draws else None)
+        block["uncertainty"] = refit_uncertainty(m, opts, rng) if opts.draws else None
         block["uncertainty_method"] = "re-fit"
         block["uncertainty_draws"] = int(opts.draws)
         return "re-fit", "; ".join(why)
     sd = {k: (float("nan") if v is None else float(v)) for k, v in stored["sd"].items()}
-    for key, bias in maxima_bias(result, idx, frame, nom, ch, fit, opts, noise).items():
+    for key, bias in section_maxima_bias(m, opts).items():
         if key in sd:
             sd[key] = float(np.hypot(sd[key], bias))
-    keys = stage._flat(measured_values).keys()
-    block["uncertainty"] = stage._unflat({k: sd[k] for k in keys if k in sd}, measured_values)
+    keys = flat(measured_values).keys()
+    block["uncertainty"] = unflat({k: sd[k] for k in keys if k in sd}, measured_values)
     block["uncertainty_method"] = "task-specific"
     block["uncertainty_draws"] = task.draws
     return "task", None
