@@ -27,7 +27,8 @@ from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, check_magnitude
 from . import checks, weighting
 from .result import RegistrationResult
-from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
+from .run_options import RegisterOptions, RunOptions
+from ..core.contracts import json_default
 
 # Points used for the ICP ranking of each PCA candidate and for the fine fit's inner
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
@@ -397,8 +398,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         full_distance's starts of those rows."""
         distance = TrackedDistance(nominal, full_distance.start.take(rows))
         fit = icp_mod.icp(measured_xyz[rows], None if snr is None else snr[rows], distance, T,
-                          options, weight_model=None if weight_model is None   # hook: issue 16
-                          else weight_model.subset(rows))
+                          options, weight_model=_weights_of_rows(weight_model, rows))
         _check_time(fit, time_limit_s)
         full_distance.start.set_rows(rows, distance.start)
         return fit.transform
@@ -433,6 +433,11 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     return fit
 
 
+def _weights_of_rows(weight_model, rows):
+    """The weight model of the measured rows ``rows`` (None: the SNR weights)."""
+    return None if weight_model is None else weight_model.subset(rows)
+
+
 def _with_deadline(progress, limit_s, what):
     """``progress`` that raises an InputError once ``limit_s`` has passed since it was made."""
     deadline = time.monotonic() + limit_s
@@ -454,31 +459,32 @@ def _check_time(fit, time_limit_s):
 
 # ---------------------------------------------------------------- the whole registration
 
-def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
-             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None,
-             fit_choice=None, weights=None, rig_kinematics=None):
+def register(nominal, pointset, seed=0, progress=None, options=None, rig_kinematics=None,
+             use_reconstruction=True, **choices):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
-    Refused (InputError) before any fitting when the points are too degenerate to fix a pose
-    or do not match the CAD's size, and after it when they do not fit the CAD (see
-    inspection.checks; ``allow_mismatch`` keeps the result with a warning instead, and
-    ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
-    in those messages. ``fit_choice``: an inspection.fitting.FitChoice applied after the ICP.
-    ``weights``: the fine fit's, "snr", "sensor" or None for the default (inspection.weighting;
-    None also takes ``fit_choice.weights``); ``rig_kinematics`` turns the sensor weights'
-    beams back (default the nominal rig's)."""
+    ``options``: inspection.run_options.RegisterOptions (None: its defaults), its fields also
+    taken as keywords (``choices``, which replace them). Refused (InputError) before any
+    fitting when the points are too degenerate to fix a pose or do not match the CAD's size,
+    and after it when they do not fit the CAD (see inspection.checks; ``allow_mismatch`` keeps
+    the result with a warning instead, and ``tolerance`` is the profile tolerance the fit rule
+    allows). ``cad_source`` names the CAD in those messages. ``fit_choice``: an
+    inspection.fitting.FitChoice applied after the ICP. ``weights``: the fine fit's, "snr",
+    "sensor" or None for the default (inspection.weighting; None also takes
+    ``fit_choice.weights``); ``rig_kinematics`` turns the sensor weights' beams back (default
+    the nominal rig's)."""
+    options = dataclasses.replace(options or RegisterOptions(), **choices)
+    tolerance, fit_choice = options.tolerance, options.fit_choice
     progress = progress or _no_progress
     timing = {}
     xyz = _check_points(pointset)
     source = pointset.source or "points"
-    cad_label = cad_source or "the CAD"
+    cad_label = options.cad_source or "the CAD"
     checks.check_spread(xyz, source, coincide_only=True)
     extent_ratio = checks.check_scale(xyz, nominal, source, cad_label)
     checks.check_spread(xyz, source)
     snr = None if pointset.snr is None else np.asarray(pointset.snr, dtype=float)
-    weight_model, weights_record = weighting.weight_model_for(   # hook: issue 16 item 3
-        pointset, weights if weights is not None else getattr(fit_choice, "weights", None),
-        kinematics=rig_kinematics)
+    weight_model, weights_record = _weight_model(pointset, options, rig_kinematics)
     rng = np.random.default_rng(seed)
     # A CAD face whose outside could not be decided signs its deviations by a guess: say so.
     warnings = list(nominal.face_side_warnings)
@@ -523,7 +529,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     progress(0.92, "signed deviations of %d points" % len(xyz))
     points_cad = tf.apply_transform(fit.transform, xyz)
-    dist = final_distances(fit, full_distance)   # hook: the fit's own residuals (issue 14)
+    dist = final_distances(fit, full_distance)
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
@@ -531,7 +537,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     fit_record["extent_ratio"] = extent_ratio
     if not fit_record["fits"]:
         message = checks.mismatch_message(fit_record, source, cad_label)
-        if not allow_mismatch:
+        if not options.allow_mismatch:
             raise InputError(message)
         fit_record["warning"] = message
         warnings.append(message)
@@ -568,11 +574,25 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         pose_uncertainty_statistical_mm=float(statistical),
         pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights,
         inlier_cut=fit.cut)
-    result.weights = weights_record   # hook: issue 16 item 3
-    if fit_choice is not None:   # hook: inspection.fitting (issue 16)
+    result.weights = weights_record
+    _apply_fit_choice(result, nominal, fit_choice, tolerance)
+    return result
+
+
+def _weight_model(pointset, options, rig_kinematics):
+    """(the fine fit's weight model, its record) for ``options.weights``, else the fit
+    choice's (inspection.weighting)."""
+    weights = options.weights
+    if weights is None:
+        weights = getattr(options.fit_choice, "weights", None)
+    return weighting.weight_model_for(pointset, weights, kinematics=rig_kinematics)
+
+
+def _apply_fit_choice(result, nominal, fit_choice, tolerance):
+    """The result moved to the pose of ``fit_choice`` (inspection.fitting; None: the ICP's)."""
+    if fit_choice is not None:
         from . import fitting
         fitting.apply(result, nominal, fit_choice, tolerance)
-    return result
 
 
 def pose_summary(fit, nominal):
@@ -724,19 +744,23 @@ def write_register_outputs(out_dir, result, extra=None, output=None):
             write(out)
 
 
-def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),
-                 allow_mismatch=False, fit_choice=None, tolerance=PROFILE_TOLERANCE_MM):
-    """The `register` command: load, register, write. Returns the RegistrationResult."""
+def run_register(cad_path, points_path, out_dir, options=None, progress=None):
+    """The `register` command: load, register, write, with ``options``
+    (inspection.run_options.RunOptions: its seed, flip_faces, allow_mismatch, fit_choice and
+    tolerance). Returns the RegistrationResult."""
+    options = options or RunOptions()
     checks.check_out_dir(out_dir)
     t0 = time.perf_counter()
-    nominal = load_nominal(cad_path, flip_faces=flip_faces)
+    nominal = load_nominal(cad_path, flip_faces=options.flip_faces)
     t_cad = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = load_points(points_path)
     t_pts = time.perf_counter() - t0
-    result = register(nominal, points, seed=seed, progress=progress,
-                      allow_mismatch=allow_mismatch, cad_source=cad_path or "the demo blade",
-                      fit_choice=fit_choice, tolerance=tolerance)
+    result = register(nominal, points, seed=options.seed, progress=progress,
+                      options=RegisterOptions(allow_mismatch=options.allow_mismatch,
+                                              cad_source=cad_path or "the demo blade",
+                                              fit_choice=options.fit_choice,
+                                              tolerance=options.tolerance))
     result.timing_s = dict(load_cad=t_cad, load_points=t_pts, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
     write_register_outputs(out_dir, result)
