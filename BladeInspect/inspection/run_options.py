@@ -106,3 +106,14 @@ class ReportSources:
     cad_path: Optional[str] = None
     cmm_data: Any = None
     batch_inputs: Optional[dict] = None
+
+
+@dataclass(frozen=True)
+class FineOptions:
+    """pipeline.fine_register's limits and start: ``time_limit_s`` for both of its ICP runs
+    (None: pipeline.FINE_TIME_LIMIT_S), ``full_distance`` the TrackedDistance of all the
+    points (None: one of its own), ``systematic_mm`` the sensor's stated accuracy (None: the
+    default sensor's, inspection.checks.SENSOR_ACCURACY_MM)."""
+    time_limit_s: Optional[float] = None
+    full_distance: Any = None
+    systematic_mm: Optional[float] = None
