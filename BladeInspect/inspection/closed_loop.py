@@ -625,8 +625,7 @@ def _loop(phase, run):
     phase.add_to_record(scan_record, state)
     with open(out.path("scan.json"), "w") as fh:
         json.dump(scan_record, fh, indent=1, default=contracts.json_default)
-    files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
-                         title=phase.title)
+    files = write_report(out, result, nominal, table, verdict, tolerance, title=phase.title)
     if run.document:
         run.document(out.path("inspection.FCStd"), nominal, result, table, tolerance=tolerance)
     timing["write"] = time.perf_counter() - t0
