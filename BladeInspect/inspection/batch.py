@@ -275,7 +275,7 @@ def run_batch(cad_path, scans_dir, out_dir, options=None, workers=None, schedule
         _run_local(workers, lot, todo, finished)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
-    airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
+    airfoil_mod.write_lot_csv(out_dir, files)   # summary_airfoil.csv
     # Every file is reported: the attempt counts are in the summary.
     shutil.rmtree(os.path.join(out_dir, ATTEMPTS_FOLDER), ignore_errors=True)
     count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)

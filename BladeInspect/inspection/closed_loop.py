@@ -637,7 +637,7 @@ def _loop(phase, run):
     extra.update(phase.result_json(plan, n_measured, state, rig_s - blind_rig_s, timing))
     extra["n_points_by_phase"]["blind"] = n_blind
     extra["rig_time_s"] = rig_s
-    extra.update(airfoil_mod.extras_of(table))  # issue 15 hook
+    extra.update(airfoil_mod.extras_of(table))
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     summary = {"result": result, "blind_result": first, "plan": plan, "sections": table,

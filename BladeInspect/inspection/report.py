@@ -531,7 +531,7 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
             pdf.savefig(fig, dpi=PDF_DPI)
             plt.close(fig)
             n_pages += 1
-        n_pages += airfoil_report.add_pages(pdf, parts, table)  # issue 15 hook
+        n_pages += airfoil_report.add_pages(pdf, parts, table)
         meta = pdf.infodict()
         meta["Title"] = title
         meta["Creator"] = "BladeInspect"
@@ -616,7 +616,7 @@ def write_result_report(result, nominal, out_dir, options=None, progress=None, d
     progress(0.82, "section table")
     table, verdict = _fit_and_judge(result, nominal, options.replace(tolerance=tolerance),
                                     sources.cmm_data)
-    if options.airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
+    if options.airfoil is not None:   # the airfoil characteristics join the verdict
         airfoil_mod.attach(result, nominal, table, verdict, options.airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0
     with pipeline.AtomicOutput(out_dir) as out:
@@ -632,7 +632,7 @@ def write_result_report(result, nominal, out_dir, options=None, progress=None, d
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance,
-            **airfoil_mod.extras_of(table),  # issue 15 hook
+            **airfoil_mod.extras_of(table),
             **({"batch_inputs": sources.batch_inputs}
                if sources.batch_inputs is not None else {})},
             output=out)
