@@ -19,7 +19,7 @@ scan.json (the blind scan's record, the planned passes, the simulator's truth), 
 
 A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint instead:
 points.csv up to the last completed blind section, planned section or raster pass, plan.json,
-and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
+and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``options.loop.resume`` (the
 CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in DIR/.checkpoint while the loop runs
 (inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
@@ -219,8 +219,9 @@ def _pointset(xyz, snr, columns, source):
 @dataclass
 class _Inspection:
     """One inspection once opened: the nominal, the rig and its kinematics, the options
-    (checked, RunOptions), those of its registrations, the CMM's table, the output and checkpoint, and the caller's
-    progress, document writer and plan viewer."""
+    (checked, RunOptions), those of its registrations, the CMM's table, the CAD's name in the
+    result, the output and checkpoint, the timings, and the caller's progress, document
+    writer and plan viewer."""
     nominal: object
     rig: object
     kinematics: RigKinematics
