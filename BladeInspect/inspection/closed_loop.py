@@ -19,8 +19,8 @@ scan.json (the blind scan's record, the planned passes, the simulator's truth), 
 
 A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint instead:
 points.csv up to the last completed blind section, planned section or raster pass, plan.json,
-and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``options.loop.resume`` (the
-CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
+and scan.json marked incomplete with the loop's state under "inspection" (no result files).
+``options.loop.resume`` (the CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in DIR/.checkpoint while the loop runs
 (inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
