@@ -374,27 +374,26 @@ def final_distances(fit, tracked):
 
 
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
-                  weight_model=None, **options):
+                  weight_model=None, **settings):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
-    information (and its covariance is the whole cloud's). ``options``: the fields of
+    information (and its covariance is the whole cloud's). ``settings``: the fields of
     inspection.run_options.FineOptions (time_limit_s, full_distance, systematic_mm; absent or
     None: FINE_TIME_LIMIT_S, a TrackedDistance of its own, the default sensor's accuracy).
     Both runs together get ``time_limit_s``; an InputError says so when it is spent.
-    ``weight_model``: core.icp's
-    (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
+    ``weight_model``: core.icp's (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
     all the points to use (so that the caller can start its deviations from the fit's last
     foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
     sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
     core.icp's defect test grants each neighbourhood the field a bias of that size leaves
     after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
-    options = FineOptions(**options)
-    time_limit_s = (FINE_TIME_LIMIT_S if options.time_limit_s is None
-                    else options.time_limit_s)
-    systematic_mm = (checks.SENSOR_ACCURACY_MM if options.systematic_mm is None
-                     else options.systematic_mm)
+    settings = FineOptions(**settings)
+    time_limit_s = (FINE_TIME_LIMIT_S if settings.time_limit_s is None
+                    else settings.time_limit_s)
+    systematic_mm = (checks.SENSOR_ACCURACY_MM if settings.systematic_mm is None
+                     else settings.systematic_mm)
     rng = np.random.default_rng(1) if rng is None else rng
-    full_distance = options.full_distance or TrackedDistance(nominal)
+    full_distance = settings.full_distance or TrackedDistance(nominal)
     deadline = time.monotonic() + time_limit_s
 
     def remaining():
