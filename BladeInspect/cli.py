@@ -254,9 +254,8 @@ def _print_result(result, out_dir, stream=None):
 
 def cmd_register(args):
     from .inspection.pipeline import run_register
-    result = run_register(args.cad, args.points, args.out, seed=args.seed, progress=Progress(),
-                          flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
-                          fit_choice=_fit_choice(args), tolerance=args.tolerance)
+    result = run_register(args.cad, args.points, args.out, _run_options(args),
+                          progress=Progress())
     _print_result(result, args.out)
 
 
@@ -287,9 +286,9 @@ def cmd_demo(args):
     judged against the simulator's truth."""
     from .inspection.airfoil_stage import options_from_args
     from .inspection.closed_loop import run_inspect
-    summary = run_inspect(None, args.out, rig_spec="sim", seed=args.seed, progress=Progress(),
-                          document=_document_writer(),
-                          airfoil=options_from_args())
+    from .inspection.run_options import RunOptions
+    summary = run_inspect(None, args.out, RunOptions(seed=args.seed, airfoil=options_from_args()),
+                          progress=Progress(), document=_document_writer())
     result = summary["result"]
     _print_result(result, args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
@@ -358,7 +357,7 @@ def _airfoil_arguments(parser, always):
 
 
 def _airfoil_options(args):
-    """inspection.airfoil.Options from the command's arguments; None with --no-airfoil."""
+    """inspection.airfoil_stage.Options from the command's arguments; None with --no-airfoil."""
     given = [args.engine_axis, args.characteristics, args.chord_method, args.edge_offsets,
              args.le_rule, args.uncertainty_task]
     if getattr(args, "no_airfoil", False):
@@ -383,15 +382,8 @@ def cmd_airfoil(args):
 
 def cmd_report(args, cad=None, points=None):
     from .inspection.report import run_report
-    options = {}
-    if args.section_heights:
-        options["heights_pct"] = args.section_heights
-    summary = run_report(args.cad, args.points, args.out, cmm=args.cmm,
-                         tolerance=args.tolerance, seed=args.seed, progress=Progress(),
-                         flip_faces=args.flip_face, allow_mismatch=args.allow_mismatch,
-                         airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
-                         measurement_model=_model(args), document=_document_writer(),
-                         **options)
+    summary = run_report(args.cad, args.points, args.out, _run_options(args),
+                         progress=Progress(), document=_document_writer())
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
@@ -403,34 +395,54 @@ def _model(args):
 
 def cmd_batch(args):
     from .inspection.batch import run_batch
-    summary = run_batch(args.cad, args.scans, args.out, workers=args.workers,
-                        scheduler=args.scheduler, tolerance=args.tolerance, progress=Progress(),
-                        allow_mismatch=args.allow_mismatch, airfoil=_airfoil_options(args),
-                        fit_choice=_fit_choice(args), document=_document_writer(),
-                        measurement_model=_model(args))
+    summary = run_batch(args.cad, args.scans, args.out, _run_options(args),
+                        workers=args.workers, scheduler=args.scheduler, progress=Progress(),
+                        document=_document_writer())
     sys.stdout.write("%s\n" % summary["message"])
 
 
 def cmd_inspect(args):
     from .inspection.closed_loop import run_inspect
-    summary = run_inspect(args.cad, args.out, rig_spec=args.rig,
-                          section_heights=args.section_heights, complete=args.complete,
-                          pitch=args.pitch, cmm=args.cmm, tolerance=args.tolerance,
-                          seed=args.seed, rig_file=args.rig_file, progress=Progress(),
-                          resume=args.resume, flip_faces=args.flip_face,
-                          allow_mismatch=args.allow_mismatch,
-                          airfoil=_airfoil_options(args), fit_choice=_fit_choice(args),
-                          measurement_model=_model(args), document=_document_writer(),
-                          **_edge_rule(args))
+    summary = run_inspect(args.cad, args.out, _run_options(args, loop=_loop_options(args)),
+                          progress=Progress(), document=_document_writer())
     _print_result(summary["result"], args.out)
     sys.stdout.write("verdict: %s\n" % summary["verdict"]["summary"])
 
 
-def _edge_rule(args):
-    # --edge-radius-sigma absent: run_inspect's default target.
-    if args.edge_radius_sigma is None:
-        return {}
-    return {"edge_radius_sigma_mm": args.edge_radius_sigma}
+def _run_options(args, loop=None):
+    """inspection.run_options.RunOptions from a command's parsed arguments: the options the
+    command has, the others at their defaults. ``loop``: the `inspect` loop's (LoopOptions).
+    The airfoil options, the fit and the measurement model are made in that order, so that a
+    bad one is reported as before."""
+    from .inspection.run_options import LoopOptions, RunOptions
+    given = {"loop": loop or LoopOptions()}
+    for name, flag in (("seed", "seed"), ("tolerance", "tolerance"), ("cmm", "cmm"),
+                       ("flip_faces", "flip_face"), ("allow_mismatch", "allow_mismatch"),
+                       ("rig_file", "rig_file")):
+        if hasattr(args, flag):
+            given[name] = getattr(args, flag)
+    # `report` with no (or empty) --section-heights takes the default heights; `inspect`'s
+    # are checked as given.
+    if loop is not None or getattr(args, "section_heights", None):
+        given["section_heights"] = args.section_heights
+    if hasattr(args, "no_airfoil"):
+        given["airfoil"] = _airfoil_options(args)
+    if hasattr(args, "fit"):
+        given["fit_choice"] = _fit_choice(args)
+    if hasattr(args, "rig_file"):
+        given["measurement_model"] = _model(args)
+    return RunOptions(**given)
+
+
+def _loop_options(args):
+    """The `inspect` loop's options (inspection.run_options.LoopOptions) from its arguments;
+    --edge-radius-sigma absent: the default target."""
+    from .inspection.run_options import LoopOptions
+    edge_rule = {}
+    if args.edge_radius_sigma is not None:
+        edge_rule["edge_radius_sigma_mm"] = args.edge_radius_sigma
+    return LoopOptions(rig_spec=args.rig, complete=args.complete, pitch=args.pitch,
+                       resume=args.resume, **edge_rule)
 
 
 def cmd_calibrate(args):

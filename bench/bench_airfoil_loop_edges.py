@@ -54,11 +54,13 @@ def truth_pose(nominal, seed):
 
 def loop_result(nominal, rig, heights, edge_sigma, seed):
     from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.run_options import RunOptions
     tmp = tempfile.mkdtemp(prefix="bi-edges-")
     try:
-        summary = run_inspect(None, tmp + "/out", rig=rig, nominal=nominal,
-                              section_heights=heights, seed=seed, document=False,
-                              edge_radius_sigma_mm=edge_sigma)
+        summary = run_inspect(None, tmp + "/out",
+                              RunOptions.of(section_heights=heights, seed=seed,
+                                            edge_radius_sigma_mm=edge_sigma), rig=rig,
+                              nominal=nominal, document=False)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return summary["result"], summary["plan"], summary["sections"]

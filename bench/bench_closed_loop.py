@@ -100,6 +100,7 @@ def inspect_figures(seeds):
     import tempfile
     from BladeInspect.core import transforms as tf
     from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.run_options import RunOptions
     from BladeInspect.inspection.pipeline import load_nominal
     from BladeInspect.rig.simulated import SimulatedRig, make_bump, random_fixture_pose
     print("== inspect loop: demo blade, random fixture pose, 30 um bump, sections 10..90 %")
@@ -111,8 +112,8 @@ def inspect_figures(seeds):
         rig = SimulatedRig(nominal, truth, error_field=make_bump(centre, 6.0, 0.03), seed=seed)
         with tempfile.TemporaryDirectory() as tmp:
             t0 = time.perf_counter()
-            out = run_inspect(None, os.path.join(tmp, "out"), rig=rig, nominal=nominal,
-                              seed=seed, document=False)
+            out = run_inspect(None, os.path.join(tmp, "out"), RunOptions.of(seed=seed), rig=rig,
+                              nominal=nominal, document=False)
             wall = time.perf_counter() - t0
         res = out["result"]
         err = tf.corner_displacement(res.measured_to_cad, truth, nominal.bbox_corners)

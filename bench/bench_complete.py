@@ -63,12 +63,14 @@ def main():
     if args.skip_inspect:
         return
     from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.run_options import RunOptions
     rig = simulated_rig_for(nominal, seed=args.seed)
     out = tempfile.mkdtemp(prefix="bench-complete-")
     try:
         t0 = time.perf_counter()
-        summary = run_inspect(None, os.path.join(out, "run"), rig=rig, nominal=nominal,
-                              complete=True, pitch=args.pitch, seed=args.seed)
+        summary = run_inspect(None, os.path.join(out, "run"),
+                              RunOptions.of(complete=True, pitch=args.pitch, seed=args.seed),
+                              rig=rig, nominal=nominal)
         wall = time.perf_counter() - t0
         timing = summary["result"].timing_s
         truth_err = np.abs(np.asarray(summary["result"].measured_to_cad)

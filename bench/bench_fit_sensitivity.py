@@ -19,6 +19,7 @@ import numpy as np
 from BladeInspect.inspection import airfoil_stage as airfoil, fitting
 from BladeInspect.inspection.closed_loop import run_inspect
 from BladeInspect.inspection.pipeline import load_nominal
+from BladeInspect.inspection.run_options import RunOptions
 
 
 def main():
@@ -28,9 +29,9 @@ def main():
     args = ap.parse_args()
     nominal = load_nominal(None)
     with tempfile.TemporaryDirectory() as out:
-        summary = run_inspect(None, out + "/inspect", seed=args.seed, document=False,
-                              airfoil=airfoil.Options(),
-                              nominal=nominal)
+        summary = run_inspect(None, out + "/inspect",
+                              RunOptions.of(seed=args.seed, airfoil=airfoil.Options()),
+                              document=False, nominal=nominal)
     result, table = summary["result"], summary["sections"]
     tolerance = summary["verdict"]["tolerance_mm"]
     print("demo blade, planned scan: %d points (%d inliers), %d sections, tolerance +-%.3f mm"

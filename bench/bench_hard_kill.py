@@ -31,6 +31,7 @@ from bench.bench_inspect_resume import against_reference, read, start_simrig, st
 def in_process(out, seed, heights, journal=True):
     from BladeInspect.app.document import write_inspection_document
     from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.run_options import RunOptions
     from BladeInspect.inspection.pipeline import load_nominal
     from BladeInspect.measurement import journal as journal_mod
     from BladeInspect.rig.simulated import simulated_rig_for
@@ -47,8 +48,8 @@ def in_process(out, seed, heights, journal=True):
                                         else lambda self, readings, rig_s: None)
     try:
         start = time.perf_counter()
-        run_inspect(None, out, rig=rig, nominal=nominal, seed=seed, section_heights=heights,
-                    document=write_inspection_document)
+        run_inspect(None, out, RunOptions.of(seed=seed, section_heights=heights), rig=rig,
+                    nominal=nominal, document=write_inspection_document)
         return time.perf_counter() - start, rig.pass_index, spent[0]
     finally:
         journal_mod.JournaledRig._append = append

@@ -38,6 +38,7 @@ from BladeInspect.core.pointio import write_points_csv
 from BladeInspect.cad.nominal import Nominal
 from BladeInspect.inspection import pipeline
 from BladeInspect.inspection.simulate import simulate_measurement
+from BladeInspect.inspection.run_options import RunOptions
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROTOR67 = os.path.join(HERE, "..", "..", "shared", "data", "blades", "nasa_rotor67",
@@ -203,7 +204,8 @@ def main(argv=None):
                 try:
                     with FallbackCount() as fallback:
                         t0, c0 = time.perf_counter(), time.process_time()
-                        result = pipeline.run_register(cad, points, out, seed=args.seed)
+                        result = pipeline.run_register(cad, points, out,
+                                                       RunOptions.of(seed=args.seed))
                         total, total_cpu = time.perf_counter() - t0, time.process_time() - c0
                 finally:
                     pipeline.time = time

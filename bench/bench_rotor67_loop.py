@@ -23,6 +23,7 @@ from tests.test_rotor67_loop import (BLIND_SECTIONS, HEIGHTS, STANDOFF, _bump_at
 def one_loop(nominal, seed, n_sections):
     from BladeInspect.core.pointio import read_points
     from BladeInspect.inspection.closed_loop import run_inspect
+    from BladeInspect.inspection.run_options import RunOptions
     from BladeInspect.rig.sensor import SensorModel
     from BladeInspect.rig.simulated import SimulatedRig, random_fixture_pose_of
     axis, bump = _bump_at_section(nominal, HEIGHTS[0])
@@ -34,8 +35,10 @@ def one_loop(nominal, seed, n_sections):
     tmp = tempfile.mkdtemp(prefix="bi-r67-loop-")
     try:
         t0 = time.perf_counter()
-        run_inspect(None, tmp + "/out", rig=rig, nominal=nominal, section_heights=HEIGHTS,
-                    seed=seed, document=False, scan_options={"n_sections": n_sections})
+        run_inspect(None, tmp + "/out",
+                    RunOptions.of(section_heights=HEIGHTS, seed=seed,
+                                  scan_options={"n_sections": n_sections}), rig=rig,
+                    nominal=nominal, document=False)
         wall = time.perf_counter() - t0
         with open(os.path.join(tmp, "out", "result.json")) as fh:
             result = json.load(fh)

@@ -75,6 +75,7 @@ from tests.helpers import suction_bump_at  # noqa: E402
 from BladeInspect.measurement import calibration as calibration_mod  # noqa: E402
 from BladeInspect.rig.kinematics import RigKinematics  # noqa: E402
 from BladeInspect.rig.sensor import SensorModel  # noqa: E402
+from BladeInspect.inspection.run_options import RunOptions  # noqa: E402
 
 BEAM = np.array([0.0, 0.0, -1.0])
 BUMP_HEIGHT = 0.03
@@ -155,8 +156,10 @@ def record(name, seed):
     rig.measure = recording
     tmp = tempfile.mkdtemp(prefix="bi-mc-")
     try:
-        run_inspect(None, tmp + "/out", rig=rig, nominal=nominal, section_heights=heights,
-                    seed=seed, document=False, scan_options={"n_sections": 3})
+        run_inspect(None, tmp + "/out",
+                    RunOptions.of(section_heights=heights, seed=seed,
+                                  scan_options={"n_sections": 3}), rig=rig, nominal=nominal,
+                    document=False)
         with open(os.path.join(tmp, "out", "scan.json")) as fh:
             scan = json.load(fh)
     finally:

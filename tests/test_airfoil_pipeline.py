@@ -19,6 +19,7 @@ from BladeInspect.inspection import airfoil_values as values
 from BladeInspect.inspection import sections as sections_mod
 from BladeInspect.inspection.result import RegistrationResult
 from BladeInspect.measurement.planning import nominal_section
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import demo_nominal
 
 HEIGHTS = (30.0, 50.0, 70.0)
@@ -329,7 +330,7 @@ class ReportAndBatch(unittest.TestCase):
         opts = stage_mod.options_from_args(characteristics=chars)
         opts.draws = 0
         cls.out = os.path.join(cls.tmp, "lot")
-        cls.summary = run_batch(None, scans, cls.out, workers=1, airfoil=opts)
+        cls.summary = run_batch(None, scans, cls.out, RunOptions.of(airfoil=opts), workers=1)
         with open(os.path.join(cls.out, "blade1", "result.json")) as fh:
             cls.doc = json.load(fh)
 

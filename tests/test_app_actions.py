@@ -18,6 +18,7 @@ from BladeInspect.app import actions, airfoil_objects, objects, registration_fit
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
 from BladeInspect.inspection.simulate import simulate_measurement
+from BladeInspect.inspection.run_options import RunOptions
 
 
 def replay(imports, call):
@@ -153,7 +154,8 @@ class ActionLines(unittest.TestCase):
             FreeCAD.closeDocument(copy.Name)
         out = os.path.join(self.tmp, "weights-report")
         write_result_report(objects.registration_result(reg, self.nominal), self.nominal, out,
-                            tolerance=0.04, fit_choice=registration_fit.choice_of(reg))
+                            RunOptions.of(tolerance=0.04,
+                                          fit_choice=registration_fit.choice_of(reg)))
         import json
         with open(os.path.join(out, "result.json")) as fh:
             self.assertEqual(json.load(fh)["weights"], registration_fit.weights_record(reg))

@@ -12,6 +12,7 @@ from BladeInspect.cad.demo_blade import BladeParams
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
 from BladeInspect.inspection import batch as B
+from BladeInspect.inspection.run_options import RunOptions
 from tests import inspection_fixtures as fx
 
 SPAN = BladeParams().span
@@ -112,12 +113,12 @@ class BatchTest(unittest.TestCase):
         out = os.path.join(self.tmp, "lot_again")
         os.makedirs(out)
         shutil.copytree(os.path.join(self.out, "blade_a"), os.path.join(out, "blade_a"))
-        lot = B.run_batch(None, scans, out, workers=1, tolerance=0.03)
+        lot = B.run_batch(None, scans, out, RunOptions.of(tolerance=0.03), workers=1)
         self.assertEqual([r["reused"] for r in lot["rows"]], [False])
         self.assertIn("1 done again", lot["message"])
         with open(os.path.join(out, "blade_a", "result.json")) as fh:
             self.assertEqual(json.load(fh)["tolerance_mm"], 0.03)
-        again = B.run_batch(None, scans, out, workers=1, tolerance=0.03)
+        again = B.run_batch(None, scans, out, RunOptions.of(tolerance=0.03), workers=1)
         self.assertEqual([r["reused"] for r in again["rows"]], [True])
 
     def test_done_means_made_from_these_inputs(self):

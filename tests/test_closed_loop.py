@@ -13,6 +13,7 @@ import numpy as np
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import demo_nominal, sensor_pose_bound
 
 HEIGHTS = (30.0, 70.0)
@@ -56,9 +57,10 @@ class TestInspectLoop(unittest.TestCase):
         cls.cmm = np.vstack(cmm)
         cmm_path = os.path.join(cls.tmp, "cmm.csv")
         np.savetxt(cmm_path, cls.cmm, delimiter=",", header="x,y,z", comments="", fmt="%.6f")
-        cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=nominal, cmm=cmm_path,
-                                  section_heights=HEIGHTS, seed=31, document=False,
-                                  scan_options={"n_sections": 5})
+        cls.summary = run_inspect(None, cls.out,
+                                  RunOptions.of(cmm=cmm_path, section_heights=HEIGHTS, seed=31,
+                                                scan_options={"n_sections": 5}), rig=cls.rig,
+                                  nominal=nominal, document=False)
         with open(os.path.join(cls.out, "result.json")) as fh:
             cls.result_json = json.load(fh)
         with open(os.path.join(cls.out, "scan.json")) as fh:
@@ -158,7 +160,8 @@ class TestInspectErrors(unittest.TestCase):
             out = os.path.join(tmp, "out")
             for bad in ((10, 120), (-1,), ("x",)):
                 with self.assertRaises(InputError) as ctx:
-                    run_inspect(None, out, section_heights=bad, nominal=demo_nominal())
+                    run_inspect(None, out, RunOptions.of(section_heights=bad),
+                                nominal=demo_nominal())
                 self.assertIn("--section-heights", str(ctx.exception))
             self.assertFalse(os.path.exists(out))
             self.assertEqual(os.listdir(tmp), [])

@@ -13,6 +13,7 @@ import numpy as np
 
 from BladeInspect.core.errors import DeviceError
 from BladeInspect.core.pointio import read_points
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import demo_nominal, first_difference, read_json, read_lines
 from tests.test_inspect_resume import HEIGHTS, RESULT_FILES, SCAN_OPTIONS, SEED, simulated_rig
 
@@ -22,9 +23,11 @@ PASSES_BEFORE_FAULT = 3
 
 def inspect_complete(nominal, out, rig, progress=None, resume=False):
     from BladeInspect.inspection.closed_loop import run_inspect
-    return run_inspect(None, out, rig=rig, nominal=nominal, seed=SEED, complete=True,
-                       pitch=PITCH, section_heights=HEIGHTS, document=False,
-                       scan_options=dict(SCAN_OPTIONS), progress=progress, resume=resume)
+    return run_inspect(None, out,
+                       RunOptions.of(seed=SEED, complete=True, pitch=PITCH,
+                                     section_heights=HEIGHTS, scan_options=dict(SCAN_OPTIONS),
+                                     resume=resume), rig=rig, nominal=nominal, document=False,
+                       progress=progress)
 
 
 class TestCompleteResume(unittest.TestCase):

@@ -12,6 +12,7 @@ from scipy.spatial import cKDTree
 
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import InputError
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import demo_nominal
 
 PITCH = 2.0
@@ -169,13 +170,15 @@ class TestInspectComplete(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="bi-complete-")
         cls.out = os.path.join(cls.tmp, "out")
         cls.plans_seen = []     # (plan, rig passes run when it was shown)
-        cls.summary = run_inspect(None, cls.out, rig=cls.rig, nominal=cls.nominal,
-                                  complete=True, pitch=INSPECT_PITCH, seed=SEED, document=False,
-                                  section_heights=HEIGHTS,
+        cls.summary = run_inspect(None, cls.out,
+                                  RunOptions.of(complete=True, pitch=INSPECT_PITCH, seed=SEED,
+                                                section_heights=HEIGHTS,
+                                                scan_options={"n_sections": 5,
+                                                              "point_spacing": 0.25,
+                                                              "probe_spacing": 1.0}),
+                                  rig=cls.rig, nominal=cls.nominal, document=False,
                                   on_plan=lambda plan: cls.plans_seen.append(
-                                      (plan, cls.rig.pass_index)),
-                                  scan_options={"n_sections": 5, "point_spacing": 0.25,
-                                                "probe_spacing": 1.0})
+                                      (plan, cls.rig.pass_index)))
         with open(os.path.join(cls.out, "scan.json")) as fh:
             cls.scan_json = json.load(fh)
         with open(os.path.join(cls.out, "result.json")) as fh:
@@ -247,8 +250,9 @@ class TestInspectComplete(unittest.TestCase):
     def test_bad_pitch_is_input_error(self):
         from BladeInspect.inspection.closed_loop import run_inspect
         with self.assertRaises(InputError):
-            run_inspect(None, os.path.join(self.tmp, "bad"), rig=self.rig, nominal=self.nominal,
-                        complete=True, pitch=0.0, document=False)
+            run_inspect(None, os.path.join(self.tmp, "bad"),
+                        RunOptions.of(complete=True, pitch=0.0), rig=self.rig,
+                        nominal=self.nominal, document=False)
         self.assertFalse(os.path.exists(os.path.join(self.tmp, "bad")))
 
 

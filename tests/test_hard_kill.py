@@ -22,6 +22,7 @@ import numpy as np
 from BladeInspect.core.errors import InputError
 from BladeInspect.core.pointio import read_points
 from BladeInspect.measurement.journal import JOURNAL_FILE, read_journal
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import (cli_process, demo_nominal, first_difference, process_state,
                            read_json, read_lines)
 from tests.serial_support import FakeSimulatedRig, section_path
@@ -150,8 +151,10 @@ class TestInspectKilled(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="bi-kill-")
         ref_out = os.path.join(cls.tmp, "reference")
         rig = sim_rig(cls.nominal)
-        run_inspect(None, ref_out, rig=rig, nominal=cls.nominal, seed=SEED,
-                    section_heights=[float(h) for h in HEIGHTS.split(",")], document=False)
+        run_inspect(None, ref_out,
+                    RunOptions.of(seed=SEED,
+                                  section_heights=[float(h) for h in HEIGHTS.split(",")]), rig=rig,
+                    nominal=cls.nominal, document=False)
         cls.ref_passes = rig.pass_index
         cls.ref_lines = read_lines(os.path.join(ref_out, "points.csv"))
         cls.ref_result = read_json(os.path.join(ref_out, "result.json"))

@@ -22,6 +22,7 @@ import numpy as np
 from BladeInspect.core import transforms as tf
 from BladeInspect.core.errors import DeviceError, InputError
 from BladeInspect.core.pointio import read_points
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import demo_nominal, first_difference, read_json, read_lines
 
 HEIGHTS = (30.0, 70.0)
@@ -61,9 +62,10 @@ class Reference:
         def on_plan(plan):
             self.plans.append(plan)
             self.path_pass.append([])
-        self.summary = run_inspect(None, out, rig=rig, nominal=nominal, seed=SEED,
-                                   section_heights=HEIGHTS, epsilon=EPSILON, document=False,
-                                   scan_options=dict(SCAN_OPTIONS), progress=progress,
+        self.summary = run_inspect(None, out,
+                                   RunOptions.of(seed=SEED, section_heights=HEIGHTS,
+                                                 epsilon=EPSILON, scan_options=dict(SCAN_OPTIONS)),
+                                   rig=rig, nominal=nominal, document=False, progress=progress,
                                    on_plan=on_plan)
         self.points_lines = read_lines(os.path.join(out, "points.csv"))
         self.points = read_points(os.path.join(out, "points.csv"))
@@ -125,9 +127,11 @@ class TestInspectResume(unittest.TestCase):
             try:
                 # The serial rig's sensor model comes from the device's ID: the defaults of
                 # the simulated rig's, so both plan the same paths.
-                return run_inspect(None, cls.out, rig=rig, nominal=cls.nominal, seed=SEED,
-                                   section_heights=HEIGHTS, epsilon=EPSILON, document=False,
-                                   scan_options=dict(SCAN_OPTIONS), resume=resume)
+                return run_inspect(None, cls.out,
+                                   RunOptions.of(seed=SEED, section_heights=HEIGHTS,
+                                                 epsilon=EPSILON, scan_options=dict(SCAN_OPTIONS),
+                                                 resume=resume), rig=rig, nominal=cls.nominal,
+                                   document=False)
             finally:
                 rig.close()
 
@@ -299,9 +303,10 @@ class TestResumeRefusals(unittest.TestCase):
             rig = SerialRig(device.port_url, timeout_s=5)
             try:
                 with contextlib.suppress(DeviceError):
-                    run_inspect(None, cls.out, rig=rig, nominal=cls.nominal, seed=SEED,
-                                section_heights=HEIGHTS, document=False,
-                                scan_options=dict(SCAN_OPTIONS))
+                    run_inspect(None, cls.out,
+                                RunOptions.of(seed=SEED, section_heights=HEIGHTS,
+                                              scan_options=dict(SCAN_OPTIONS)), rig=rig,
+                                nominal=cls.nominal, document=False)
             finally:
                 rig.close()
         cls.files = cls.contents()
@@ -321,11 +326,11 @@ class TestResumeRefusals(unittest.TestCase):
 
     def refused(self, pattern, **options):
         from BladeInspect.inspection.closed_loop import run_inspect
-        kwargs = dict(rig=simulated_rig(self.nominal), nominal=self.nominal, seed=SEED,
-                      section_heights=HEIGHTS, document=False, resume=True)
-        kwargs.update(options)
+        nominal = options.pop("nominal", self.nominal)
+        run_options = RunOptions.of(seed=SEED, section_heights=HEIGHTS, resume=True)
         with self.assertRaisesRegex(InputError, pattern) as ctx:
-            run_inspect(None, self.out, **kwargs)
+            run_inspect(None, self.out, run_options.replace(**options),
+                        rig=simulated_rig(self.nominal), nominal=nominal, document=False)
         self.assertNotIsInstance(ctx.exception, DeviceError)
         self.assertNotIn("\n", str(ctx.exception))
         self.assertEqual(self.contents(), self.files)
@@ -367,8 +372,8 @@ class TestResumeRefusals(unittest.TestCase):
         from BladeInspect.inspection.closed_loop import run_inspect
         empty = os.path.join(self.tmp, "empty")
         with self.assertRaisesRegex(InputError, "holds no interrupted inspection"):
-            run_inspect(None, empty, rig=simulated_rig(self.nominal), nominal=self.nominal,
-                        seed=SEED, resume=True, document=False)
+            run_inspect(None, empty, RunOptions.of(seed=SEED, resume=True),
+                        rig=simulated_rig(self.nominal), nominal=self.nominal, document=False)
         self.assertFalse(os.path.exists(empty))
 
     def test_failure_over_an_earlier_result_leaves_no_result(self):
@@ -389,9 +394,10 @@ class TestResumeRefusals(unittest.TestCase):
             rig = SerialRig(device.port_url, timeout_s=5)
             try:
                 with self.assertRaises(DeviceError):
-                    run_inspect(None, out, rig=rig, nominal=self.nominal, seed=SEED,
-                                section_heights=HEIGHTS, document=False,
-                                scan_options=dict(SCAN_OPTIONS))
+                    run_inspect(None, out,
+                                RunOptions.of(seed=SEED, section_heights=HEIGHTS,
+                                              scan_options=dict(SCAN_OPTIONS)), rig=rig,
+                                nominal=self.nominal, document=False)
             finally:
                 rig.close()
         self.assertEqual(sorted(os.listdir(out)), ["points.csv", "scan.json"])
@@ -447,10 +453,11 @@ class TestCancelledInspectionResumes(unittest.TestCase):
             if (message.startswith("planned scan: path")
                     and rig.pass_index >= inside_second_section):
                 raise Cancelled("inspection cancelled")
-        options = dict(nominal=nominal, seed=SEED, section_heights=HEIGHTS, epsilon=EPSILON,
-                       document=False, scan_options=dict(SCAN_OPTIONS))
+        options = RunOptions.of(seed=SEED, section_heights=HEIGHTS, epsilon=EPSILON,
+                                scan_options=dict(SCAN_OPTIONS))
         with self.assertRaises(Cancelled):
-            run_inspect(None, out, rig=rig, progress=cancel_inside_second_section, **options)
+            run_inspect(None, out, options, rig=rig, nominal=nominal, document=False,
+                        progress=cancel_inside_second_section)
         record = read_json(os.path.join(out, "scan.json"))
         self.assertFalse(record["complete"])
         self.assertEqual(record["inspection"]["phase"], "planned")
@@ -463,7 +470,8 @@ class TestCancelledInspectionResumes(unittest.TestCase):
         blind, ref_blind = (p.xyz[p.columns["phase"] == "blind"] for p in (kept, ref.points))
         np.testing.assert_allclose(blind, ref_blind, atol=1e-6)
 
-        run_inspect(None, out, rig=simulated_rig(nominal), resume=True, **options)
+        run_inspect(None, out, options.replace(resume=True), rig=simulated_rig(nominal),
+                    nominal=nominal, document=False)
         self.assertIsNone(first_difference(read_lines(os.path.join(out, "points.csv")),
                                            ref.points_lines))
         pose = np.asarray(read_json(os.path.join(out, "result.json"))["measured_to_cad"])

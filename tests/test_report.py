@@ -19,6 +19,7 @@ from BladeInspect.core.errors import InputError
 from BladeInspect.inspection import report as R
 from BladeInspect.inspection import sections as S
 from BladeInspect.inspection import verdict as V
+from BladeInspect.inspection.run_options import RunOptions
 from tests import inspection_fixtures as fx
 
 SPAN = BladeParams().span
@@ -227,10 +228,12 @@ class RunReportTest(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(out, "result.json")))
         self.assertEqual([n for n in os.listdir(self.tmp) if n.startswith(".bladeinspect")], [])
         with self.assertRaises(InputError):
-            R.run_report(None, self.points_path, out, nominal=self.nominal, tolerance=0)
+            R.run_report(None, self.points_path, out, RunOptions.of(tolerance=0),
+                         nominal=self.nominal)
         with self.assertRaises(InputError):
-            R.run_report(None, self.points_path, out, nominal=self.nominal,
-                         cmm=os.path.join(self.tmp, "missing_cmm.csv"))
+            R.run_report(None, self.points_path, out,
+                         RunOptions.of(cmm=os.path.join(self.tmp, "missing_cmm.csv")),
+                         nominal=self.nominal)
         self.assertFalse(os.path.exists(os.path.join(out, "result.json")))
 
 

@@ -26,6 +26,7 @@ import unittest
 import numpy as np
 
 from BladeInspect.core import transforms as tf
+from BladeInspect.inspection.run_options import RunOptions
 from tests.helpers import ROTOR67_SECTIONS, have_rotor67, sensor_pose_bound, suction_bump_at
 
 STANDOFF = 44.0
@@ -177,9 +178,10 @@ class TestInspectLoop(unittest.TestCase):
         cls.log = record_passes(rig)
         cls.tmp = tempfile.mkdtemp(prefix="bi-r67-inspect-")
         cls.out = os.path.join(cls.tmp, "out")
-        run_inspect(None, cls.out, rig=rig, nominal=nominal, section_heights=HEIGHTS,
-                    seed=SEED_LOOP, document=False,
-                    scan_options={"n_sections": BLIND_SECTIONS})
+        run_inspect(None, cls.out,
+                    RunOptions.of(section_heights=HEIGHTS, seed=SEED_LOOP,
+                                  scan_options={"n_sections": BLIND_SECTIONS}), rig=rig,
+                    nominal=nominal, document=False)
         with open(os.path.join(cls.out, "result.json")) as fh:
             cls.result = json.load(fh)
         with open(os.path.join(cls.out, "scan.json")) as fh:

@@ -22,6 +22,7 @@ import numpy as np
 
 from tests import inspection_fixtures as fx
 from tests.test_fit_pipeline import T, demo_cloud
+from BladeInspect.inspection.run_options import RunOptions
 
 
 class NotProvenInEveryFileTest(unittest.TestCase):
@@ -63,11 +64,11 @@ class NotProvenInEveryFileTest(unittest.TestCase):
         with open(os.path.join(scans, "blade.csv"), "w") as fh:
             fh.write("x,y,z\n")       # never read: its result.json is already there
         write_result_report(dataclasses.replace(cls.result), cls.nominal,
-                            os.path.join(lot, "out", "blade"), tolerance=T,
-                            heights_pct=cls.heights,
-                            fit_choice=fitting.FitChoice(decision_rule=rule))
-        summary = batch.run_batch(None, scans, os.path.join(lot, "out"), workers=1,
-                                  tolerance=T)
+                            os.path.join(lot, "out", "blade"),
+                            RunOptions.of(tolerance=T, section_heights=cls.heights,
+                                          fit_choice=fitting.FitChoice(decision_rule=rule)))
+        summary = batch.run_batch(None, scans, os.path.join(lot, "out"),
+                                  RunOptions.of(tolerance=T), workers=1)
         return os.path.join(lot, "out", "blade"), summary["summary_csv"]
 
     def files(self, rule):

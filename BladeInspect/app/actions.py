@@ -236,6 +236,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
     under "objects"."""
     from ..inspection import airfoil_stage as airfoil_mod
     from ..inspection.closed_loop import run_inspect
+    from ..inspection.run_options import RunOptions
     from . import airfoil_objects, loop
     airfoil_options = airfoil_mod.options_from_args() if airfoil else None
     doc = _document(doc_name)
@@ -246,10 +247,11 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
     p = _progress()
     with objects.building(doc, "Inspect"), inspection_rig(nominal_obj, seed, rig_file) as rig:
         summary = run_inspect(
-            getattr(nominal_obj, "SourceFile", "") or None, out_dir, rig_spec="sim",
-            section_heights=heights, tolerance=tolerance, seed=seed, rig_file=rig_file,
-            progress=p, rig=rig, nominal=objects.nominal_of(nominal_obj), document=False,
-            on_plan=_INTERACTIVE["on_plan"], fit_choice=choice, airfoil=airfoil_options)
+            getattr(nominal_obj, "SourceFile", "") or None, out_dir,
+            RunOptions(section_heights=heights, tolerance=tolerance, seed=seed,
+                       rig_file=rig_file, fit_choice=choice, airfoil=airfoil_options),
+            rig=rig, nominal=objects.nominal_of(nominal_obj), progress=p, document=False,
+            on_plan=_INTERACTIVE["on_plan"])
         result = summary["result"]
         p(0.95, "adding the inspection to the document")
         points_csv = os.path.join(out_dir, "points.csv")

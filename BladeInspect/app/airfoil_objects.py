@@ -3,7 +3,7 @@ LE/TE edge circles of the nominal profile (the CAD's exact cut) and of the measu
 section's registered points), as FeaturePython objects in an "Airfoil" group beside the
 section profiles. Each keeps its plane and links as inputs and rebuilds its shape when the
 nominal's shape, the registration's points or the plane change (a signature is stored, so
-opening a document is cheap); the numbers come from inspection.airfoil.run_stage, the same
+opening a document is cheap); the numbers come from inspection.airfoil_stage.run_stage, the same
 stage the `airfoil` and `report --airfoil` commands run.
 
 No GUI imports: view providers come from the gui layer's hook (objects.set_view_provider_hook)."""
@@ -195,7 +195,7 @@ def _make(doc, cls, name, section, profile, ch, registration, nominal_obj, opts)
 
 
 def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
-    """A group holding, per section of ``stage`` (inspection.airfoil.Stage), a CamberLine and
+    """A group holding, per section of ``stage`` (inspection.airfoil_stage.Stage), a CamberLine and
     an EdgeCircles of the nominal profile and, where the section was measured, of the measured
     one; the stage's blocks (result.json's ``airfoil``) kept on the group for the table."""
     made = []

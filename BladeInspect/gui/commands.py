@@ -15,6 +15,7 @@ from ..app import actions, objects, registration_fit, settings
 from ..app.document import write_inspection_document
 from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
+from ..inspection.run_options import ReportSources, RunOptions
 from ..measurement.scan import open_rig
 from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
 from .command_base import Command, find_measurement, find_nominal, find_registration
@@ -415,10 +416,10 @@ class Report(Command):
             nominal = objects.nominal_of(nominal_obj)
             result = objects.registration_result(registration, nominal)
             result.cad_source = cad_path or "built-in demo blade"
-            return write_result_report(result, nominal, out_dir,
-                                       tolerance=settings.value("ToleranceMm"), progress=p,
-                                       document=writer, cad_path=cad_path,
-                                       fit_choice=registration_fit.choice_of(registration))
+            options = RunOptions(tolerance=settings.value("ToleranceMm"),
+                                 fit_choice=registration_fit.choice_of(registration))
+            return write_result_report(result, nominal, out_dir, options, progress=p,
+                                       document=writer, sources=ReportSources(cad_path=cad_path))
         doc = registration.Document
         try:
             return progress.run(translate("BladeInspect", "Report"), job)

@@ -230,7 +230,7 @@ def airfoil_rows(blocks):
     """The characteristics table's rows: per section a group line ``[text, verdict]``, then
     per characteristic [key, name, unit, nominal, actual, deviation, U (k = 2; the decision's,
     else 2u of the block's standard uncertainty), tolerance, verdict] (from
-    inspection.airfoil.csv_rows, by its column names)."""
+    inspection.airfoil_stage.csv_rows, by its column names)."""
     by_label = {b["label"]: b for b in blocks}
     rows, shown = [], None
     for row in airfoil_mod.csv_rows(blocks):

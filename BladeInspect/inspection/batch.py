@@ -28,6 +28,7 @@ import socket
 import sys
 import threading
 import time
+from dataclasses import dataclass
 
 from ..core.atomic_file import atomic_write
 from ..core.contracts import BUILTIN_CADS, PROFILE_TOLERANCE_MM
@@ -35,6 +36,7 @@ from ..core.errors import InputError
 from . import airfoil_stage as airfoil_mod
 from .pipeline import load_nominal
 from .report import run_report
+from .run_options import RunOptions
 
 POINT_EXTENSIONS = (".csv", ".xyz", ".asc", ".txt", ".ply", ".pcd")
 SUMMARY_FIELDS = ["file", "status", "n_points", "rms_mm", "worst_deviation_mm", "verdict",
@@ -143,14 +145,14 @@ def _read_done(folder, record=None):
     return doc if doc.get("tolerance_mm") == record["tolerance_mm"] else None
 
 
-def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
-               allow_mismatch=False, airfoil=None, fit_choice=None, document=None,
-               measurement_model=None, record=None):
+def report_one(cad_path, points_path, folder, options, attempt_log=None, document=None,
+               record=None):
     """One file of the lot, in whichever process runs it: a summary row, never an exception.
-    ``attempt_log``: the file this run is recorded in before it begins; ``document``: as for
-    run_report (a module-level function, so that it pickles to a worker process);
-    ``measurement_model``: as for run_report (read from the lot's RIG.json once, by run_batch);
-    ``record``: the file's inputs (inputs_record), kept in its result.json."""
+    ``options``: the lot's RunOptions (inspection.run_options), as for run_report (its
+    measurement model read from the lot's RIG.json once, by run_batch); ``attempt_log``: the
+    file this run is recorded in before it begins; ``document``: as for run_report (a
+    module-level function, so that it pickles to a worker process); ``record``: the file's
+    inputs (inputs_record), kept in its result.json."""
     # A Dask worker is a plain Python process, perhaps on another machine: FreeCAD is started
     # there as the command line starts it, with its module folders on the path (FreeCAD 1.0's
     # Part needs them, or crashes).
@@ -160,10 +162,8 @@ def report_one(cad_path, points_path, folder, tolerance, seed, attempt_log=None,
     if attempt_log is not None:
         _record_attempt(attempt_log)
     try:
-        run_report(cad_path, points_path, folder, tolerance=tolerance, seed=seed,
-                   nominal=_nominal_for(cad_path), allow_mismatch=allow_mismatch,
-                   airfoil=airfoil, fit_choice=fit_choice, document=document,
-                   measurement_model=measurement_model, batch_inputs=record)
+        run_report(cad_path, points_path, folder, options, nominal=_nominal_for(cad_path),
+                   document=document, batch_inputs=record)
     except InputError as exc:
         return {"file": name, "status": "error", "error": str(exc)}
     except Exception as exc:  # a bug on one blade must not stop the line; it is reported
@@ -221,21 +221,20 @@ def _csv_value(v):
     return v
 
 
-def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
-              tolerance=PROFILE_TOLERANCE_MM, seed=0, progress=None,
-              allow_mismatch=False, airfoil=None, fit_choice=None, document=None,
-              measurement_model=None):
+def run_batch(cad_path, scans_dir, out_dir, options=None, workers=None, scheduler=None,
+              progress=None, document=None):
     """Report every point file of ``scans_dir`` into ``out_dir``/<stem>/ and write
     ``out_dir``/summary.csv. ``workers`` processes (default: one per CPU; 1 runs here), or the
     Dask cluster at ``scheduler`` ('tcp://HOST:PORT'). Returns {'rows': the summary rows in
     file order, each with 'reused' True when the file was already done, 'summary_csv': path,
-    'message': one line for the command line}. ``allow_mismatch``, ``airfoil``, ``fit_choice``:
-    as for `report`; with ``airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil);
-    ``document``: the writer of each file's inspection.FCStd, as for report.run_report;
-    ``measurement_model``: inspection.uncertainty.MeasurementModel of every blade's U (the rig
-    calibration's term from `--rig-file`), as for report.run_report."""
+    'message': one line for the command line}. ``options``: inspection.run_options.RunOptions
+    of every file, as for `report` (its tolerance, seed, allow_mismatch, airfoil, fit and
+    measurement model, the rig calibration's term from `--rig-file`, make the inputs record);
+    with ``options.airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil);
+    ``document``: the writer of each file's inspection.FCStd, as for report.run_report."""
+    options = options or RunOptions()
     progress = progress or (lambda f, m: None)
-    tolerance = float(tolerance)
+    tolerance = float(options.tolerance)
     if not tolerance > 0:
         raise InputError("--tolerance: must be a positive number of mm, got %r" % (tolerance,))
     if cad_path is not None and not os.path.exists(cad_path) and cad_path not in BUILTIN_CADS:
@@ -244,14 +243,16 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
     os.makedirs(out_dir, exist_ok=True)
     summary_path = os.path.join(out_dir, "summary.csv")
 
-    options = lot_options(cad_path, tolerance, seed, allow_mismatch, airfoil, fit_choice,
-                          measurement_model)
+    options = options.replace(tolerance=tolerance)
+    lot = _Lot(cad_path, out_dir, options, document, {})
+    inputs = lot_options(cad_path, tolerance, options.seed, options.allow_mismatch,
+                         options.airfoil, options.fit_choice, options.measurement_model)
     rows = {}
     todo = []
-    records = {}
+    records = lot.records
     redone = 0
     for stem, path in files:
-        records[stem] = inputs_record(path, options)
+        records[stem] = inputs_record(path, inputs)
         folder = os.path.join(out_dir, stem)
         doc = _read_done(folder, records[stem])
         if doc is not None:
@@ -269,14 +270,12 @@ def run_batch(cad_path, scans_dir, out_dir, workers=None, scheduler=None,
 
     t0 = time.perf_counter()
     if todo and scheduler:
-        _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                  airfoil, fit_choice, document, measurement_model, records)
+        _run_dask(scheduler, lot, todo, finished)
     elif todo:
-        _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-                   airfoil, fit_choice, document, measurement_model, records)
+        _run_local(workers, lot, todo, finished)
     ordered = [rows[s] for s, _ in files]
     write_summary(summary_path, ordered)
-    airfoil_mod.write_lot_csv(out_dir, files)  # issue 15 hook: summary_airfoil.csv
+    airfoil_mod.write_lot_csv(out_dir, files)   # summary_airfoil.csv
     # Every file is reported: the attempt counts are in the summary.
     shutil.rmtree(os.path.join(out_dir, ATTEMPTS_FOLDER), ignore_errors=True)
     count = {k: sum(1 for r in ordered if r["status"] == "ok" and r["verdict"] == k)
@@ -317,36 +316,45 @@ def _attempt_log(out_dir, stem):
     return os.path.join(os.path.abspath(out_dir), ATTEMPTS_FOLDER, stem)
 
 
-def _run_local(workers, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-               airfoil=None, fit_choice=None, document=None, measurement_model=None,
-               records=None):
-    records = records or {}
+@dataclass
+class _Lot:
+    """What every file of a lot is reported with: the CAD, the lot's folder, the RunOptions,
+    the document writer and each file's inputs record (by stem)."""
+    cad_path: object
+    out_dir: str
+    options: RunOptions
+    document: object
+    records: dict
+
+
+def _run_local(workers, lot, todo, finished):
+    """The files ``todo`` of the ``lot`` in ``workers`` processes (1: here), ``finished``
+    called with each file's row."""
+    cad_path, out_dir, records = lot.cad_path, lot.out_dir, lot.records
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if workers < 1:
         raise InputError("--workers: must be at least 1, got %d" % workers)
     if workers == 1 or len(todo) == 1:
         for stem, path in todo:
-            finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem), tolerance,
-                                      seed, _attempt_log(out_dir, stem), allow_mismatch,
-                                      airfoil, fit_choice, document, measurement_model,
+            finished(stem, report_one(cad_path, path, os.path.join(out_dir, stem),
+                                      lot.options, _attempt_log(out_dir, stem), lot.document,
                                       records.get(stem)))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=min(workers, len(todo)),
                              mp_context=_spawn_context()) as pool:
         futures = {pool.submit(report_one, cad_path, path, os.path.join(out_dir, stem),
-                               tolerance, seed, _attempt_log(out_dir, stem), allow_mismatch,
-                               airfoil, fit_choice, document, measurement_model,
+                               lot.options, _attempt_log(out_dir, stem), lot.document,
                                records.get(stem)):
                    stem for stem, path in todo}
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
 
 
-def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, allow_mismatch,
-              airfoil=None, fit_choice=None, document=None, measurement_model=None,
-              records=None):
-    records = records or {}
+def _run_dask(scheduler, lot, todo, finished):
+    """The files ``todo`` of the ``lot`` on the Dask cluster at ``scheduler``, ``finished``
+    called with each file's row."""
+    cad_path, out_dir, records = lot.cad_path, lot.out_dir, lot.records
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -363,9 +371,9 @@ def _run_dask(scheduler, cad_path, out_dir, todo, tolerance, seed, finished, all
         cad = os.path.abspath(cad_path) if cad_path is not None else None
         for stem, path in todo:
             fut = client.submit(report_one, cad, os.path.abspath(path),
-                                os.path.join(os.path.abspath(out_dir), stem), tolerance, seed,
-                                _attempt_log(out_dir, stem), allow_mismatch, airfoil, fit_choice,
-                                document, measurement_model, records.get(stem), pure=False)
+                                os.path.join(os.path.abspath(out_dir), stem), lot.options,
+                                _attempt_log(out_dir, stem), lot.document, records.get(stem),
+                                pure=False)
             stems[fut.key] = stem
             futures.append(fut)
         for fut in as_completed(futures):

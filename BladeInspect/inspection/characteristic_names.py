@@ -109,7 +109,7 @@ PART = QT_TRANSLATE_NOOP("BladeInspect", "Part")
 SECTION = QT_TRANSLATE_NOOP("BladeInspect", "Section %s")
 PART_VERDICT = QT_TRANSLATE_NOOP("BladeInspect", "Part verdict")
 
-# The airfoil verdict's line (inspection.airfoil.stage_verdict's summary) in display names;
+# The airfoil verdict's line (inspection.airfoil_verdicts.stage_verdict's summary) in display names;
 # result.json's ``summary`` keeps the field names, which files, scripts and tests match.
 AIRFOIL_VERDICT_LINES = {
     None: QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: no characteristic toleranced"),
@@ -118,7 +118,7 @@ AIRFOIL_VERDICT_LINES = {
                                                     "characteristics: %s"),
     "pass": QT_TRANSLATE_NOOP("BladeInspect", "Airfoil: PASS (%d characteristics)"),
 }
-NOT_MEASURED = " (not measured)"   # inspection.airfoil._judge's suffix of an unmeasured key
+NOT_MEASURED = " (not measured)"   # inspection.airfoil_verdicts.judge's suffix of an unmeasured key
 NOT_MEASURED_NAME = QT_TRANSLATE_NOOP("BladeInspect", "%s (not measured)")
 
 # Verdicts as core.decision and inspection.airfoil write them, marked so that they are
@@ -238,7 +238,7 @@ def airfoil_verdict_text(verdict, blocks=(), tr=_same):
 
 
 def part_summary_text(summary, airfoil_verdict, blocks=(), tr=_same):
-    """The part verdict's summary with the airfoil clause inspection.airfoil.attach appended
+    """The part verdict's summary with the airfoil clause inspection.airfoil_stage.attach appended
     (the stage's summary, field names) in display names; as it is without that clause."""
     clause = (airfoil_verdict or {}).get("summary")
     if not clause or clause not in summary:

@@ -215,21 +215,25 @@ def _saved_checkpoint(record_path):
     return state
 
 
-def inspection_identity(nominal, seed, heights, complete, pitch, epsilon, kinematics, scan_options,
-                        edge_radius_sigma_mm=None):
+def inspection_identity(nominal, run_options, kinematics):
     """What a resumed inspection must share with the interrupted one to measure the same
-    points (JSON-ready). ``scan_options`` None: whatever the interrupted run used;
-    ``edge_radius_sigma_mm`` the planned sections' edge-density target (None: off)."""
+    points (JSON-ready): of ``run_options`` (inspection.run_options.RunOptions, checked) the
+    seed, section heights and the loop's options. Its ``loop.scan_options`` None: whatever the
+    interrupted run used; ``loop.edge_radius_sigma_mm`` the planned sections' edge-density
+    target (None: off)."""
+    loop = run_options.loop
     options = None
-    if scan_options is not None:
-        options = contracts.json_ready(scan_options)
+    if loop.scan_options is not None:
+        options = contracts.json_ready(loop.scan_options)
+    sigma = loop.edge_radius_sigma_mm
     return {"cad_bbox": np.asarray(nominal.bbox_corners, dtype=float).tolist(),
-            "seed": int(seed), "section_heights": [float(h) for h in heights],
-            "complete": bool(complete), "pitch_mm": float(pitch) if complete else None,
-            "epsilon_mm": float(epsilon), "kinematics": kinematics.to_dict(),
+            "seed": int(run_options.seed),
+            "section_heights": [float(h) for h in run_options.section_heights],
+            "complete": bool(loop.complete),
+            "pitch_mm": float(loop.pitch) if loop.complete else None,
+            "epsilon_mm": float(loop.epsilon), "kinematics": kinematics.to_dict(),
             "scan_options": options,
-            "edge_radius_sigma_mm": (None if edge_radius_sigma_mm is None
-                                     else float(edge_radius_sigma_mm))}
+            "edge_radius_sigma_mm": None if sigma is None else float(sigma)}
 
 
 IDENTITY_FLAGS = (("cad_bbox", "the CAD (its bounding box)"), ("seed", "--seed"),

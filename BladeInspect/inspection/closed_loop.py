@@ -19,8 +19,8 @@ scan.json (the blind scan's record, the planned passes, the simulator's truth), 
 
 A rig failure (DeviceError), a cancel or Ctrl-C mid-loop leaves DIR a checkpoint instead:
 points.csv up to the last completed blind section, planned section or raster pass, plan.json,
-and scan.json marked incomplete with the loop's state under "inspection" (no result files). ``resume=True`` (the
-CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
+and scan.json marked incomplete with the loop's state under "inspection" (no result files).
+``options.loop.resume`` (the CLI's --resume) continues it on a fresh rig and ends as the uninterrupted run would have:
 measured data is kept section by section in DIR/.checkpoint while the loop runs
 (inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
@@ -31,6 +31,7 @@ checkpoint's fields.
 import json
 import os
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,7 +42,7 @@ from ..core import stats as stats_mod
 from ..core.pointio import PointSet, write_points_csv
 from ..measurement import scan as scan_mod
 from ..measurement.complete import check_step, plan_complete, scan_complete
-from ..measurement.planning import DEFAULT_EDGE_RADIUS_SIGMA_MM, edge_radius_sigma, plan_sections
+from ..measurement.planning import edge_radius_sigma, plan_sections
 from ..rig.kinematics import RigKinematics
 from . import airfoil_stage as airfoil_mod
 from . import pipeline
@@ -52,8 +53,8 @@ from .checkpoint import LIVE_FOLDER, Checkpoint, inspection_identity, save_plan,
 from .checks import unmeasured_warning
 from .report import write_report
 from .result import RegistrationResult
+from .run_options import RegisterOptions, RunOptions
 
-EPSILON_MM = 2.0
 # The planned points must lie within 0.01 mm of their nominal planes: a pose that moves them by
 # more than a quarter of that budget (5 um, the fraction 1/400 of the 2 mm epsilon) is worth a
 # re-plan. The standoff criterion epsilon itself is far looser than the plane budget.
@@ -134,19 +135,40 @@ def pose_change_mm(old_table_to_cad, new_table_to_cad, cad_points):
     return float(np.max(np.linalg.norm(old - new, axis=1)))
 
 
-def _result_of_all(nominal, blind, blind_sections, later, phase, xyz, snr, fit, first, timing,
-                   cad_label, source):
+def _result_of_all(run, phase, blind, blind_sections, later, points, fit, first):
     """points.csv's extra columns and the RegistrationResult of the blind rows followed by
-    those measured after them (``later``: xyz, snr, section, angle_deg; tagged ``phase``)."""
+    those measured after them (``later``: xyz, snr, section, angle_deg; tagged with the
+    ``phase``'s name), ``points`` (xyz, snr) all of them, registered by ``fit``."""
     n_blind = len(blind.xyz)
+    xyz, snr = points
     columns = {"section": np.concatenate([blind_sections, later[2]]),
                "angle_deg": np.concatenate([_blind_column(blind, "angle_deg", n_blind),
                                             later[3]]),
-               "phase": np.array(["blind"] * n_blind + [phase] * len(later[0]))}
-    result = _result_from_fit(nominal, _pointset(xyz, snr, columns, source), fit, first.coarse,
-                              dict(timing), list(first.warnings))
-    result.cad_source = cad_label
+               "phase": np.array(["blind"] * n_blind + [phase.name] * len(later[0]))}
+    result = _result_from_fit(run.nominal, _pointset(xyz, snr, columns, phase.source), fit,
+                              first.coarse, dict(run.timing), list(first.warnings))
+    result.cad_source = run.cad_label
     return columns, result
+
+
+def _fit_all_points(run, phase, points, pose):
+    """The fine ICP of every point (``points``: xyz, snr, rotary angle) from ``pose``,
+    weighted by the run's weight model (inspection.weighting), its beams turned back by the
+    run's kinematics. Returns (the fit, the weights' record)."""
+    xyz, snr, angles = points
+    weight_model, weights_record = weighting.weights_for_rows(
+        xyz, snr, angles, run.register_options.weights, run.kinematics, phase.source)
+    fit = pipeline.fine_register(xyz, snr, run.nominal, pose,
+                                 progress=lambda f, m: run.progress(phase.fit_progress, m),
+                                 weight_model=weight_model,
+                                 systematic_mm=run.rig.sensor.accuracy)
+    return fit, weights_record
+
+
+def _add_airfoil(run, result, table, verdict):
+    """The airfoil characteristics into the table and the verdict, when the run asks."""
+    if run.options.airfoil is not None:
+        airfoil_mod.attach(result, run.nominal, table, verdict, run.options.airfoil)
 
 
 def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
@@ -194,25 +216,38 @@ def _pointset(xyz, snr, columns, source):
                     columns=columns, n_rows_skipped=0, source=source)
 
 
-def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SECTION_HEIGHTS_PCT,
-                complete=False, pitch=0.1, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
-                seed=0, rig_file=None,
-                progress=None, rig=None, nominal=None, epsilon=EPSILON_MM, document=None,
-                scan_options=None, on_plan=None, resume=False, flip_faces=(),
-                allow_mismatch=False, airfoil=None, fit_choice=None, measurement_model=None,
-                edge_radius_sigma_mm=DEFAULT_EDGE_RADIUS_SIGMA_MM):
-    """The `inspect` command (see the module notes). ``rig`` (an open Rig) and ``nominal``
-    replace opening them from ``rig_spec`` and ``cad_path``: tests and the GUI pass their own.
-    ``scan_options``: options of the blind scan (measurement.scan.scan_to_dir, e.g. n_sections).
-    ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
-    ``resume``: continue the interrupted inspection in out_dir (same CAD, seed and options;
-    ``scan_options`` None takes the interrupted run's). ``flip_faces``: CAD faces whose
-    outward side is reversed (``--flip-face``, cad.orient). ``allow_mismatch``: go on with a
-    blind scan that does not fit the CAD, with the warning (pipeline.register). ``airfoil``: an
-    inspection.airfoil.Options to add the airfoil characteristics (issue 15; None: none).
-    ``fit_choice``, ``measurement_model``: the fit and the decision, as for `report`.
-    ``edge_radius_sigma_mm``: the planned sections' edge-density target (issue 15 item 7,
-    measurement.planning; None, 0 or "off": the rule off).
+@dataclass
+class _Inspection:
+    """One inspection once opened: the nominal, the rig and its kinematics, the options
+    (checked, RunOptions), those of its registrations, the CMM's table, the CAD's name in the
+    result, the output and checkpoint, the timings, and the caller's progress, document
+    writer and plan viewer."""
+    nominal: object
+    rig: object
+    kinematics: RigKinematics
+    options: RunOptions
+    register_options: RegisterOptions
+    cmm_data: object
+    cad_label: str
+    out: object
+    checkpoint: Checkpoint
+    timing: dict
+    progress: object
+    document: object
+    on_plan: object
+
+
+def run_inspect(cad_path, out_dir, options=None, rig=None, nominal=None, progress=None,
+                document=None, on_plan=None):
+    """The `inspect` command (see the module notes) with ``options`` (RunOptions; its
+    ``loop`` the loop's own, LoopOptions). ``rig`` (an open Rig) and ``nominal`` replace
+    opening them from ``options.loop.rig_spec`` and ``cad_path``: tests and the GUI pass their
+    own. ``on_plan(plan)`` sees each plan before its paths are scanned (the GUI draws them).
+    ``options.loop.resume``: continue the interrupted inspection in out_dir (same CAD, seed
+    and options). ``options.allow_mismatch``: go on with a blind scan that does not fit the
+    CAD, with the warning (pipeline.register). ``options.airfoil``: adds the airfoil
+    characteristics (None: none). ``options.fit_choice``, ``options.measurement_model``: the
+    fit and the decision, as for `report`.
     ``document``: the writer of inspection.FCStd (app.document.write_inspection_document, which
     this layer cannot import), or None for no document. Returns a summary dict.
     The result files appear in out_dir together, or none: on a
@@ -221,45 +256,31 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     progress = progress or _no_progress
     if not out_dir:
         raise InputError("--out: a folder is required")
-    heights = contracts.section_heights(section_heights)
-    tolerance = contracts.profile_tolerance(tolerance)
-    if complete:
-        pitch = check_step(pitch, "--pitch")
-    cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
-    edge_radius_sigma_mm = edge_radius_sigma(edge_radius_sigma_mm)
-    if scan_options is not None or not resume:
-        scan_options = dict(scan_options or {})
-        scan_options.setdefault("epsilon", epsilon)
+    options, cmm_data = _checked(options or RunOptions())
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
-        nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
-    kinematics = RigKinematics.from_json(rig_file) if rig_file else RigKinematics()
-    identity = inspection_identity(nominal, seed, heights, complete, pitch, epsilon,
-                                   kinematics, scan_options, edge_radius_sigma_mm)
+        nominal = pipeline.load_nominal(cad_path, flip_faces=options.flip_faces)
+    kinematics = (RigKinematics.from_json(options.rig_file) if options.rig_file
+                  else RigKinematics())
+    identity = inspection_identity(nominal, options, kinematics)
     opened = rig is None
     if opened:
-        rig = scan_mod.open_rig(rig_spec, nominal=nominal, seed=seed, kinematics=kinematics)
+        rig = scan_mod.open_rig(options.loop.rig_spec, nominal=nominal, seed=options.seed,
+                                kinematics=kinematics)
     timing["load"] = time.perf_counter() - t0
     try:
         with pipeline.AtomicOutput(out_dir) as out:
             checkpoint = Checkpoint(os.path.join(os.path.abspath(out_dir), LIVE_FOLDER),
-                                    out_dir, identity, rig, resume)
-            scan_options = dict(checkpoint.identity["scan_options"] or {})
-            register_options = {"allow_mismatch": allow_mismatch, "tolerance": tolerance,
-                                "cad_source": cad_path or "the demo blade",
-                                "weights": getattr(fit_choice, "weights", None)}  # issue 16
-            judge_options = {"fit_choice": fit_choice,   # hook: issue 16
-                             "measurement_model": measurement_model}
-            phase = (_RasterPhase(nominal, checkpoint.rig, kinematics, epsilon, pitch)
-                     if complete else
-                     _SectionsPhase(nominal, checkpoint.rig, kinematics, epsilon, pitch,
-                                    edge_radius_sigma_mm))
+                                    out_dir, identity, rig, options.loop.resume)
+            options = options.replace(
+                scan_options=dict(checkpoint.identity["scan_options"] or {}))
+            run = _Inspection(nominal, checkpoint.rig, kinematics, options,
+                              options.register_options(cad_path or "the demo blade"), cmm_data,
+                              cad_path or "built-in demo blade", out, checkpoint, timing,
+                              progress, document, on_plan)
             try:
-                summary = _loop(phase, nominal, checkpoint.rig, kinematics, heights, seed,
-                                cmm_data, tolerance, out, checkpoint, timing, progress,
-                                document, scan_options, cad_path or "built-in demo blade",
-                                register_options, on_plan, judge_options, airfoil)
+                summary = _loop(_phase_of(run), run)
             except (DeviceError, Cancelled, KeyboardInterrupt):
                 # An inspection interrupted midway keeps what it measured.
                 checkpoint.keep()
@@ -277,22 +298,49 @@ def run_inspect(cad_path, out_dir, rig_spec="sim", section_heights=contracts.SEC
     return summary
 
 
-def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-                 scan_share, register_share, **register_options):
+def _checked(options):
+    """(``options`` with the heights, tolerance, pitch and edge rule checked (InputError naming
+    the flag) and the blind scan's epsilon set, the CMM's table or None)."""
+    loop = options.loop
+    heights = contracts.section_heights(options.section_heights)
+    tolerance = contracts.profile_tolerance(options.tolerance)
+    pitch = check_step(loop.pitch, "--pitch") if loop.complete else loop.pitch
+    cmm_data = sections_mod.read_cmm(options.cmm) if options.cmm is not None else None
+    sigma = edge_radius_sigma(loop.edge_radius_sigma_mm)
+    scan_options = loop.scan_options
+    if scan_options is not None or not loop.resume:
+        scan_options = dict(scan_options or {})
+        scan_options.setdefault("epsilon", loop.epsilon)
+    checked = options.replace(section_heights=heights, tolerance=tolerance, pitch=pitch,
+                              edge_radius_sigma_mm=sigma, scan_options=scan_options)
+    return checked, cmm_data
+
+
+def _phase_of(run):
+    """The phase after the blind scan: the complete raster or the planned sections."""
+    loop = run.options.loop
+    if loop.complete:
+        return _RasterPhase(run.nominal, run.rig, run.kinematics, loop.epsilon, loop.pitch)
+    return _SectionsPhase(run.nominal, run.rig, run.kinematics, loop.epsilon, loop.pitch,
+                          loop.edge_radius_sigma_mm)
+
+
+def _blind_stage(run, scan_share, register_share):
     """The blind section scan into the checkpoint and its registration: nothing is known of
     the pose yet, so only what the sensor reads is used. A resumed inspection continues an
-    interrupted blind scan (scan_to_dir's own resume) or reads the finished one back.
-    ``register_options``: pipeline.register's allow_mismatch, tolerance, cad_source and
-    weights (their beams turned back by ``kinematics``).
+    interrupted blind scan (scan_to_dir's own resume) or reads the finished one back. The
+    registration's weights have their beams turned back by the run's kinematics; the scan and
+    the registration take ``scan_share`` and ``register_share`` of the progress.
     Returns (the blind scan's record, points, rig time spent, registration)."""
+    nominal, checkpoint, timing, progress = run.nominal, run.checkpoint, run.timing, run.progress
     t0 = time.perf_counter()
     state = checkpoint.state
     if state is None or state["phase"] == "blind":
         progress(0.0, "blind section scan" + (" (resumed)" if state else ""))
-        scan_mod.scan_to_dir(checkpoint.folder, rig, seed=seed, kinematics=kinematics,
-                             resume=state is not None, phase="blind",
-                             progress=lambda f, m: progress(scan_share * f, m),
-                             on_record=checkpoint.mark_blind, **scan_options)
+        scan_mod.scan_to_dir(checkpoint.folder, run.rig, seed=run.options.seed,
+                             kinematics=run.kinematics, resume=state is not None,
+                             phase="blind", progress=lambda f, m: progress(scan_share * f, m),
+                             on_record=checkpoint.mark_blind, **run.options.loop.scan_options)
         blind_rig_s = checkpoint.rig_s()
     else:
         blind_rig_s = float(state["blind_rig_s"])
@@ -304,9 +352,9 @@ def _blind_stage(nominal, rig, kinematics, seed, checkpoint, timing, progress, s
     timing["blind_scan"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     first = pipeline.register(
-        nominal, blind, seed=seed,
+        nominal, blind, seed=run.options.seed,
         progress=lambda f, m: progress(scan_share + register_share * f, m),
-        rig_kinematics=kinematics, **register_options)
+        options=run.register_options, rig_kinematics=run.kinematics)
     timing["register_blind"] = time.perf_counter() - t0
     if state is not None and state["phase"] != "blind":
         # The saved pose plans the rest; a registration that no longer lands there means the
@@ -486,17 +534,18 @@ class _RasterPhase:
         return {"complete_rig_s": rig_s, "complete_simulated_s": timing["complete_scan"]}
 
 
-def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, out, checkpoint,
-          timing, progress, document, scan_options, cad_label, register_options, on_plan,
-          judge_options=None, airfoil=None):
-    """The inspection after opening: the blind stage, then ``phase`` planned from its pose,
-    scanned unit by unit into the checkpoint, ICP on every point (and the phase's re-plan),
-    Table 2 at the nominal sections, the verdict and the result files in ``out``."""
+def _loop(phase, run):
+    """The inspection ``run`` after opening: the blind stage, then ``phase`` planned from its
+    pose, scanned unit by unit into the checkpoint, ICP on every point (and the phase's
+    re-plan), Table 2 at the nominal sections, the verdict and the result files in its
+    output."""
+    nominal, rig, checkpoint, timing, progress = (run.nominal, run.rig, run.checkpoint,
+                                                  run.timing, run.progress)
+    out, tolerance = run.out, run.options.tolerance
     # 1-2. blind section scan and its registration
     resumed = checkpoint.state if (checkpoint.state or {}).get("phase") == phase.name else None
-    scan_record, blind, blind_rig_s, first = _blind_stage(
-        nominal, rig, kinematics, seed, checkpoint, timing, progress, scan_options,
-        scan_share=phase.scan_share, register_share=phase.register_share, **register_options)
+    scan_record, blind, blind_rig_s, first = _blind_stage(run, phase.scan_share,
+                                                          phase.register_share)
     n_blind = len(blind.xyz)
     blind_sections = _blind_column(blind, "section", n_blind)
     # The units measured after the blind scan are numbered after its sections, so a `report`
@@ -514,10 +563,10 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     for attempt in range(int(state.get("attempt", 0)), phase.attempts):
         pose = np.asarray(state["plan_pose"], dtype=float)
         t0 = time.perf_counter()
-        plan = phase.plan(pose, attempt, heights, span_axis, progress)
+        plan = phase.plan(pose, attempt, run.options.section_heights, span_axis, progress)
         timing[phase.plan_timing[attempt]] = time.perf_counter() - t0
-        if on_plan is not None:
-            on_plan(plan)
+        if run.on_plan is not None:
+            run.on_plan(plan)
         save_plan(plan, checkpoint)
         # Units measured before an interruption are read back; this run's are kept too.
         earlier = checkpoint.rows(phase.name) if state[phase.done_key] else None
@@ -544,13 +593,8 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
         t0 = time.perf_counter()
         xyz = np.vstack([blind.xyz, measured[0]])
         snr = np.concatenate([blind.snr, measured[1]])
-        weight_model, weights_record = weighting.weights_for_rows(   # hook: issue 16 item 3
-            xyz, snr, np.concatenate([_blind_column(blind, "angle_deg", n_blind), measured[3]]),
-            register_options["weights"], kinematics, phase.source)
-        fit = pipeline.fine_register(xyz, snr, nominal, pose,
-                                     progress=lambda f, m: progress(phase.fit_progress, m),
-                                     weight_model=weight_model,
-                                     systematic_mm=rig.sensor.accuracy)
+        angles = np.concatenate([_blind_column(blind, "angle_deg", n_blind), measured[3]])
+        fit, weights_record = _fit_all_points(run, phase, (xyz, snr, angles), pose)
         timing[phase.fit_timing[attempt]] = time.perf_counter() - t0
         if not phase.again(state, plan, pose, fit, n_measured, attempt, checkpoint):
             break
@@ -559,19 +603,17 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
 
     # 5. results at the nominal sections
     t0 = time.perf_counter()
-    columns, result = _result_of_all(nominal, blind, blind_sections, measured, phase.name, xyz,
-                                     snr, fit, first, timing, cad_label, phase.source)
-    result.weights = weights_record   # hook: issue 16 item 3
+    columns, result = _result_of_all(run, phase, blind, blind_sections, measured, (xyz, snr),
+                                     fit, first)
+    result.weights = weights_record
     # issue 15 item 7: the plan's edges a sensor spot averages away are said, not hidden
     edge_rule = (getattr(plan, "info", None) or {}).get("edge_density")
     if edge_rule:
         result.warnings += edge_rule["warnings"]
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
-    table, verdict = _judge_after_blind(result, nominal, n_blind, n_measured, heights,
-                                        span_axis, cmm_data, tolerance, **(judge_options or {}))
-    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
-        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
+    table, verdict = _judge_after_blind(run, result, n_blind, n_measured, span_axis)
+    _add_airfoil(run, result, table, verdict)
     timing["sections"] = time.perf_counter() - t0
 
     progress(0.85, "writing the report")
@@ -584,10 +626,9 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     phase.add_to_record(scan_record, state)
     with open(out.path("scan.json"), "w") as fh:
         json.dump(scan_record, fh, indent=1, default=contracts.json_default)
-    files = write_report(None, result, nominal, table, verdict, tolerance, output=out,
-                         title=phase.title)
-    if document:
-        document(out.path("inspection.FCStd"), nominal, result, table, tolerance=tolerance)
+    files = write_report(out, result, nominal, table, verdict, tolerance, title=phase.title)
+    if run.document:
+        run.document(out.path("inspection.FCStd"), nominal, result, table, tolerance=tolerance)
     timing["write"] = time.perf_counter() - t0
     result.timing_s = timing
     extra = {"sections": phase.sections_json(table, plan), "section_table": table.to_json(),
@@ -597,7 +638,7 @@ def _loop(phase, nominal, rig, kinematics, heights, seed, cmm_data, tolerance, o
     extra.update(phase.result_json(plan, n_measured, state, rig_s - blind_rig_s, timing))
     extra["n_points_by_phase"]["blind"] = n_blind
     extra["rig_time_s"] = rig_s
-    extra.update(airfoil_mod.extras_of(table))  # issue 15 hook
+    extra.update(airfoil_mod.extras_of(table))
     pipeline.write_register_outputs(None, result, extra=extra, output=out)
     progress(1.0, verdict["summary"])
     summary = {"result": result, "blind_result": first, "plan": plan, "sections": table,
@@ -622,21 +663,22 @@ def _measured_rows(earlier, session):
         np.concatenate([np.asarray(p[k], dtype=float) for p in parts]) for k in (1, 2, 3))
 
 
-def _judge_after_blind(result, nominal, n_blind, n_rows, heights, span_axis, cmm_data,
-                       tolerance, fit_choice=None, measurement_model=None):
+def _judge_after_blind(run, result, n_blind, n_rows, span_axis):
     """Table 2 from the rows measured after the blind scan (the nominal sections are theirs),
     indexed back into the whole result, and the verdict on every point; the result moved to
-    the pose of ``fit_choice`` first (inspection.fitting), its fit sensitivity recorded."""
+    the pose of the run's fit first (inspection.fitting), its fit sensitivity recorded."""
+    nominal, options = run.nominal, run.options
+
     def planned_table(fitted):
         rows = np.arange(n_blind, n_blind + n_rows)
         table = sections_mod.section_table(fitted.planned_rows(rows), nominal,
-                                           heights_pct=heights, span_axis=span_axis,
-                                           cmm=cmm_data)
+                                           heights_pct=options.section_heights,
+                                           span_axis=span_axis, cmm=run.cmm_data)
         for sec in table.sections:
             sec.point_index = sec.point_index + n_blind
         return table
-    return fit_and_judge(result, nominal, fit_choice, tolerance, planned_table,
-                         measurement_model=measurement_model)
+    return fit_and_judge(result, nominal, options.fit_choice, options.tolerance, planned_table,
+                         measurement_model=options.measurement_model)
 
 
 def _blind_column(pointset, name, n):

@@ -52,7 +52,7 @@ class FitChoice:
     decision_rule: str = "iso14253"
     engine_axis: tuple = ENGINE_AXIS
     datum_faces: Optional[str] = None
-    weights: Optional[str] = None   # hook: issue 16 item 3, inspection.weighting
+    weights: Optional[str] = None   # inspection.weighting
 
     def __post_init__(self):
         # Checked before anything is measured or written: a typo must not cost a scan.

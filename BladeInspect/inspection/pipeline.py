@@ -27,7 +27,8 @@ from ..core.errors import InputError
 from ..core.pointio import MIN_POINTS, check_magnitude
 from . import checks, weighting
 from .result import RegistrationResult
-from ..core.contracts import PROFILE_TOLERANCE_MM, json_default
+from .run_options import FineOptions, RegisterOptions, RunOptions
+from ..core.contracts import json_default
 
 # Points used for the ICP ranking of each PCA candidate and for the fine fit's inner
 # iterations; the full cloud only enters the last Gauss-Newton steps and the deviations, which
@@ -366,20 +367,26 @@ def final_distances(fit, tracked):
 
 
 def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progress,
-                  time_limit_s=FINE_TIME_LIMIT_S, weight_model=None, full_distance=None,
-                  systematic_mm=checks.SENSOR_ACCURACY_MM):
+                  weight_model=None, **settings):
     """SNR-weighted ICP (paper 3.2) against the exact CAD faces: converged on a subsample, then
     finished with Gauss-Newton steps on every point so the pose carries the whole cloud's
-    information (and its covariance is the whole cloud's). Both runs together get
-    ``time_limit_s``; an InputError says so when it is spent. ``weight_model``: core.icp's
-    (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
+    information (and its covariance is the whole cloud's). ``settings``: the fields of
+    inspection.run_options.FineOptions (time_limit_s, full_distance, systematic_mm; absent or
+    None: FINE_TIME_LIMIT_S, a TrackedDistance of its own, the default sensor's accuracy).
+    Both runs together get ``time_limit_s``; an InputError says so when it is spent.
+    ``weight_model``: core.icp's (inspection.weighting; None: the SNR weights). ``full_distance``: the TrackedDistance of
     all the points to use (so that the caller can start its deviations from the fit's last
     foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
     sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
     core.icp's defect test grants each neighbourhood the field a bias of that size leaves
     after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
+    settings = FineOptions(**settings)
+    time_limit_s = (FINE_TIME_LIMIT_S if settings.time_limit_s is None
+                    else settings.time_limit_s)
+    systematic_mm = (checks.SENSOR_ACCURACY_MM if settings.systematic_mm is None
+                     else settings.systematic_mm)
     rng = np.random.default_rng(1) if rng is None else rng
-    full_distance = full_distance or TrackedDistance(nominal)
+    full_distance = settings.full_distance or TrackedDistance(nominal)
     deadline = time.monotonic() + time_limit_s
 
     def remaining():
@@ -390,8 +397,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
         full_distance's starts of those rows."""
         distance = TrackedDistance(nominal, full_distance.start.take(rows))
         fit = icp_mod.icp(measured_xyz[rows], None if snr is None else snr[rows], distance, T,
-                          options, weight_model=None if weight_model is None   # hook: issue 16
-                          else weight_model.subset(rows))
+                          options, weight_model=_weights_of_rows(weight_model, rows))
         _check_time(fit, time_limit_s)
         full_distance.start.set_rows(rows, distance.start)
         return fit.transform
@@ -426,6 +432,11 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     return fit
 
 
+def _weights_of_rows(weight_model, rows):
+    """The weight model of the measured rows ``rows`` (None: the SNR weights)."""
+    return None if weight_model is None else weight_model.subset(rows)
+
+
 def _with_deadline(progress, limit_s, what):
     """``progress`` that raises an InputError once ``limit_s`` has passed since it was made."""
     deadline = time.monotonic() + limit_s
@@ -447,31 +458,32 @@ def _check_time(fit, time_limit_s):
 
 # ---------------------------------------------------------------- the whole registration
 
-def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
-             allow_mismatch=False, tolerance=PROFILE_TOLERANCE_MM, cad_source=None,
-             fit_choice=None, weights=None, rig_kinematics=None):
+def register(nominal, pointset, seed=0, progress=None, options=None, rig_kinematics=None,
+             use_reconstruction=True, **choices):
     """Register a measured point set to the nominal with no knowledge of its pose.
 
-    Refused (InputError) before any fitting when the points are too degenerate to fix a pose
-    or do not match the CAD's size, and after it when they do not fit the CAD (see
-    inspection.checks; ``allow_mismatch`` keeps the result with a warning instead, and
-    ``tolerance`` is the profile tolerance the fit rule allows). ``cad_source`` names the CAD
-    in those messages. ``fit_choice``: an inspection.fitting.FitChoice applied after the ICP.
-    ``weights``: the fine fit's, "snr", "sensor" or None for the default (inspection.weighting;
-    None also takes ``fit_choice.weights``); ``rig_kinematics`` turns the sensor weights'
-    beams back (default the nominal rig's)."""
+    ``options``: inspection.run_options.RegisterOptions (None: its defaults), its fields also
+    taken as keywords (``choices``, which replace them). Refused (InputError) before any
+    fitting when the points are too degenerate to fix a pose or do not match the CAD's size,
+    and after it when they do not fit the CAD (see inspection.checks; ``allow_mismatch`` keeps
+    the result with a warning instead, and ``tolerance`` is the profile tolerance the fit rule
+    allows). ``cad_source`` names the CAD in those messages. ``fit_choice``: an
+    inspection.fitting.FitChoice applied after the ICP. ``weights``: the fine fit's, "snr",
+    "sensor" or None for the default (inspection.weighting; None also takes
+    ``fit_choice.weights``); ``rig_kinematics`` turns the sensor weights' beams back (default
+    the nominal rig's)."""
+    options = dataclasses.replace(options or RegisterOptions(), **choices)
+    tolerance, fit_choice = options.tolerance, options.fit_choice
     progress = progress or _no_progress
     timing = {}
     xyz = _check_points(pointset)
     source = pointset.source or "points"
-    cad_label = cad_source or "the CAD"
+    cad_label = options.cad_source or "the CAD"
     checks.check_spread(xyz, source, coincide_only=True)
     extent_ratio = checks.check_scale(xyz, nominal, source, cad_label)
     checks.check_spread(xyz, source)
     snr = None if pointset.snr is None else np.asarray(pointset.snr, dtype=float)
-    weight_model, weights_record = weighting.weight_model_for(   # hook: issue 16 item 3
-        pointset, weights if weights is not None else getattr(fit_choice, "weights", None),
-        kinematics=rig_kinematics)
+    weight_model, weights_record = _weight_model(pointset, options, rig_kinematics)
     rng = np.random.default_rng(seed)
     # A CAD face whose outside could not be decided signs its deviations by a guess: say so.
     warnings = list(nominal.face_side_warnings)
@@ -516,7 +528,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     t0 = time.perf_counter()
     progress(0.92, "signed deviations of %d points" % len(xyz))
     points_cad = tf.apply_transform(fit.transform, xyz)
-    dist = final_distances(fit, full_distance)   # hook: the fit's own residuals (issue 14)
+    dist = final_distances(fit, full_distance)
     stats = stats_mod.deviation_statistics(dist.distance)
     inlier = np.asarray(fit.inlier, dtype=bool)
     rms = float(np.sqrt(np.mean(dist.distance[inlier] ** 2))) if inlier.any() else float("nan")
@@ -524,7 +536,7 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
     fit_record["extent_ratio"] = extent_ratio
     if not fit_record["fits"]:
         message = checks.mismatch_message(fit_record, source, cad_label)
-        if not allow_mismatch:
+        if not options.allow_mismatch:
             raise InputError(message)
         fit_record["warning"] = message
         warnings.append(message)
@@ -561,11 +573,25 @@ def register(nominal, pointset, seed=0, progress=None, use_reconstruction=True,
         pose_uncertainty_statistical_mm=float(statistical),
         pose_uncertainty_includes_rival=includes_rival, icp_weights=fit.weights,
         inlier_cut=fit.cut)
-    result.weights = weights_record   # hook: issue 16 item 3
-    if fit_choice is not None:   # hook: inspection.fitting (issue 16)
+    result.weights = weights_record
+    _apply_fit_choice(result, nominal, fit_choice, tolerance)
+    return result
+
+
+def _weight_model(pointset, options, rig_kinematics):
+    """(the fine fit's weight model, its record) for ``options.weights``, else the fit
+    choice's (inspection.weighting)."""
+    weights = options.weights
+    if weights is None:
+        weights = getattr(options.fit_choice, "weights", None)
+    return weighting.weight_model_for(pointset, weights, kinematics=rig_kinematics)
+
+
+def _apply_fit_choice(result, nominal, fit_choice, tolerance):
+    """The result moved to the pose of ``fit_choice`` (inspection.fitting; None: the ICP's)."""
+    if fit_choice is not None:
         from . import fitting
         fitting.apply(result, nominal, fit_choice, tolerance)
-    return result
 
 
 def pose_summary(fit, nominal):
@@ -717,19 +743,23 @@ def write_register_outputs(out_dir, result, extra=None, output=None):
             write(out)
 
 
-def run_register(cad_path, points_path, out_dir, seed=0, progress=None, flip_faces=(),
-                 allow_mismatch=False, fit_choice=None, tolerance=PROFILE_TOLERANCE_MM):
-    """The `register` command: load, register, write. Returns the RegistrationResult."""
+def run_register(cad_path, points_path, out_dir, options=None, progress=None):
+    """The `register` command: load, register, write, with ``options``
+    (inspection.run_options.RunOptions: its seed, flip_faces, allow_mismatch, fit_choice and
+    tolerance). Returns the RegistrationResult."""
+    options = options or RunOptions()
     checks.check_out_dir(out_dir)
     t0 = time.perf_counter()
-    nominal = load_nominal(cad_path, flip_faces=flip_faces)
+    nominal = load_nominal(cad_path, flip_faces=options.flip_faces)
     t_cad = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = load_points(points_path)
     t_pts = time.perf_counter() - t0
-    result = register(nominal, points, seed=seed, progress=progress,
-                      allow_mismatch=allow_mismatch, cad_source=cad_path or "the demo blade",
-                      fit_choice=fit_choice, tolerance=tolerance)
+    result = register(nominal, points, seed=options.seed, progress=progress,
+                      options=RegisterOptions(allow_mismatch=options.allow_mismatch,
+                                              cad_source=cad_path or "the demo blade",
+                                              fit_choice=options.fit_choice,
+                                              tolerance=options.tolerance))
     result.timing_s = dict(load_cad=t_cad, load_points=t_pts, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
     write_register_outputs(out_dir, result)

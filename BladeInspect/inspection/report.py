@@ -30,6 +30,7 @@ from . import verdict as verdict_mod
 from .checks import check_out_dir
 from .report_table import TableStyle, html_table, img_tag, mpl, pdf_table, png_bytes
 from .result import rival_lines
+from .run_options import ReportSources, RunOptions
 
 # Enough points for a faithful picture; more only costs time and PDF size.
 MAX_VIEW_POINTS = 120000
@@ -392,15 +393,16 @@ def _verdict_lines(verdict, table):
 
 # ---------------------------------------------------------------- the report
 
-def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=None,
-                 magnification=None, title=None):
+def write_report(out, result, nominal, sections, verdict, tolerance, magnification=None,
+                 title=None):
     """report.html and report.pdf for a registration, its section table and verdict. Written
-    into ``output`` (an open pipeline.AtomicOutput) when given, else atomically into out_dir.
+    into ``out``: an open pipeline.AtomicOutput, or a folder (written atomically).
     Returns {'html': name, 'pdf': name, 'pdf_pages': count}."""
-    if output is None:
-        with pipeline.AtomicOutput(out_dir) as out:
-            return write_report(out_dir, result, nominal, sections, verdict, tolerance,
-                                output=out, magnification=magnification, title=title)
+    if not isinstance(out, pipeline.AtomicOutput):
+        with pipeline.AtomicOutput(out) as output:
+            return write_report(output, result, nominal, sections, verdict, tolerance,
+                                magnification=magnification, title=title)
+    output = out
     plt, _, _ = mpl()
     from matplotlib.backends.backend_pdf import PdfPages
     table = sections
@@ -424,7 +426,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
                  tolerance),
              "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in verdict_lines) + "</ul>",
              "<h2>Pose and its uncertainty</h2>", html_table(["Quantity", "Value"], p_rows)]
-    parts += fit_report.html_parts(result, verdict, html_table)   # hook: issue 16
+    parts += _fit_parts(result, verdict)
     for w in list(result.warnings) + list(table.warnings):
         parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
 
@@ -449,10 +451,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
         plt.close(fig)
         n_pages += 1
 
-        for fig in fit_report.pdf_pages(plt, result, verdict):   # hook: issue 16
-            pdf.savefig(fig, dpi=PDF_DPI)
-            plt.close(fig)
-            n_pages += 1
+        n_pages += _add_fit_pages(pdf, plt, result, verdict)
 
         fig = figure_views(result, table, tolerance)
         parts += ["<h2>Deviation map</h2>", img_tag(png_bytes(fig), "deviation map, three views")]
@@ -501,7 +500,7 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
             pdf.savefig(fig, dpi=PDF_DPI)
             plt.close(fig)
             n_pages += 1
-        n_pages += airfoil_report.add_pages(pdf, parts, table)  # issue 15 hook
+        n_pages += airfoil_report.add_pages(pdf, parts, table)
         meta = pdf.infodict()
         meta["Title"] = title
         meta["Creator"] = "BladeInspect"
@@ -512,91 +511,112 @@ def write_report(out_dir, result, nominal, sections, verdict, tolerance, output=
     return {"html": "report.html", "pdf": "report.pdf", "pdf_pages": n_pages}
 
 
+def _fit_parts(result, verdict):
+    """The report.html sections of the fit and its sensitivity (inspection.fit_report)."""
+    return fit_report.html_parts(result, verdict, html_table)
+
+
+def _add_fit_pages(pdf, plt, result, verdict):
+    """The PDF pages of the fit and its sensitivity (inspection.fit_report); their count."""
+    n_pages = 0
+    for fig in fit_report.pdf_pages(plt, result, verdict):
+        pdf.savefig(fig, dpi=PDF_DPI)
+        plt.close(fig)
+        n_pages += 1
+    return n_pages
+
+
 # ---------------------------------------------------------------- the `report` command
 
-def run_report(cad_path, points_path, out_dir, cmm=None, tolerance=contracts.PROFILE_TOLERANCE_MM,
-               seed=0, progress=None, heights_pct=contracts.SECTION_HEIGHTS_PCT,
-               nominal=None, document=None, flip_faces=(), allow_mismatch=False, airfoil=None,
-               fit_choice=None, measurement_model=None, batch_inputs=None):
+def run_report(cad_path, points_path, out_dir, options=None, progress=None, nominal=None,
+               document=None, batch_inputs=None):
     """Register, then write_result_report: result.json, deviations.csv, report.html,
-    report.pdf and inspection.FCStd into out_dir, all or nothing. ``nominal`` skips loading
-    the CAD (a batch loads it once); ``flip_faces`` as ``--flip-face`` (cad.orient).
-    ``allow_mismatch``: write the result of a scan that does not fit the CAD, with the warning
-    (pipeline.register). ``document``, ``airfoil``, ``fit_choice``, ``measurement_model``,
-    ``batch_inputs``: as for write_result_report. Returns a summary dict."""
+    report.pdf and inspection.FCStd into out_dir, all or nothing, with ``options``
+    (inspection.run_options.RunOptions; None: the defaults). ``nominal`` skips loading the
+    CAD (a batch loads it once); ``options.flip_faces`` as ``--flip-face`` (cad.orient).
+    ``options.allow_mismatch``: write the result of a scan that does not fit the CAD, with the
+    warning (pipeline.register). ``document``, ``batch_inputs``: as for write_result_report.
+    Returns a summary dict."""
+    options = options or RunOptions()
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
-    tolerance = contracts.profile_tolerance(tolerance)
+    options = options.replace(tolerance=contracts.profile_tolerance(options.tolerance))
     timing = {}
     t0 = time.perf_counter()
     if nominal is None:
-        nominal = pipeline.load_nominal(cad_path, flip_faces=flip_faces)
+        nominal = pipeline.load_nominal(cad_path, flip_faces=options.flip_faces)
     timing["load_cad"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     points = pipeline.load_points(points_path)
-    cmm_data = sections_mod.read_cmm(cmm) if cmm is not None else None
+    cmm_data = sections_mod.read_cmm(options.cmm) if options.cmm is not None else None
     timing["load_points"] = time.perf_counter() - t0
-    result = pipeline.register(nominal, points, seed=seed,
+    result = pipeline.register(nominal, points, seed=options.seed,
                                progress=lambda f, m: progress(0.8 * f, m),
-                               allow_mismatch=allow_mismatch, tolerance=tolerance,
-                               cad_source=cad_path or "the demo blade",
-                               weights=getattr(fit_choice, "weights", None))   # issue 16
+                               options=options.register_options(cad_path or "the demo blade"))
     result.timing_s = dict(timing, **result.timing_s)
     result.cad_source = cad_path or "built-in demo blade"
-    return write_result_report(result, nominal, out_dir, cmm_data=cmm_data,
-                               tolerance=tolerance, progress=progress, heights_pct=heights_pct,
-                               document=document, cad_path=cad_path, airfoil=airfoil,
-                               fit_choice=fit_choice, measurement_model=measurement_model,
-                               batch_inputs=batch_inputs)
+    return write_result_report(result, nominal, out_dir, options, progress, document,
+                               ReportSources(cad_path=cad_path, cmm_data=cmm_data,
+                                             batch_inputs=batch_inputs))
 
 
-def write_result_report(result, nominal, out_dir, cmm_data=None,
-                        tolerance=contracts.PROFILE_TOLERANCE_MM, progress=None,
-                        heights_pct=contracts.SECTION_HEIGHTS_PCT, document=None,
-                        cad_path=None, airfoil=None, fit_choice=None, measurement_model=None,
-                        batch_inputs=None):
+def write_result_report(result, nominal, out_dir, options=None, progress=None, document=None,
+                        sources=None):
     """The `report` files of a registration already made (a RegistrationResult, e.g. a
     document's Registration): tabulate the sections, judge, and write result.json,
     deviations.csv, report.html, report.pdf and inspection.FCStd into out_dir, all or nothing:
     the files are made in a private folder beside out_dir and moved in only when every one is
-    complete. ``cmm_data``: sections.read_cmm's table, or None. ``document``: the writer of
-    inspection.FCStd (app.document.write_inspection_document, which this layer cannot import),
-    or None for no document. ``cad_path``: the CAD file of the nominal (None: the demo blade).
-    ``airfoil``: an inspection.airfoil.Options to add the airfoil characteristics (issue 15;
-    None: none). ``fit_choice`` (inspection.fitting.FitChoice, default least squares and ISO
-    14253-1) and ``measurement_model`` (inspection.uncertainty) choose the fit and the
-    decision. ``batch_inputs``: what a batch made this file from (inspection.batch), kept in
-    result.json so that a lot run again knows the file done. Returns a summary dict."""
+    complete. ``options``: inspection.run_options.RunOptions (None: the defaults): its
+    tolerance, section heights, airfoil options (None: no airfoil characteristics), fit
+    (inspection.fitting.FitChoice, default least squares and ISO 14253-1) and measurement
+    model (inspection.uncertainty) choose what is measured and decided. ``document``: the
+    writer of inspection.FCStd (app.document.write_inspection_document, which this layer
+    cannot import), or None for no document. ``sources``: inspection.run_options.ReportSources,
+    what the report is made from besides the registration: the CAD file of the nominal (None:
+    the demo blade), the CMM's table (sections.read_cmm; None: none) and what a batch made
+    this file from (inspection.batch), kept in result.json so that a lot run again knows the
+    file done. Returns a summary dict."""
+    options = options or RunOptions()
+    sources = sources or ReportSources()
     check_out_dir(out_dir)
     progress = progress or (lambda f, m: None)
-    tolerance = contracts.profile_tolerance(tolerance)
+    tolerance = contracts.profile_tolerance(options.tolerance)
     t0 = time.perf_counter()
     progress(0.82, "section table")
-    table, verdict = judging.fit_and_judge(   # hook: issue 16, the fit and the decision
-        result, nominal, fit_choice, tolerance,
-        lambda fitted: sections_mod.section_table(fitted, nominal, heights_pct=heights_pct,
-                                                  cmm=cmm_data),
-        measurement_model=measurement_model)
-    if airfoil is not None:  # issue 15 hook: airfoil characteristics, into the verdict
-        airfoil_mod.attach(result, nominal, table, verdict, airfoil)
+    table, verdict = _fit_and_judge(result, nominal, options.replace(tolerance=tolerance),
+                                    sources.cmm_data)
+    if options.airfoil is not None:   # the airfoil characteristics join the verdict
+        airfoil_mod.attach(result, nominal, table, verdict, options.airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0
     with pipeline.AtomicOutput(out_dir) as out:
         t0 = time.perf_counter()
         progress(0.86, "report")
-        files = write_report(out_dir, result, nominal, table, verdict, tolerance, output=out)
+        files = write_report(out, result, nominal, table, verdict, tolerance)
         result.timing_s["report"] = time.perf_counter() - t0
         if document:
             t0 = time.perf_counter()
             progress(0.95, "FreeCAD document")
             document(out.path("inspection.FCStd"), nominal, result, table,
-                     tolerance=tolerance, verdict=verdict, cad_path=cad_path)
+                     tolerance=tolerance, verdict=verdict, cad_path=sources.cad_path)
             result.timing_s["document"] = time.perf_counter() - t0
         pipeline.write_register_outputs(out_dir, result, extra={
             "sections": table.to_json(), "verdict": verdict, "tolerance_mm": tolerance,
-            **airfoil_mod.extras_of(table),  # issue 15 hook
-            **({"batch_inputs": batch_inputs} if batch_inputs is not None else {})},
+            **airfoil_mod.extras_of(table),
+            **({"batch_inputs": sources.batch_inputs}
+               if sources.batch_inputs is not None else {})},
             output=out)
     progress(1.0, verdict["summary"])
     return {"out_dir": os.path.abspath(out_dir), "result": result, "sections": table,
             "verdict": verdict, "files": sorted(os.listdir(out_dir)),
             "pdf_pages": files["pdf_pages"]}
+
+
+def _fit_and_judge(result, nominal, options, cmm_data):
+    """(section table, verdict) of ``result`` moved to the pose of the fit ``options`` choose
+    (inspection.judging), the table at their section heights with the CMM's columns."""
+    return judging.fit_and_judge(
+        result, nominal, options.fit_choice, options.tolerance,
+        lambda fitted: sections_mod.section_table(fitted, nominal,
+                                                  heights_pct=options.section_heights,
+                                                  cmm=cmm_data),
+        measurement_model=options.measurement_model)

@@ -3,8 +3,10 @@ moved by a random known rotation and translation, given measurement error, then 
 no knowledge of the pose; the pose error is judged against the truth and against the pose's own
 Cramér–Rao bound."""
 
+import dataclasses
 import json
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -96,13 +98,33 @@ def measurement_error(n, noise, rng, amplitude=0.006, sigma=0.002):
     raise InputError("--noise: expected uniform or normal, got %r" % noise)
 
 
-def simulate_measurement(nominal, n_points=20000, sides="both", noise="uniform",
-                         amplitude=0.006, sigma=0.002, outlier_fraction=0.0,
-                         section_heights=SECTION_LINE_HEIGHTS_PCT, seed=0, max_translation=100.0,
-                         pose=None):
-    """A measured point set in an unknown frame and the truth that maps it into the CAD frame.
+@dataclass(frozen=True)
+class SimulatedScan:
+    """What the simulated measurement samples and how it errs: ``n_points`` surface points on
+    the ``sides`` (both, suction, pressure), section lines at ``section_heights`` (% of span),
+    measurement error ``noise`` (uniform on +-``amplitude`` or normal ``sigma``, mm), a
+    fraction ``outlier_fraction`` of gross outliers, and a random pose whose translation is at
+    most ``max_translation`` mm."""
+    n_points: int = 20000
+    sides: str = "both"
+    noise: str = "uniform"
+    amplitude: float = 0.006
+    sigma: float = 0.002
+    outlier_fraction: float = 0.0
+    section_heights: tuple = SECTION_LINE_HEIGHTS_PCT
+    max_translation: float = 100.0
+
+
+def simulate_measurement(nominal, scan=None, seed=0, pose=None, **fields):
+    """A measured point set in an unknown frame and the truth that maps it into the CAD frame:
+    ``scan`` (SimulatedScan; None: its defaults) with ``fields`` of SimulatedScan replacing
+    its values, drawn from ``seed``, moved by ``pose`` (None: a random pose).
 
     Returns (PointSet, measured_to_cad_truth, info dict)."""
+    scan = dataclasses.replace(scan or SimulatedScan(), **fields)
+    n_points, sides, noise = scan.n_points, scan.sides, scan.noise
+    amplitude, sigma, outlier_fraction = scan.amplitude, scan.sigma, scan.outlier_fraction
+    section_heights, max_translation = scan.section_heights, scan.max_translation
     if n_points < 10:
         raise InputError("--points: at least 10 points are needed, got %d" % n_points)
     rng = np.random.default_rng(seed)
