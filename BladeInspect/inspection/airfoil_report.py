@@ -1,4 +1,4 @@
-"""The report's airfoil pages (issue 15): per section a characteristics table (nominal, actual,
+"""The report's airfoil pages: per section a characteristics table (nominal, actual,
 deviation, +-u, tolerance, verdict) and a figure of the profile with its mean camber line, a
 few inscribed circles, the LE/TE circles and the chord line; then shift and twist along the
 span. Drawn from the stage inspection.airfoil_stage attached to the section table."""
