@@ -196,7 +196,7 @@ def build_parser():
                    help="plan points round each section's LE and TE so closely that the fitted "
                         "edge radius's 1-sigma at the sensor's noise is at most MM (default "
                         "0.002; 0 or off: the rule off, points every 0.1 mm; "
-                        "docs/airfoil.md)")
+                        "docs/user-guide.md)")
     fitting_args(i)
 
     a = sub.add_parser("airfoil", help="airfoil characteristics per section (nominal, or "
@@ -353,7 +353,7 @@ def _airfoil_arguments(parser, always):
                         help="task-specific uncertainty: reuse the re-fit draws stored in FILE "
                              "for the sections whose measurement matches the task's "
                              "conditions; FILE absent: make it from this blade (48 draws a "
-                             "section; docs/airfoil.md)")
+                             "section; docs/user-guide.md)")
 
 
 def _airfoil_options(args):

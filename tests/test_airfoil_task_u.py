@@ -91,7 +91,7 @@ class TaskFile(unittest.TestCase):
         cls.path = os.path.join(cls.tmp, "task.json")
         cls.blade_a = _measurement(cls.nominal, cls.sections, SIGMA, 1)
         # (seed 2's section 2 would state a TE radius u twice the other seeds' in its own
-        # re-fit, a blade-to-blade spread the task's u does not follow: docs/airfoil.md)
+        # re-fit, a blade-to-blade spread the task's u does not follow: docs/user-guide.md, "Task-specific uncertainty")
         cls.blade_b = _measurement(cls.nominal, cls.sections, SIGMA, 3, _defect)
         cls.made, cls.made_calls = _run(
             cls.nominal, cls.blade_a,

@@ -119,7 +119,7 @@ class _SectionGeometry(Proxy):
 
 class CamberLine(_SectionGeometry):
     """The mean camber line: centres of the circles inscribed between the sides, extended to
-    the LE and TE points (docs/airfoil.md), in the section plane (CAD frame)."""
+    the LE and TE points (docs/user-guide.md), in the section plane (CAD frame)."""
     Type = "BladeInspect::CamberLine"
 
     def add_results(self, obj):
@@ -153,7 +153,7 @@ class CamberLine(_SectionGeometry):
 
 
 class EdgeCircles(_SectionGeometry):
-    """The circles fitted to the LE and TE zones (docs/airfoil.md), in the section plane."""
+    """The circles fitted to the LE and TE zones (docs/user-guide.md), in the section plane."""
     Type = "BladeInspect::EdgeCircles"
 
     def add_results(self, obj):

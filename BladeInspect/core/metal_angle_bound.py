@@ -15,7 +15,7 @@ The bound is relative to the model: an estimator that may assume a lower-degree 
 (e.g. one that knows the part deviates from its CAD only as a parabola over the window) is held
 to the lower figure that degree gives; one that must follow any part to the degree-4 figure:
 the definition is a quartic fit over the window, so degree 4 and up give the same bound (the
-definition's own variance; degree 6 is within 1 % of it on the DCA section). docs/airfoil.md
+definition's own variance; degree 6 is within 1 % of it on the DCA section). docs/validation.md
 states both.
 """
 import numpy as np

@@ -132,7 +132,7 @@ def add_pages(pdf, parts, table):
     parts += ["<h2>Airfoil characteristics</h2>",
               "<p>%s</p>" % html.escape(characteristic_names.airfoil_verdict_text(
                   stage.verdict, stage.blocks)),
-              "<p class='note'>Definitions: docs/airfoil.md; chord %s; angles from the engine "
+              "<p class='note'>Definitions: docs/user-guide.md; chord %s; angles from the engine "
               "axis %s; LE: %s; uncertainty: %s, %s. Tolerances limit the deviation; "
               "decision rule: %s (%s).</p>"
               % (html.escape(stage.settings["chord_method"]),

@@ -2,7 +2,7 @@
 exact cut, the measured ones from that section's registered points, their deviation, standard
 uncertainty, tolerance and verdict, and the blade's lean and bow; its options, its section
 planes, the nominal cuts it remembers, and its files (airfoil.json, airfoil.csv, a lot's
-summary_airfoil.csv). The numerics are core.airfoil's, the definitions docs/airfoil.md; the
+summary_airfoil.csv). The numerics are core.airfoil's, the definitions docs/user-guide.md; the
 measuring of a section's points is airfoil_measure's, their uncertainty airfoil_uncertainty's
 (or an uncertainty task file's, airfoil_task), the verdicts airfoil_verdicts'.
 """

@@ -230,7 +230,7 @@ def run_batch(cad_path, scans_dir, out_dir, options=None, workers=None, schedule
     'message': one line for the command line}. ``options``: inspection.run_options.RunOptions
     of every file, as for `report` (its tolerance, seed, allow_mismatch, airfoil, fit and
     measurement model, the rig calibration's term from `--rig-file`, make the inputs record);
-    with ``options.airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil);
+    with ``options.airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil_stage);
     ``document``: the writer of each file's inspection.FCStd, as for report.run_report."""
     options = options or RunOptions()
     progress = progress or (lambda f, m: None)

@@ -121,7 +121,7 @@ AIRFOIL_VERDICT_LINES = {
 NOT_MEASURED = " (not measured)"   # inspection.airfoil_verdicts.judge's suffix of an unmeasured key
 NOT_MEASURED_NAME = QT_TRANSLATE_NOOP("BladeInspect", "%s (not measured)")
 
-# Verdicts as core.decision and inspection.airfoil write them, marked so that they are
+# Verdicts as core.decision and inspection.airfoil_verdicts write them, marked so that they are
 # translated where they are shown.
 VERDICTS = (QT_TRANSLATE_NOOP("BladeInspect", "pass"),
             QT_TRANSLATE_NOOP("BladeInspect", "fail"),

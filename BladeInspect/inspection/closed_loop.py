@@ -24,7 +24,7 @@ and scan.json marked incomplete with the loop's state under "inspection" (no res
 measured data is kept section by section in DIR/.checkpoint while the loop runs
 (inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
-depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
+depends only on the pass number, which the checkpoint carries. See docs/maintainers.md ("The closed loop and its checkpoint") for the
 checkpoint's fields.
 """
 

@@ -379,7 +379,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
     sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
     core.icp's defect test grants each neighbourhood the field a bias of that size leaves
-    after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
+    after the fit (the sensor's own error, not a defect's flank: docs/maintainers.md)."""
     settings = FineOptions(**settings)
     time_limit_s = (FINE_TIME_LIMIT_S if settings.time_limit_s is None
                     else settings.time_limit_s)
