@@ -329,13 +329,13 @@ def cmd_simrig(args):
 
 
 def _airfoil_arguments(parser, always):
-    # report, inspect and batch add the airfoil characteristics unless --no-airfoil (issue 15:
-    # result.json always gains `airfoil`); --airfoil, the former switch, is kept and a no-op.
+    # report, inspect and batch add the airfoil characteristics unless --no-airfoil
+    # (result.json always gains `airfoil`); --airfoil, the former switch, is kept and a no-op.
     if not always:
         parser.add_argument("--airfoil", action="store_true",
                             help="add the airfoil characteristics per section (the default)")
         parser.add_argument("--no-airfoil", action="store_true",
-                            help="leave out the airfoil characteristics (issue 15)")
+                            help="leave out the airfoil characteristics")
     parser.add_argument("--engine-axis", default=None,
                         help="engine axis: x, y, z, -x, ... or \"1,0,0\" (default the CAD's +X)")
     parser.add_argument("--characteristics", default=None, metavar="FILE",

@@ -537,7 +537,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
-        if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+        if weight_model is not None:   # sensor-model weights (core.weights)
             a = normalised_weights(weight_model, T, normals, len(points))
         rho, _, _ = robust_selection(distances, a, options, neighbourhoods,
                                      bias_response(T, moved, normals))
@@ -585,7 +585,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
-    if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+    if weight_model is not None:   # sensor-model weights (core.weights)
         a = normalised_weights(weight_model, T, normals, len(points))
     rho, _, cut = robust_selection(distances, a, options, neighbourhoods,
                                    bias_response(T, moved, normals))

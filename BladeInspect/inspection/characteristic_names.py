@@ -1,4 +1,4 @@
-"""What a metrology engineer reads for each airfoil characteristic (issue 15 item 5): its name,
+"""What a metrology engineer reads for each airfoil characteristic: its name,
 its unit and a one-line meaning, keyed by the result.json field name (``chord_mm``;
 ``le_thickness_mm[1]`` for a list element). The report writes these names, the workbench shows
 them through Qt's translation. The field name stays what the files and ``--characteristics``

@@ -659,7 +659,7 @@ def result_json(result, extra=None):
         "pose_unmeasured": list(result.pose_unmeasured),
         "surface_fit": result.surface_fit,
     }
-    for name in ("fit", "fit_sensitivity", "weights"):   # hook: inspection.fitting (issue 16)
+    for name in ("fit", "fit_sensitivity", "weights"):   # inspection.fitting
         if getattr(result, name, None) is not None:
             doc[name] = getattr(result, name)
     if extra:

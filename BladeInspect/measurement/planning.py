@@ -186,7 +186,7 @@ EDGE_DENSIFY_REACH = 2.0
 # the fitted circle: this many times the rule's points (measured on the demo blade: 1.0 gave
 # sigma_R 2.23 um for a 2 um target).
 EDGE_DENSIFY_MARGIN = 1.25
-# `inspect` plans its sections with this edge-radius 1-sigma target (issue 15 item 7; its
+# `inspect` plans its sections with this edge-radius 1-sigma target (its
 # --edge-radius-sigma changes it, 0 or off turns the rule off).
 DEFAULT_EDGE_RADIUS_SIGMA_MM = 0.002
 # An edge whose radius is under this many spot diameters is averaged away by the spot (the
@@ -454,7 +454,7 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     (None: the nominal axis through the origin along +Y); ``limits`` an AxisLimits.
     Returns a Plan. Raises InputError for heights outside 0-100 or a plane that misses the
     CAD, DeviceError when a setpoint is unreachable within the soft limits.
-    ``edge_radius_sigma_mm`` (issue 15 item 7; None: off): points round each section's LE and
+    ``edge_radius_sigma_mm`` (None: off): points round each section's LE and
     TE closer, so that its fitted edge radius's 1-sigma at the sensor's reference noise
     (sensor.sigma_ref) is at most this (docs/user-guide.md, "Edges measured densely enough")."""
     heights = [float(h) for h in np.atleast_1d(heights_pct)]
