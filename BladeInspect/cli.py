@@ -196,7 +196,7 @@ def build_parser():
                    help="plan points round each section's LE and TE so closely that the fitted "
                         "edge radius's 1-sigma at the sensor's noise is at most MM (default "
                         "0.002; 0 or off: the rule off, points every 0.1 mm; "
-                        "docs/airfoil.md)")
+                        "docs/user-guide.md)")
     fitting_args(i)
 
     a = sub.add_parser("airfoil", help="airfoil characteristics per section (nominal, or "
@@ -329,13 +329,13 @@ def cmd_simrig(args):
 
 
 def _airfoil_arguments(parser, always):
-    # report, inspect and batch add the airfoil characteristics unless --no-airfoil (issue 15:
-    # result.json always gains `airfoil`); --airfoil, the former switch, is kept and a no-op.
+    # report, inspect and batch add the airfoil characteristics unless --no-airfoil
+    # (result.json always gains `airfoil`); --airfoil, the former switch, is kept and a no-op.
     if not always:
         parser.add_argument("--airfoil", action="store_true",
                             help="add the airfoil characteristics per section (the default)")
         parser.add_argument("--no-airfoil", action="store_true",
-                            help="leave out the airfoil characteristics (issue 15)")
+                            help="leave out the airfoil characteristics")
     parser.add_argument("--engine-axis", default=None,
                         help="engine axis: x, y, z, -x, ... or \"1,0,0\" (default the CAD's +X)")
     parser.add_argument("--characteristics", default=None, metavar="FILE",
@@ -353,7 +353,7 @@ def _airfoil_arguments(parser, always):
                         help="task-specific uncertainty: reuse the re-fit draws stored in FILE "
                              "for the sections whose measurement matches the task's "
                              "conditions; FILE absent: make it from this blade (48 draws a "
-                             "section; docs/airfoil.md)")
+                             "section; docs/user-guide.md)")
 
 
 def _airfoil_options(args):

@@ -1,4 +1,4 @@
-"""Airfoil characteristics (core/airfoil.py): accuracy against closed forms and CPU time.
+"""Airfoil characteristics (core.airfoil): accuracy against closed forms and CPU time.
 
     /usr/bin/python3 bench/bench_airfoil.py [--noise-trials 20]
 

@@ -1,5 +1,5 @@
 """Airfoil characteristics of the CAD nominals: the demo blade and Rotor 67, five planes across
-the span (10..90 %), cut by cad/airfoil_sections.py and measured by core/airfoil.py.
+the span (10..90 %), cut by cad/airfoil_sections.py and measured by core.airfoil.
 
     PYTHONPATH=.:/usr/lib/freecad-python3/lib /usr/bin/python3 bench/bench_airfoil_cad.py
 

@@ -1,4 +1,4 @@
-"""Airfoil characteristics (core/airfoil.py) against closed forms built here: a cambered
+"""Airfoil characteristics (core.airfoil) against closed forms built here: a cambered
 double-circular-arc section with exact circular edges (its camber line is an ellipse) and NACA
 4-digit sections from their formula (tests/airfoil_shapes.py), at random poses."""
 import unittest

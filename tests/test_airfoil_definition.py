@@ -75,6 +75,16 @@ class Definition(unittest.TestCase):
         self.assertEqual(d.le_rule, "larger-radius")
         self.assertEqual(d.kernel_version, airfoil.KERNEL_VERSION)
 
+    def test_read_back(self):
+        d = AirfoilDefinition(chord_method="tangent", edge_offsets_mm=(0.3, 1.0),
+                              le_rule="engine-axis", metal_angle_window_pct=40.0)
+        self.assertEqual(AirfoilDefinition.from_dict(json.loads(json.dumps(d.as_dict()))), d)
+        # a stored kernel version is not carried over: the value read is this kernel's
+        old = dict(d.as_dict(), kernel_version=d.kernel_version - 1)
+        self.assertEqual(AirfoilDefinition.from_dict(old), d)
+        with self.assertRaises(InputError):
+            AirfoilDefinition.from_dict(dict(d.as_dict(), edge_rule="spline"))
+
     def test_invalid(self):
         for bad in ({"chord_method": "longest"}, {"le_rule": "upstream"},
                     {"edge_zone_deg": float("nan")}, {"edge_offsets_mm": (1.0, "x")}):

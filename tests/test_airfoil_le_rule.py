@@ -6,6 +6,7 @@ import unittest
 
 import numpy as np
 
+from BladeInspect.core.airfoil import AirfoilDefinition
 from BladeInspect.cad import rotor67 as r67
 from BladeInspect.inspection import airfoil_stage as stage_mod
 from tests.helpers import ROTOR67_SECTIONS
@@ -29,7 +30,9 @@ class Rotor67LeadingEdge(unittest.TestCase):
         cls.le_line, cls.te_line = upper[:, 0, :], upper[:, -1, :]
         planes = stage_mod.nominal_planes(cls.nominal, HEIGHTS)
         cls.by_rule = {rule: stage_mod.run_stage(cls.nominal, planes,
-                                                 stage_mod.Options(draws=0, le_rule=rule))
+                                                 stage_mod.Options(
+                                                     draws=0,
+                                                     definition=AirfoilDefinition(le_rule=rule)))
                        for rule in stage_mod.LE_RULES}
 
     def _ends(self, section):
@@ -82,9 +85,9 @@ class CommandLineDefaults(unittest.TestCase):
                                                  "--out", "o"]):
             opts = self._options(base)
             self.assertIsNotNone(opts, base)
-            self.assertEqual(opts.le_rule, "engine-axis")
-            self.assertEqual(self._options(base + ["--le-rule", "larger-radius"]).le_rule,
-                             "larger-radius")
+            self.assertEqual(opts.definition.le_rule, "engine-axis")
+            self.assertEqual(self._options(base + ["--le-rule", "larger-radius"])
+                             .definition.le_rule, "larger-radius")
             self.assertIsNone(self._options(base + ["--no-airfoil"]))
             with self.assertRaises(InputError):
                 self._options(base + ["--no-airfoil", "--engine-axis", "z"])

@@ -24,7 +24,7 @@ def noisy_scans(sec, seeds, spacing=0.02):
 class NoiseRepeatability(unittest.TestCase):
     """A perfect part at sigma = 2 um, several seeds: measured - nominal against the issue's
     targets (lengths 2 um, edge radii 5 um). Metal angles: 0.005 deg is out of reach from one
-    scan at this noise (1-sigma ~6 mdeg over 50 % of the camber line, docs/airfoil.md); they are
+    scan at this noise (1-sigma ~6 mdeg over 50 % of the camber line, docs/validation.md); they are
     held to the measured spread (4 sigma)."""
 
     @classmethod

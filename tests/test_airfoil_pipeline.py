@@ -30,9 +30,8 @@ SPACING = 0.02
 COARSE_SPACING = 0.05    # for the tolerance and report wiring
 SENSOR_SIGMA = 0.002     # the sensor's 1 sigma noise (mm) for the perfect part
 QUIET_SIGMA = 0.0005     # for the known changes: the change, not the noise, is read back
-# What the kernel reaches on one scan's noisy points; the issue asks 2 um / 0.005 deg, which
-# these do not meet (docs/airfoil.md "Figures": the camber line's ends and the edge fits on
-# noisy points are being improved in core/airfoil.py). Largest |measured - nominal| over 3
+# What the kernel reaches on one scan's noisy points (docs/validation.md, "The kernel on
+# exact and noisy sections"); 2 um / 0.005 deg are not met. Largest |measured - nominal| over 3
 # seeds x 3 sections (sigma 2 um, 0.02 mm): nose-tail chord 3.2 um, stagger 0.0085 deg, LE
 # radius 7.9 um, TE radius 5.5 um, inlet angle 0.88 deg, outlet angle 1.9 deg, thickness
 # 0.5 mm from an edge 3.7 um, max-thickness position 0.48 %.

@@ -1,6 +1,6 @@
 """A trailing edge that is a corner (Rotor 67's 90 % section leaves the blade through its tip
 face there) is reported as not measurable, not read as a confident wrong angle (issue 15,
-docs/airfoil.md "Sharp edges").
+docs/user-guide.md "Sharp edges").
 
 The section is built here: a double-circular-arc section (tests/airfoil_shapes.py) whose TE
 circle is removed and its two sides run on to where their circles cross -- a corner. Its LE is

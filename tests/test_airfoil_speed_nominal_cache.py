@@ -14,6 +14,8 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from airfoil_shapes import ArcSection  # noqa: E402
 
+from BladeInspect.core import airfoil as kernel  # noqa: E402
+from BladeInspect.core.airfoil import AirfoilDefinition  # noqa: E402
 from BladeInspect.inspection import airfoil_stage as stage  # noqa: E402
 
 UM = 1e-3
@@ -28,8 +30,9 @@ class RememberedNominal(unittest.TestCase):
     def tearDown(self):
         stage.clear_nominal_cache()
 
-    def _read(self, xy, offsets=(0.5, 1.0, 2.0)):
-        return stage.nominal_characteristics(xy, "nose-tail", offsets, None, (-1.0, 0.0))
+    def _read(self, xy, offsets=(0.5, 1.0, 2.0), **definition):
+        return stage.nominal_characteristics(
+            xy, AirfoilDefinition(edge_offsets_mm=offsets, **definition), None, (-1.0, 0.0))
 
     def test_remembered_cut_reads_the_closed_form(self):
         first = self._read(self.xy)
@@ -50,6 +53,22 @@ class RememberedNominal(unittest.TestCase):
         self.assertEqual(other.edge_offsets_mm, [0.25, 0.75])
         self.assertEqual(len(other.le_thickness_mm), 2)
         self.assertEqual(len(stage._NOMINAL_CACHE), 3)
+
+    def test_a_cut_of_another_definition_is_read_afresh(self):
+        """Every definition field keys the remembered cut: a changed edge zone or metal-angle
+        window (not arguments of the cut before the definition held them) gives that
+        definition's characteristics, not the remembered ones."""
+        first = self._read(self.xy)
+        for change in ({"edge_zone_deg": 30.0}, {"metal_angle_window_pct": 30.0},
+                       {"le_radius_sigmas": 2.0}, {"chord_method": "caliper"}):
+            got = self._read(self.xy, **change)
+            want = kernel.characteristics(self.xy, le_upstream=(-1.0, 0.0),
+                                          definition=AirfoilDefinition(**change))
+            self.assertEqual(kernel.characteristics_state(got),
+                             kernel.characteristics_state(want), change)
+        zone = self._read(self.xy, edge_zone_deg=30.0)
+        self.assertNotEqual(zone.le_radius_mm, first.le_radius_mm)
+        self.assertEqual(len(stage._NOMINAL_CACHE), 5)
 
     def test_a_caller_writing_into_its_lists_does_not_change_the_next(self):
         first = self._read(self.xy)

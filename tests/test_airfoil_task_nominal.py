@@ -145,7 +145,7 @@ class TaskKeepsTheNominal(unittest.TestCase):
         task = task_u.load(self.path)
         states = dict(task.nominal)
         xy = ArcSection().points(0.05)
-        ch = stage_mod.nominal_characteristics(xy, "nose-tail", (0.5, 1.0, 2.0), None, None,
+        ch = stage_mod.nominal_characteristics(xy, kernel.AirfoilDefinition(), None, None,
                                                states)
         self.assertEqual(len(states), len(doc["nominal"]) + 1)   # a new key, none reused
         _same(ch, kernel.characteristics(xy, edge_offsets_mm=(0.5, 1.0, 2.0)))
@@ -154,7 +154,7 @@ class TaskKeepsTheNominal(unittest.TestCase):
         """A kept state that no longer fits Characteristics (a field it lacks, as a file made
         by an older version would) is computed afresh and kept anew, not a section lost."""
         xy = ArcSection().points(0.05)
-        args = ("nose-tail", (0.5, 1.0, 2.0), None, None)
+        args = (kernel.AirfoilDefinition(), None, None)
         states = {}
         stage_mod.clear_nominal_cache()
         stage_mod.nominal_characteristics(xy, *args, states)

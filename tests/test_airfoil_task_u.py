@@ -91,7 +91,7 @@ class TaskFile(unittest.TestCase):
         cls.path = os.path.join(cls.tmp, "task.json")
         cls.blade_a = _measurement(cls.nominal, cls.sections, SIGMA, 1)
         # (seed 2's section 2 would state a TE radius u twice the other seeds' in its own
-        # re-fit, a blade-to-blade spread the task's u does not follow: docs/airfoil.md)
+        # re-fit, a blade-to-blade spread the task's u does not follow: docs/user-guide.md, "Task-specific uncertainty")
         cls.blade_b = _measurement(cls.nominal, cls.sections, SIGMA, 3, _defect)
         cls.made, cls.made_calls = _run(
             cls.nominal, cls.blade_a,
@@ -211,10 +211,18 @@ class TaskFile(unittest.TestCase):
 
     # (c) another task: refused, or recomputed for a moved plane; never reused
     def test_other_options_refused(self):
+        definition = stage_mod.DEFAULT_DEFINITION
         for change in ({"chord_method": "caliper"}, {"edge_offsets_mm": (0.5, 1.0)},
-                       {"le_rule": "larger-radius"}, {"accuracy_mm": 0.003},
-                       {"engine_axis": (0.0, 1.0, 0.0)}):
-            opts = stage_mod.Options(task_uncertainty=self.path, **change)
+                       {"le_rule": "larger-radius"}, {"edge_zone_deg": 30.0},
+                       {"metal_angle_window_pct": 30.0}, {"le_radius_sigmas": 2.0},
+                       {"kernel_version": definition.kernel_version + 1},
+                       {"accuracy_mm": 0.003}, {"engine_axis": (0.0, 1.0, 0.0)}):
+            if next(iter(change)) in ("accuracy_mm", "engine_axis"):
+                opts = stage_mod.Options(task_uncertainty=self.path, **change)
+            else:   # every field of the definition keys the task
+                opts = stage_mod.Options(task_uncertainty=self.path,
+                                         definition=dataclasses.replace(definition, **change))
+                change = {"definition": None}
             with self.assertRaises(InputError) as ctx:
                 _run(self.nominal, self.blade_b, opts)
             msg = str(ctx.exception)

@@ -5,6 +5,8 @@ those objects hold is checked against independent truth (the simulator's pose, t
 plane, circle geometry). The airfoil objects and a fitted Registration survive save and
 reopen; a default-fit Registration keeps the input signature older documents stored."""
 import ast
+import dataclasses
+import json
 import os
 import shutil
 import tempfile
@@ -16,7 +18,9 @@ import FreeCAD
 
 from BladeInspect.app import actions, airfoil_objects, objects, registration_fit
 from BladeInspect.core import transforms as tf
+from BladeInspect.core.airfoil import AirfoilDefinition
 from BladeInspect.core.errors import InputError
+from BladeInspect.inspection import airfoil_stage
 from BladeInspect.inspection.simulate import simulate_measurement
 from BladeInspect.inspection.run_options import RunOptions
 
@@ -284,6 +288,14 @@ class ActionLines(unittest.TestCase):
             circles.InputSignature = ""
             circles.Proxy.execute(circles)
             self.assertAlmostEqual(circles.LeRadiusMm, radius, places=9)
+            # ... by the definition it was measured by, kept in the document
+            kept = AirfoilDefinition.from_dict(json.loads(circles.Definition))
+            self.assertEqual(kept, airfoil_stage.DEFAULT_DEFINITION)
+            circles.Definition = json.dumps(
+                dataclasses.replace(kept, edge_zone_deg=20.0).as_dict())
+            circles.InputSignature = ""
+            circles.Proxy.execute(circles)
+            self.assertGreater(abs(circles.LeRadiusMm - radius), 1e-6)
         finally:
             FreeCAD.closeDocument(copy.Name)
 

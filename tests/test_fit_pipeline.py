@@ -130,7 +130,7 @@ class DecisionThroughVerdictTest(unittest.TestCase):
 
 class PartWorstBesideLeftOutReadings(unittest.TestCase):
     """The part's worst is the largest |deviation| among the fit's inliers; readings the fit
-    left out that lie beyond it are named (docs/fits.md, "The part's worst inlier: a
+    left out that lie beyond it are named (docs/maintainers.md, "The part's worst inlier: a
     censored maximum"): a bump whose top the robust fit rejected, below the tolerance."""
 
     @classmethod

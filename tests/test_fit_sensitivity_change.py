@@ -1,5 +1,5 @@
 """The fit-sensitivity table's change of a worst deviation is the change of its size, what the
-verdict judges against +-T (issue 16 item 2, docs/fits.md): a section whose worst deviation
+verdict judges against +-T (docs/user-guide.md, "Fit objectives"): a section whose worst deviation
 is +6 um under one objective and -6 um under another has not changed (same margin to the
 band), and says that its worst point changed side; one whose worst deviation grows from 4 to
 10 um has changed by 6 um and is the largest change.

@@ -279,7 +279,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
 
 def airfoil(doc_name, registration, characteristics=None, chord_method=None,
             engine_axis=None, draws=None):
-    """The airfoil characteristics (inspection.airfoil) of the Registration named
+    """The airfoil characteristics (inspection.airfoil_stage) of the Registration named
     ``registration`` at its section table's planes, and the nominal and measured mean camber
     lines and edge circles of each section as document objects (app.airfoil_objects).
     Returns the stage (its ``blocks`` are result.json's ``airfoil``)."""

@@ -1,4 +1,4 @@
-"""The airfoil analysis in the document (issue 15): per section, the mean camber line and the
+"""The airfoil analysis in the document: per section, the mean camber line and the
 LE/TE edge circles of the nominal profile (the CAD's exact cut) and of the measured one (that
 section's registered points), as FeaturePython objects in an "Airfoil" group beside the
 section profiles. Each keeps its plane and links as inputs and rebuilds its shape when the
@@ -8,12 +8,14 @@ stage the `airfoil` and `report --airfoil` commands run.
 
 No GUI imports: view providers come from the gui layer's hook (objects.set_view_provider_hook)."""
 
+import dataclasses
 import json
 
 import numpy as np
 
 import FreeCAD
 
+from ..core import airfoil as kernel
 from ..core.contracts import json_default
 from ..core.errors import InputError
 from ..inspection import airfoil_stage as airfoil_mod
@@ -24,6 +26,16 @@ from .objects.base import (READ_ONLY, Proxy, add_property, add_table, building, 
 GROUP_NAME = "Airfoil"
 PROFILES = ("nominal", "measured")
 MCL_SAMPLES = 200
+
+
+def _definition(obj):
+    """The object's airfoil definition, its ChordMethod property (the one a user edits)
+    over the stored one; a document saved before objects kept a definition has only the
+    chord method, the other fields then the stage's defaults."""
+    text = getattr(obj, "Definition", "")
+    stored = (kernel.AirfoilDefinition.from_dict(json.loads(text)) if text
+              else airfoil_mod.DEFAULT_DEFINITION)
+    return dataclasses.replace(stored, chord_method=obj.ChordMethod or "nose-tail")
 
 
 def _vector(v):
@@ -52,6 +64,8 @@ class _SectionGeometry(Proxy):
         add(obj, "App::PropertyVector", "EngineAxis", g, "Engine axis (--engine-axis)")
         add(obj, "App::PropertyString", "ChordMethod", g,
             "Chord definition: nose-tail, caliper or tangent")
+        add(obj, "App::PropertyString", "Definition", g,
+            "The airfoil definition the profile was measured by (JSON)", hidden=True)
         add(obj, "App::PropertyIntegerList", "PointIndex", g,
             "Rows of the registration's points in this section", hidden=True)
         add(obj, "App::PropertyString", "InputSignature", g,
@@ -66,6 +80,8 @@ class _SectionGeometry(Proxy):
             return ""
         parts = [shape_signature(obj.Nominal.Shape), tuple(obj.PlaneOrigin),
                  tuple(obj.PlaneNormal), tuple(obj.EngineAxis), obj.ChordMethod, obj.Profile]
+        if getattr(obj, "Definition", ""):
+            parts.append(obj.Definition)
         if obj.Profile == "measured":
             if obj.Registration is None:
                 return ""
@@ -82,7 +98,7 @@ class _SectionGeometry(Proxy):
                                   np.array(obj.PlaneNormal, dtype=float), obj.HeightPct,
                                   point_index=np.asarray(obj.PointIndex, dtype=int))
         opts = airfoil_mod.Options(engine_axis=tuple(obj.EngineAxis),
-                                   chord_method=obj.ChordMethod or "nose-tail", draws=0)
+                                   definition=_definition(obj), draws=0)
         section = airfoil_mod.run_stage(nominal, [plane], opts, result).sections[0]
         ch = section.measured if obj.Profile == "measured" else section.nominal
         if ch is None:
@@ -103,7 +119,7 @@ class _SectionGeometry(Proxy):
 
 class CamberLine(_SectionGeometry):
     """The mean camber line: centres of the circles inscribed between the sides, extended to
-    the LE and TE points (docs/airfoil.md), in the section plane (CAD frame)."""
+    the LE and TE points (docs/user-guide.md), in the section plane (CAD frame)."""
     Type = "BladeInspect::CamberLine"
 
     def add_results(self, obj):
@@ -137,7 +153,7 @@ class CamberLine(_SectionGeometry):
 
 
 class EdgeCircles(_SectionGeometry):
-    """The circles fitted to the LE and TE zones (docs/airfoil.md), in the section plane."""
+    """The circles fitted to the LE and TE zones (docs/user-guide.md), in the section plane."""
     Type = "BladeInspect::EdgeCircles"
 
     def add_results(self, obj):
@@ -184,7 +200,8 @@ def _make(doc, cls, name, section, profile, ch, registration, nominal_obj, opts)
     obj.PlaneOrigin = _vector(plane.origin)
     obj.PlaneNormal = _vector(plane.normal)
     obj.EngineAxis = _vector(opts.engine_axis)
-    obj.ChordMethod = opts.chord_method
+    obj.ChordMethod = opts.definition.chord_method
+    obj.Definition = json.dumps(opts.definition.as_dict(), sort_keys=True)
     obj.PointIndex = [int(i) for i in (plane.point_index if plane.point_index is not None
                                        else [])]
     obj.Label = "%s %s (%s)" % ({"CamberLine": "MCL", "EdgeCircles": "Edge circles"}[

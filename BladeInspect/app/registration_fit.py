@@ -1,4 +1,4 @@
-"""A Registration's fit (issue 16, inspection.fitting): the objective, free degrees of freedom,
+"""A Registration's fit (inspection.fitting): the objective, free degrees of freedom,
 region weights, decision rule and the fine ICP's weights (``--weights``) as its inputs, and
 the fit record, the fit-sensitivity table and the weights used (result.json's ``fit``,
 ``fit_sensitivity`` and ``weights``) as read-only results.

@@ -1,5 +1,5 @@
 """Section curves: plane cuts of a CAD shape as dense ordered polylines (the nominal profiles
-a CMM measures; docs/internals.md "Words")."""
+a CMM measures; docs/maintainers.md "Words")."""
 import numpy as np
 
 import FreeCAD

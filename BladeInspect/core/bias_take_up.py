@@ -23,7 +23,7 @@ Edge feet. A point whose beam meets its normal more obliquely than the sensor re
 motion of tens of um. It takes up nothing (``takes_part``). One such point past the demo blade's
 hub end, at core.weights' grazing floor (41 against a median weight of 0.6), held two thirds of
 the take-up's weakest direction (the span screw) and made the take-up along it 3.7 where the
-fit's is 11.5 mm per mm of bias (docs/fits.md).
+fit's is 11.5 mm per mm of bias (docs/maintainers.md).
 """
 
 import numpy as np

@@ -178,7 +178,7 @@ def robust_selection(distances, a, options, neighbourhoods=None, bias_response=N
     beta_i - J_i (J^T W J)^-1 J^T W beta, beta_i = beam . normal; see _bias_response): a smooth
     field reaching several um where the beams meet the surface unlike the rest (edges, grazing
     views), 5-7 spreads, which the test alone would reject as a flank, and reject or keep
-    depending on the draw (docs/fits.md, "The defect test and the sensor's bias"). So with
+    depending on the draw (docs/maintainers.md, "The defect test and the sensor's bias"). So with
     `bias_response` a neighbourhood's mean counts only by what exceeds the most that field can
     put in it, systematic_mm times the mean of |s_i| sqrt(a_i) (z's scaling): a point is
     down-weighted from that + k_full spreads, rejected from that + k_zero spreads. Where the
@@ -448,7 +448,7 @@ def random_residual_share(weights, residuals, n_parameters=6):
 
     Why: an uncertainty budget that carries the sensor's bias as its own term would count it
     twice through a pose covariance scaled by s^2 (Rotor 67's planned scan, a 6 um bias: the
-    covariance's 1 sigma 1.8x the noise-only one; docs/fits.md, "The pose term's scale")."""
+    covariance's 1 sigma 1.8x the noise-only one; docs/maintainers.md, "The pose term's scale")."""
     w = np.asarray(weights, dtype=float)
     r = np.asarray(residuals, dtype=float)
     keep = np.isfinite(w) & np.isfinite(r) & (w > 0)
@@ -537,7 +537,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
         iterations += 1
-        if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+        if weight_model is not None:   # sensor-model weights (core.weights)
             a = normalised_weights(weight_model, T, normals, len(points))
         rho, _, _ = robust_selection(distances, a, options, neighbourhoods,
                                      bias_response(T, moved, normals))
@@ -585,7 +585,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
     else:
         moved = points @ T[:3, :3].T + T[:3, 3]
         closest, normals, distances = closest_fn(moved)
-    if weight_model is not None:   # hook: sensor-model weights (core.weights, issue 16)
+    if weight_model is not None:   # sensor-model weights (core.weights)
         a = normalised_weights(weight_model, T, normals, len(points))
     rho, _, cut = robust_selection(distances, a, options, neighbourhoods,
                                    bias_response(T, moved, normals))

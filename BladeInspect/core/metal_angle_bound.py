@@ -1,5 +1,5 @@
 """Cramer-Rao lower bound of the inlet and outlet metal angles on a given set of measured
-points (issue 15's 0.005 deg), numpy/scipy only.
+points (the 0.005 deg target), numpy/scipy only.
 
 Model: near each edge the measured profile is the nominal one moved along its normal by a
 deviation field e that is, on each side, a polynomial of degree ``degree`` (Legendre, in the
@@ -15,7 +15,7 @@ The bound is relative to the model: an estimator that may assume a lower-degree 
 (e.g. one that knows the part deviates from its CAD only as a parabola over the window) is held
 to the lower figure that degree gives; one that must follow any part to the degree-4 figure:
 the definition is a quartic fit over the window, so degree 4 and up give the same bound (the
-definition's own variance; degree 6 is within 1 % of it on the DCA section). docs/airfoil.md
+definition's own variance; degree 6 is within 1 % of it on the DCA section). docs/validation.md
 states both.
 """
 import numpy as np
@@ -26,7 +26,7 @@ from . import airfoil
 # the angle's linear regime (5e-5 and 1e-3 mm agree to 1e-2 in every component) and wide
 # enough that the rule's sub-mdeg discrete steps (a centre more or less) do not show.
 GRADIENT_STEP_MM = 1e-3
-TARGET_DEG = 0.005          # issue 15: measured - nominal within 0.005 deg for angles
+TARGET_DEG = 0.005          # the target: measured - nominal within 0.005 deg for angles
 
 
 def _end_points(chars):

@@ -96,7 +96,7 @@ def _split_csv(path, text):
         raise InputError("%s: a header but no data rows" % path)
     if "#" not in body and _every_line_has_commas(body, n_cols - 1):
         # The usual file: one split of the whole text instead of one per line; or, when every
-        # field is a plain number, numpy's parser of the whole text (hook: issue 14, speed).
+        # field is a plain number, numpy's parser of the whole text.
         fields = body.replace("\n", ",")
         numbers = _all_numbers(fields, body.count("\n") + 1, n_cols)
         if numbers is not None:

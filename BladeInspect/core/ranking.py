@@ -1,6 +1,6 @@
 """One objective for ranking candidate poses, and the test of whether the best two differ.
 
-Why this objective (issue 13): a candidate judged by the residual of the points it keeps, or
+Why this objective: a candidate judged by the residual of the points it keeps, or
 by a median, can look better than the truth by explaining most of the part and rejecting the
 rest - on a near-symmetric vane the half-turned pose fits both arcs and drops both edges. So
 every candidate is judged on the same points (all of them), by the same loss, at the same

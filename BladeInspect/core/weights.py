@@ -1,4 +1,4 @@
-"""The readings' weights from the sensor's noise model (issue 16, item 3).
+"""The readings' weights from the sensor's noise model.
 
 A conoscopic sensor measures a distance along its beam: a reading's error is a displacement
 along the beam of standard deviation sigma_beam(SNR) = sigma_ref sqrt(SNR_ref / SNR)

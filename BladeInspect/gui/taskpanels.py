@@ -207,7 +207,7 @@ class ScanPanel(FormPanel):
 
 
 class FitSelector(QtGui.QGroupBox):
-    """The fit choice (issue 16): --fit, --free, --weights-by-zone, --decision-rule and the
+    """The fit choice: --fit, --free, --weights-by-zone, --decision-rule and the
     fine ICP's --weights, as the command line's (inspection.fitting checks them when the
     command runs)."""
 
@@ -312,7 +312,7 @@ def registration_html(obj):
             record["objective"], ",".join(record["free"]) if isinstance(record["free"], list)
             else record["free"], record["decision_rule"]))))
     weights = getattr(obj, "WeightsUsed", "")
-    if weights:   # issue 16 item 3: which weights the fine ICP used, and why
+    if weights:   # which weights the fine ICP used, and why
         rows.append((tr("ICP weights"), _escape(weights)))
     html = "<table cellspacing='4'>" + "".join(
         "<tr><td><b>%s</b></td><td>%s</td></tr>" % row for row in rows) + "</table>"
@@ -421,7 +421,7 @@ class TablePanel(_ResultPanel):
             layout.addWidget(sensitivity_widget(sensitivity))
 
 
-# ---------------------------------------------------------------- airfoil (issue 15)
+# ---------------------------------------------------------------- airfoil
 
 class AirfoilOptionsPanel(FormPanel):
     """The `airfoil` command's options: the characteristics file, chord method, engine axis."""

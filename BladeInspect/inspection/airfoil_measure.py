@@ -43,9 +43,8 @@ def point_noise(pts2d, nominal_profile):
 def measure(pts2d, nominal_chars, opts, noise, le_hint):
     ordered = kernel.order_by_nominal(pts2d, nominal_chars.profile)
     measured = kernel.Profile(ordered, noise, nominal=nominal_chars.profile)
-    ch = kernel.characteristics(measured, engine_axis=(1.0, 0.0), chord_method=opts.chord_method,
-                                edge_offsets_mm=opts.edge_offsets_mm, le_hint=le_hint,
-                                noise_mm=noise)
+    ch = kernel.characteristics(measured, engine_axis=(1.0, 0.0), le_hint=le_hint,
+                                noise_mm=noise, definition=opts.definition)
     ch = kernel.withhold_corner_edges(ch, nominal_chars)      # metal-angle hook: sharp edges
     # the twist's pivot, the nominal's centroid, is known: not integrated again for each draw
     fit = kernel.fit_section(ordered, nominal_chars.profile, pivot=nominal_chars.centroid_mm)

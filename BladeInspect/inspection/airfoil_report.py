@@ -1,4 +1,4 @@
-"""The report's airfoil pages (issue 15): per section a characteristics table (nominal, actual,
+"""The report's airfoil pages: per section a characteristics table (nominal, actual,
 deviation, +-u, tolerance, verdict) and a figure of the profile with its mean camber line, a
 few inscribed circles, the LE/TE circles and the chord line; then shift and twist along the
 span. Drawn from the stage inspection.airfoil_stage attached to the section table."""
@@ -132,7 +132,7 @@ def add_pages(pdf, parts, table):
     parts += ["<h2>Airfoil characteristics</h2>",
               "<p>%s</p>" % html.escape(characteristic_names.airfoil_verdict_text(
                   stage.verdict, stage.blocks)),
-              "<p class='note'>Definitions: docs/airfoil.md; chord %s; angles from the engine "
+              "<p class='note'>Definitions: docs/user-guide.md; chord %s; angles from the engine "
               "axis %s; LE: %s; uncertainty: %s, %s. Tolerances limit the deviation; "
               "decision rule: %s (%s).</p>"
               % (html.escape(stage.settings["chord_method"]),

@@ -1,8 +1,8 @@
-"""The airfoil stage (issue 15): per section plane the nominal characteristics from the CAD's
+"""The airfoil stage: per section plane the nominal characteristics from the CAD's
 exact cut, the measured ones from that section's registered points, their deviation, standard
 uncertainty, tolerance and verdict, and the blade's lean and bow; its options, its section
 planes, the nominal cuts it remembers, and its files (airfoil.json, airfoil.csv, a lot's
-summary_airfoil.csv). The numerics are core.airfoil's, the definitions docs/airfoil.md; the
+summary_airfoil.csv). The numerics are core.airfoil's, the definitions docs/user-guide.md; the
 measuring of a section's points is airfoil_measure's, their uncertainty airfoil_uncertainty's
 (or an uncertainty task file's, airfoil_task), the verdicts airfoil_verdicts'.
 """
@@ -41,11 +41,24 @@ CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "
               "lower", "upper", "U_k2", "decision_rule", "verdict")
 
 
+# Which end of the nominal profile is the LE when the CAD's faces do not name it:
+# "engine-axis" -- the flow runs along +engine axis, so the LE is the upstream end (the end
+# furthest along -engine axis in the plane); "larger-radius" -- the blunter end (the kernel's
+# rule without a direction; it picks Rotor 67's TE at 10 % span, whose radius is the larger).
+LE_RULES = ("engine-axis", "larger-radius")
+LE_RULE_TEXT = {"engine-axis": "the upstream end: the flow runs along +engine axis",
+                "larger-radius": "the end with the larger edge radius (the engine axis when "
+                                 "the radii agree within their uncertainty)"}
+# The stage's definition unless one is given: the kernel's, the LE upstream.
+DEFAULT_DEFINITION = kernel.AirfoilDefinition(le_rule="engine-axis")
+
+
 @dataclass
 class Options:
     engine_axis: tuple = (1.0, 0.0, 0.0)
-    chord_method: str = "nose-tail"
-    edge_offsets_mm: tuple = kernel.DEFAULT_EDGE_OFFSETS_MM
+    # what each characteristic means (chord method, edge offsets, LE rule, edge zone,
+    # metal-angle window): one value, whose digest keys the nominal cuts and task files
+    definition: kernel.AirfoilDefinition = DEFAULT_DEFINITION
     tolerances: list = field(default_factory=list)     # of Tolerance
     characteristics_file: str = None
     draws: int = DEFAULT_DRAWS      # re-fits for the uncertainty; 0: none
@@ -80,14 +93,6 @@ class Tolerance:
     row: int = 0
 
 
-# Which end of the nominal profile is the LE when the CAD's faces do not name it:
-# "engine-axis" -- the flow runs along +engine axis, so the LE is the upstream end (the end
-# furthest along -engine axis in the plane); "larger-radius" -- the blunter end (the kernel's
-# rule without a direction; it picks Rotor 67's TE at 10 % span, whose radius is the larger).
-LE_RULES = ("engine-axis", "larger-radius")
-LE_RULE_TEXT = {"engine-axis": "the upstream end: the flow runs along +engine axis",
-                "larger-radius": "the end with the larger edge radius (the engine axis when "
-                                 "the radii agree within their uncertainty)"}
 # The plane frame's x axis is the engine axis (cad/airfoil_sections.py): upstream is -x.
 UPSTREAM_2D = (-1.0, 0.0)
 
@@ -193,13 +198,14 @@ def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
                       edge_offsets=None, le_rule=None, uncertainty_task=None):
     """Options from the command line's text values (None: the default)."""
     opts = Options()
+    definition = {}
     if uncertainty_task is not None:
         airfoil_task.check_file(uncertainty_task)   # an existing file must be a task file
         opts.task_uncertainty = uncertainty_task
     if le_rule is not None:
         if le_rule not in LE_RULES:
             raise InputError("--le-rule: %r is not one of %s" % (le_rule, ", ".join(LE_RULES)))
-        opts.le_rule = le_rule
+        definition["le_rule"] = le_rule
     if engine_axis is not None:
         opts.engine_axis = parse_engine_axis(engine_axis)
     if characteristics is not None:
@@ -209,9 +215,10 @@ def options_from_args(engine_axis=None, characteristics=None, chord_method=None,
         if chord_method not in kernel.CHORD_METHODS:
             raise InputError("--chord-method: %r is not one of %s"
                              % (chord_method, ", ".join(kernel.CHORD_METHODS)))
-        opts.chord_method = chord_method
+        definition["chord_method"] = chord_method
     if edge_offsets is not None:
-        opts.edge_offsets_mm = parse_offsets(edge_offsets)
+        definition["edge_offsets_mm"] = parse_offsets(edge_offsets)
+    opts.definition = dataclasses.replace(opts.definition, **definition)
     return opts
 
 
@@ -297,8 +304,7 @@ NOMINAL_CACHE_SIZE = 16
 _NOMINAL_CACHE = {}
 
 
-def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstream,
-                            states=None):
+def nominal_characteristics(xy, definition, le_hint, le_upstream, states=None):
     """kernel.characteristics of a nominal cut (engine axis +x of its frame), remembered
     (above); each call has its own Characteristics (its own warnings list), the numbers and
     the profile shared. ``states``: a dict of computed cuts by the same key
@@ -306,7 +312,7 @@ def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstr
     found there is read back instead of computed (the same bits), one computed is added."""
     xy = np.ascontiguousarray(xy, dtype=float)
     h = hashlib.sha256(xy.tobytes())
-    h.update(repr((xy.shape, chord_method, [float(v) for v in edge_offsets_mm],
+    h.update(repr((xy.shape, definition.digest(),
                    None if le_hint is None else np.asarray(le_hint, float).tolist(),
                    None if le_upstream is None else np.asarray(le_upstream, float).tolist()))
              .encode())
@@ -320,9 +326,8 @@ def nominal_characteristics(xy, chord_method, edge_offsets_mm, le_hint, le_upstr
             # it) is computed afresh, not taken for a section the kernel cannot read
             del states[key]
     if ch is None:
-        ch = kernel.characteristics(xy, engine_axis=(1.0, 0.0), chord_method=chord_method,
-                                    edge_offsets_mm=edge_offsets_mm, le_hint=le_hint,
-                                    le_upstream=le_upstream)
+        ch = kernel.characteristics(xy, engine_axis=(1.0, 0.0), le_hint=le_hint,
+                                    le_upstream=le_upstream, definition=definition)
     if states is not None and key not in states:
         states[key] = kernel.characteristics_state(ch)
     _NOMINAL_CACHE[key] = ch            # the most recent last
@@ -347,9 +352,9 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis,
                                     polylines=plane.cut_polylines)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
-        upstream = UPSTREAM_2D if opts.le_rule == "engine-axis" else None
-        nom = nominal_characteristics(xy, opts.chord_method, opts.edge_offsets_mm, hint,
-                                      upstream, None if task is None else task.nominal)
+        upstream = UPSTREAM_2D if opts.definition.le_rule == "engine-axis" else None
+        nom = nominal_characteristics(xy, opts.definition, hint, upstream,
+                                      None if task is None else task.nominal)
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
@@ -477,11 +482,14 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     else:
         calibration = "the rig calibration not included (no RIG.json stating its uncertainty)"
     settings = {"engine_axis": list(map(float, opts.engine_axis)),
-                "chord_method": opts.chord_method,
-                "le_rule": opts.le_rule,
-                "le_rule_meaning": LE_RULE_TEXT[opts.le_rule] + " (unless the CAD's faces "
-                                   "name the LE: the block's le_rule says \"given\")",
-                "edge_offsets_mm": list(map(float, opts.edge_offsets_mm)),
+                "chord_method": opts.definition.chord_method,
+                "le_rule": opts.definition.le_rule,
+                "le_rule_meaning": LE_RULE_TEXT[opts.definition.le_rule] + " (unless the "
+                                   "CAD's faces name the LE: the block's le_rule says "
+                                   "\"given\")",
+                "edge_offsets_mm": list(map(float, opts.definition.edge_offsets_mm)),
+                "definition": opts.definition.as_dict(),
+                "definition_digest": opts.definition.digest(),
                 "characteristics_file": opts.characteristics_file,
                 "tolerance_meaning": "lower/upper limit the deviation measured - nominal",
                 "uncertainty_method": "re-fit of perturbed points: pose from the registration "
@@ -537,7 +545,7 @@ def attach(result, nominal, table, verdict, opts=None):
         if verdict.get("verdict") in (decision_mod.PASS, None):
             verdict["verdict"] = decision_mod.NOT_PROVEN
     verdict["airfoil"] = stage.verdict
-    if getattr(result, "fit_sensitivity", None):   # issue 16 item 2: the airfoil rows
+    if getattr(result, "fit_sensitivity", None):   # the airfoil rows
         add_to_sensitivity(result.fit_sensitivity, stage, result, opts)
     return stage
 

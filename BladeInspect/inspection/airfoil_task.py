@@ -23,12 +23,10 @@ from .airfoil_uncertainty import (maxima_bias, point_noise_model, refit_uncertai
 from .airfoil_values import flat, unflat
 
 # Raise whenever the re-fit draws' model (inspection.airfoil_uncertainty.refit_uncertainty,
-# point_noise_model, inspection.airfoil_measure.measure) changes: files of another version are
-# refused. 2: the measured profile's fit takes the nominal's knots where the points thin out
-# (core.airfoil._knots_from_nominal), which changes the draws' scatter. 3: the draws' base is
-# each reading's beam where it meets the smooth fit (inspection.airfoil_uncertainty.beam_feet),
-# and their pose the covariance's random part (inspection.uncertainty.random_pose_covariance).
-TASK_MODEL_VERSION = 3
+# point_noise_model, inspection.airfoil_measure.measure) or the key's layout changes: files of
+# another version are refused, never read as this one's. A changed airfoil definition or
+# kernel needs no raise: the key holds the definition and its kernel version.
+TASK_MODEL_VERSION = 4
 FILE_KIND = "BladeInspect airfoil task uncertainty"
 DEFAULT_TASK_DRAWS = 48
 # The match rule: relative half-widths about the stored conditions.
@@ -79,9 +77,7 @@ def task_key(nominal, opts, result):
     key = {"version": TASK_MODEL_VERSION,
            "cad": cad_fingerprint(nominal),
            "engine_axis": [round(float(v), 9) for v in opts.engine_axis],
-           "chord_method": opts.chord_method,
-           "edge_offsets_mm": [round(float(v), 9) for v in opts.edge_offsets_mm],
-           "le_rule": opts.le_rule,
+           "definition": opts.definition.as_dict(),
            "sensor": json.loads(json.dumps(asdict(sensor_of(opts)))),
            "fit": _fit_of(result),
            "readings": {"snr": result.snr is not None,

@@ -5,7 +5,7 @@ Each draw moves the section's points by a pose drawn from the registration's cov
 random part, inspection.uncertainty.random_pose_covariance), lays fresh sensor noise on the
 measured profile's smooth fit where each reading's beam meets it (beam_feet; "The draws'
 base": the closest point would keep the scan's own error along the surface beneath the draw's,
-docs/fits.md) -- each reading's own sigma_beam(SNR) along its beam, in the sensor's
+docs/maintainers.md) -- each reading's own sigma_beam(SNR) along its beam, in the sensor's
 distribution (its normal part is inspection.uncertainty.normal_noise; along the normal without
 beams, the section's point-to-point scatter only for readings without SNR) -- and adds one
 reading bias within the sensor's stated accuracy carried through the registration as
@@ -125,7 +125,7 @@ def refit_uncertainty(m, opts, rng, draws_sd=None):
         if opts.calibration_mm and axis_fields is None:
             # the calibration's error at the part as one in-plane translation of the section
             # (1 sigma per axis): its location part, which the Monte Carlo showed missing
-            # (docs/airfoil.md, "Decisions")
+            # (docs/user-guide.md, "Decisions")
             p2 = p2 + float(opts.calibration_mm) * rng.standard_normal(2)
         try:
             c, f, k, _ = airfoil_measure.measure(p2, nom, opts, noise, nom.le_point)
@@ -149,7 +149,7 @@ def _calibration_model(result, idx, opts, sensor):
     """(fields (n, 3, 4), Cholesky factor (4, 4)) of the section's readings' axis errors
     (uncertainty.calibration_fields) when the options carry RIG.json's axis covariance and the
     readings their angles, else (None, None): calibration_mm's in-plane translation serves
-    instead (it over-states the shifts and holds no shape part, docs/airfoil.md). The fields
+    instead (it over-states the shifts and holds no shape part, docs/maintainers.md, "The airfoil draws"). The fields
     of the whole scan cost ~0.04 s (demo loop, 16264 readings), against ~1 s of a section's
     re-fits: not kept between sections."""
     if opts.calibration_axis is None:

@@ -215,10 +215,10 @@ def add_to_sensitivity(doc, stage, result, opts):
                     largest = {"characteristic": row["characteristic"], "change": change,
                                "unit": row["unit"], "change_over_U": float(score)}
     doc["rows"] = doc["rows"] + rows
-    # issue 15 item 5 hook: what completes these rows' display names (chord method, edge
-    # offsets; inspection.characteristic_names)
-    doc["airfoil_definitions"] = {"chord_method": opts.chord_method,
-                                  "edge_offsets_mm": [float(x) for x in opts.edge_offsets_mm]}
+    # what completes these rows' display names (inspection.characteristic_names)
+    doc["airfoil_definitions"] = {
+        "chord_method": opts.definition.chord_method,
+        "edge_offsets_mm": [float(x) for x in opts.definition.edge_offsets_mm]}
     doc["largest_change_airfoil"] = largest
     doc["largest_change_airfoil_rule"] = ("the airfoil row whose change across the fits is "
                                           "largest in units of its U (k = 2); none when no "

@@ -82,7 +82,7 @@ def _row_from_result_json(name, doc):
     worst = max((dev.get("min"), dev.get("max")), key=lambda v: abs(v or 0.0))
     row = {"file": name, "status": "ok", "n_points": doc.get("n_points"),
            "rms_mm": doc.get("rms_mm"), "worst_deviation_mm": worst,
-           # the decision rule's pass / not proven / fail (issue 16), else today's pass/fail
+           # the decision rule's pass / not proven / fail, else today's pass/fail
            "verdict": verdict.get("verdict") or ("pass" if verdict.get("pass") else "fail"),
            "pose_uncertainty_mm": doc.get("pose_uncertainty_mm"), "error": ""}
     for sec in (doc.get("sections") or {}).get("sections", []):
@@ -230,7 +230,7 @@ def run_batch(cad_path, scans_dir, out_dir, options=None, workers=None, schedule
     'message': one line for the command line}. ``options``: inspection.run_options.RunOptions
     of every file, as for `report` (its tolerance, seed, allow_mismatch, airfoil, fit and
     measurement model, the rig calibration's term from `--rig-file`, make the inputs record);
-    with ``options.airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil);
+    with ``options.airfoil`` also ``out_dir``/summary_airfoil.csv (inspection.airfoil_stage);
     ``document``: the writer of each file's inspection.FCStd, as for report.run_report."""
     options = options or RunOptions()
     progress = progress or (lambda f, m: None)

@@ -1,4 +1,4 @@
-"""What a metrology engineer reads for each airfoil characteristic (issue 15 item 5): its name,
+"""What a metrology engineer reads for each airfoil characteristic: its name,
 its unit and a one-line meaning, keyed by the result.json field name (``chord_mm``;
 ``le_thickness_mm[1]`` for a list element). The report writes these names, the workbench shows
 them through Qt's translation. The field name stays what the files and ``--characteristics``
@@ -121,7 +121,7 @@ AIRFOIL_VERDICT_LINES = {
 NOT_MEASURED = " (not measured)"   # inspection.airfoil_verdicts.judge's suffix of an unmeasured key
 NOT_MEASURED_NAME = QT_TRANSLATE_NOOP("BladeInspect", "%s (not measured)")
 
-# Verdicts as core.decision and inspection.airfoil write them, marked so that they are
+# Verdicts as core.decision and inspection.airfoil_verdicts write them, marked so that they are
 # translated where they are shown.
 VERDICTS = (QT_TRANSLATE_NOOP("BladeInspect", "pass"),
             QT_TRANSLATE_NOOP("BladeInspect", "fail"),

@@ -1,7 +1,7 @@
 """The inspection's checkpoint: what `inspect` has measured so far, kept in DIR/.checkpoint
 while it runs (Checkpoint), and how a resumed run checks that it continues the same
 inspection (inspection_identity) and puts the points file, the rig's pass numbering and the
-journal back to where the interrupted run stood (start_or_resume). docs/internals.md
+journal back to where the interrupted run stood (start_or_resume). docs/maintainers.md
 describes the fields.
 """
 

@@ -1,4 +1,4 @@
-"""What a registration refuses, and what it reports it could not measure (issue 13, item 3).
+"""What a registration refuses, and what it reports it could not measure.
 
 A metrology result must be right or say it cannot be trusted, so a registration is refused,
 with one line naming the file and the problem, when

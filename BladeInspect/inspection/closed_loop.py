@@ -24,7 +24,7 @@ and scan.json marked incomplete with the loop's state under "inspection" (no res
 measured data is kept section by section in DIR/.checkpoint while the loop runs
 (inspection.checkpoint), every pass in between journaled (measurement.journal), so a kill -9 or a power cut
 loses at most the pass in flight and --resume continues that folder; a simulated rig's noise
-depends only on the pass number, which the checkpoint carries. See docs/internals.md for the
+depends only on the pass number, which the checkpoint carries. See docs/maintainers.md ("The closed loop and its checkpoint") for the
 checkpoint's fields.
 """
 
@@ -404,7 +404,7 @@ class _SectionsPhase:
         progress(0.45 + 0.05 * attempt, "planning the nominal sections from the CAD")
         return plan_sections(self.nominal, pose, heights, self.rig.sensor, self.rig.limits,
                              span_axis=span_axis, kinematics=self.kinematics,
-                             edge_radius_sigma_mm=self.edge_radius_sigma_mm)  # issue 15 item 7
+                             edge_radius_sigma_mm=self.edge_radius_sigma_mm)
 
     def scan(self, plan, attempt, first, on_unit, progress):
         scan_plan(self.rig, plan, self.kinematics,
@@ -451,7 +451,7 @@ class _SectionsPhase:
     def result_json(self, plan, n_read, state, rig_s, timing):
         return {"replans": state["replans"], "n_points_by_phase": {"blind": None,
                                                                     self.name: n_read},
-                "edge_density": plan.info.get("edge_density")}  # issue 15 item 7
+                "edge_density": plan.info.get("edge_density")}
 
     def summary(self, plan, state, rig_s, timing):
         return {"replans": state["replans"]}
@@ -606,7 +606,7 @@ def _loop(phase, run):
     columns, result = _result_of_all(run, phase, blind, blind_sections, measured, (xyz, snr),
                                      fit, first)
     result.weights = weights_record
-    # issue 15 item 7: the plan's edges a sensor spot averages away are said, not hidden
+    # the plan's edges a sensor spot averages away are said, not hidden
     edge_rule = (getattr(plan, "info", None) or {}).get("edge_density")
     if edge_rule:
         result.warnings += edge_rule["warnings"]

@@ -1,4 +1,4 @@
-"""The report's decision, uncertainty and fit pages (issue 16): the decision rule, U and the
+"""The report's decision, uncertainty and fit pages: the decision rule, U and the
 test uncertainty ratio of every judged value, the fit used and the fit-sensitivity table."""
 
 import html
@@ -62,7 +62,7 @@ def weights_text(record):
 
 
 def fit_lines(result):
-    weights = weights_text(getattr(result, "weights", None))   # issue 16 item 3
+    weights = weights_text(getattr(result, "weights", None))
     lines = ["ICP weights: " + weights] if weights else []
     fit = result.fit
     if not fit:

@@ -1,4 +1,4 @@
-"""The step every command takes between a registration and its verdict (issue 16): move the
+"""The step every command takes between a registration and its verdict: move the
 result to the chosen fit's pose (inspection.fitting.apply, every objective fitted for the
 sensitivity table), tabulate its sections, judge them with the chosen decision rule
 (inspection.verdict.judge) and record the fit-sensitivity table. `report`, `inspect` and the

@@ -379,7 +379,7 @@ def fine_register(measured_xyz, snr, nominal, init, rng=None, progress=_no_progr
     foot points), or None. ``systematic_mm``: the sensor's stated accuracy (the default
     sensor's, as the uncertainty model's systematic term); with the sensor weights' beams,
     core.icp's defect test grants each neighbourhood the field a bias of that size leaves
-    after the fit (the sensor's own error, not a defect's flank: docs/fits.md)."""
+    after the fit (the sensor's own error, not a defect's flank: docs/maintainers.md)."""
     settings = FineOptions(**settings)
     time_limit_s = (FINE_TIME_LIMIT_S if settings.time_limit_s is None
                     else settings.time_limit_s)
@@ -659,7 +659,7 @@ def result_json(result, extra=None):
         "pose_unmeasured": list(result.pose_unmeasured),
         "surface_fit": result.surface_fit,
     }
-    for name in ("fit", "fit_sensitivity", "weights"):   # hook: inspection.fitting (issue 16)
+    for name in ("fit", "fit_sensitivity", "weights"):   # inspection.fitting
         if getattr(result, name, None) is not None:
             doc[name] = getattr(result, name)
     if extra:

@@ -1,6 +1,6 @@
 """Profile sections' errors (paper 4.2, Table 2, Figs 9-10): the registered points of each
 profile section against the CAD's section curve in the same plane, optionally beside a CMM's
-points of the same sections (docs/internals.md "Words").
+points of the same sections (docs/maintainers.md "Words").
 
 Where the profile sections are:
 - with a ``section`` column, each section line's own points (CAD frame) define its plane

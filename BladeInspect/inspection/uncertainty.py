@@ -361,7 +361,7 @@ def worst_terms(result, candidates, model=None, left_out=None):
     up at one point and not at its neighbour pushes one of them up), else they add their
     variance at the worst as for a single reading; the calibration term is the single
     reading's. The bias of the maximum is included in U, not corrected: the reported worst
-    deviation stays the measured one (docs/fits.md). A lone worst is a single reading."""
+    deviation stays the measured one (docs/maintainers.md). A lone worst is a single reading."""
     model = model or MeasurementModel()
     candidates = np.atleast_1d(np.asarray(candidates, dtype=int))
     dev = np.asarray(result.deviation, dtype=float)[candidates]
@@ -396,7 +396,7 @@ def censored_worst_terms(result, worst, candidates, left_out, model):
 
     Where a defect straddles the robust fit's cut-off, the fit keeps its flanks and gives its
     top no weight, and which flank readings it keeps follows their measured deviations; the
-    worst inlier's truth then follows the noise too (docs/fits.md, "The part's worst inlier: a
+    worst inlier's truth then follows the noise too (docs/maintainers.md, "The part's worst inlier: a
     censored maximum"). Each reading's true level is the mean of the measured deviations of
     its LEVEL_NEIGHBOURS nearest readings (kept or left out), turned to the worst's side. The
     competitors are the readings whose level lies within COMPETING_SIGMAS combined noise sigmas

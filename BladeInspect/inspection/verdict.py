@@ -31,8 +31,8 @@ ZONE_TEXT = {"LE": "leading edge", "TE": "trailing edge", "suction": "suction si
 
 def linked_groups(points, out_idx, neighbours):
     """Groups of the points ``out_idx`` (the out-of-tolerance ones here; the fit's rejected
-    ones in inspection.airfoil) linked when one is among the other's nearest measured points:
-    (component label per point, component sizes)."""
+    ones in inspection.airfoil_verdicts) linked when one is among the other's nearest
+    measured points: (component label per point, component sizes)."""
     n = len(out_idx)
     if n == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
@@ -86,7 +86,7 @@ def _larger_not_fitted(result, dev, worst, left_out):
     whose |deviation| exceeds the part's worst inlier: {n, worst_deviation_mm, xyz}, None when
     there are none. Where a defect straddles the robust fit's cut-off, the worst inlier is
     pinned under it and which readings are inliers follows their measured deviations
-    (docs/fits.md, "The part's worst inlier: a censored maximum"): the part's largest
+    (docs/maintainers.md, "The part's worst inlier: a censored maximum"): the part's largest
     deviation is then not that row's; those readings are judged where a section's band or a
     spot holds them."""
     larger = left_out[np.abs(dev[left_out]) > abs(dev[worst])]

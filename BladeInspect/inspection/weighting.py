@@ -1,4 +1,4 @@
-"""Which weights the fine registration uses (`--weights snr|sensor`, issue 16 item 3) and the
+"""Which weights the fine registration uses (`--weights snr|sensor`) and the
 record of that choice in result.json's ``weights`` block.
 
 - ``snr``: the paper's SNR-linear weights (uniform when the points carry no SNR);

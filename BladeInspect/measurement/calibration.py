@@ -219,7 +219,7 @@ def calibrate(rig, sphere_diameter=DEFAULT_DIAMETER, angles=DEFAULT_ANGLES, out_
                          % (sphere_diameter, measured_d))
     axis = axis_from_centres(centres, angles)
     calibrated = _with_axis(prior, axis["point"], axis["direction"])
-    # hook: the calibration's own uncertainty (issue 16), written into RIG.json beside the axis
+    # the calibration's own uncertainty, written into RIG.json beside the axis
     own = calibration_uncertainty(centres, centre_covariances, angles, calibrated,
                                   sphere_position)
     if out_path is not None:

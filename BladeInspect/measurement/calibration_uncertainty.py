@@ -1,4 +1,4 @@
-"""The rig calibration's own uncertainty (issue 16): how well `calibrate` knows the rotary axis,
+"""The rig calibration's own uncertainty: how well `calibrate` knows the rotary axis,
 and what that means at the part.
 
 The axis is a line: four parameters, (x, z) where it crosses the machine plane y = 0 and its

@@ -186,7 +186,7 @@ EDGE_DENSIFY_REACH = 2.0
 # the fitted circle: this many times the rule's points (measured on the demo blade: 1.0 gave
 # sigma_R 2.23 um for a 2 um target).
 EDGE_DENSIFY_MARGIN = 1.25
-# `inspect` plans its sections with this edge-radius 1-sigma target (issue 15 item 7; its
+# `inspect` plans its sections with this edge-radius 1-sigma target (its
 # --edge-radius-sigma changes it, 0 or off turns the rule off).
 DEFAULT_EDGE_RADIUS_SIGMA_MM = 0.002
 # An edge whose radius is under this many spot diameters is averaged away by the spot (the
@@ -197,7 +197,7 @@ EDGE_MIN_SPOTS = 2.0
 def _edge_spacing(loop, plane_point, plane_normal, spacing, noise_mm, radius_sigma_mm,
                   record=None):
     """Spacing wanted at each vertex of a closed loop: ``spacing``, or within
-    EDGE_DENSIFY_REACH radii of an edge circle (core/airfoil.py's LE/TE fit on the cut) the
+    EDGE_DENSIFY_REACH radii of an edge circle (core.airfoil's LE/TE fit on the cut) the
     spacing that gives its +-45 degree zone edge_points_needed(noise, sigma_R) points.
     ``record``: a list that gets each edge's circle and spacing (the plan's info)."""
     from ..cad.airfoil_sections import plane_frame
@@ -454,9 +454,9 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     (None: the nominal axis through the origin along +Y); ``limits`` an AxisLimits.
     Returns a Plan. Raises InputError for heights outside 0-100 or a plane that misses the
     CAD, DeviceError when a setpoint is unreachable within the soft limits.
-    ``edge_radius_sigma_mm`` (issue 15 item 7; None: off): points round each section's LE and
+    ``edge_radius_sigma_mm`` (None: off): points round each section's LE and
     TE closer, so that its fitted edge radius's 1-sigma at the sensor's reference noise
-    (sensor.sigma_ref) is at most this (docs/airfoil.md, "Edges measured densely enough")."""
+    (sensor.sigma_ref) is at most this (docs/user-guide.md, "Edges measured densely enough")."""
     heights = [float(h) for h in np.atleast_1d(heights_pct)]
     if not heights:
         raise InputError("--section-heights: at least one height is needed")
@@ -556,7 +556,7 @@ def edge_density_info(densify, edges, heights, spot_mm):
             "margin": EDGE_DENSIFY_MARGIN, "reach_radii": EDGE_DENSIFY_REACH,
             "rule": "n = ceil((noise / radius_sigma * f(zone))^2) points in each +-zone edge "
                     "zone, times margin, spread within reach_radii edge radii of the edge "
-                    "circle's centre (docs/airfoil.md)",
+                    "circle's centre (docs/user-guide.md)",
             "sections": edges}
 
 

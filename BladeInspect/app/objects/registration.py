@@ -38,7 +38,7 @@ class Registration(Proxy):
         add(obj, "App::PropertyLink", "Measurement", g, "Measured points")
         add(obj, "App::PropertyLink", "Nominal", g, "Nominal CAD (a Part feature)")
         add(obj, "App::PropertyInteger", "Seed", g, "Random seed of the coarse stage")
-        registration_fit.add_properties(obj, add)   # hook: the fit (issue 16)
+        registration_fit.add_properties(obj, add)   # the fit
         g = "Pose"
         add(obj, "App::PropertyPlacement", "Pose", g, "Measured -> CAD rigid transform",
             read_only=True)
@@ -89,7 +89,7 @@ class Registration(Proxy):
         m = obj.Measurement
         return signature(np.asarray(m.Coordinates), np.asarray(m.SNR),
                          shape_signature(obj.Nominal.Shape), obj.Seed,
-                         *registration_fit.signature_part(obj))   # hook: issue 16
+                         *registration_fit.signature_part(obj))
 
     def execute(self, obj):
         signature = self.signature(obj)
@@ -97,8 +97,8 @@ class Registration(Proxy):
             return
         nominal = nominal_of(obj.Nominal)
         result = pipeline.register(nominal, pointset_of(obj.Measurement), seed=obj.Seed,
-                                   **registration_fit.register_options(obj))  # issue 16
-        registration_fit.refit(obj, result, nominal)   # hook: issue 16
+                                   **registration_fit.register_options(obj))
+        registration_fit.refit(obj, result, nominal)
         store_registration(obj, result)
         obj.InputSignature = signature
 
@@ -130,7 +130,7 @@ def store_registration(obj, result):
     obj.PointsCad = np.asarray(result.points_cad, dtype=float).ravel().tolist()
     obj.Deviation = np.asarray(result.deviation, dtype=float).tolist()
     obj.Inlier = np.asarray(result.inlier, dtype=int).tolist()
-    registration_fit.store(obj, result)   # hook: issue 16
+    registration_fit.store(obj, result)
 
 
 def make_registration(doc, result, measurement=None, nominal=None, seed=0,
@@ -144,7 +144,7 @@ def make_registration(doc, result, measurement=None, nominal=None, seed=0,
         obj.Measurement = measurement
         obj.Nominal = nominal
         obj.Seed = int(seed)
-        if fit_choice is not None:   # hook: issue 16
+        if fit_choice is not None:
             registration_fit.set_choice(obj, fit_choice)
         store_registration(obj, result)
         finish(obj)
@@ -181,5 +181,5 @@ def registration_result(obj, nominal):
         coarse=json.loads(obj.CoarseJson or "{}"), warnings=list(obj.Warnings),
         source=obj.Measurement.SourceFile if obj.Measurement is not None else "",
         cad_source=obj.Nominal.Label if obj.Nominal is not None else "")
-    registration_fit.restore(obj, result)   # hook: issue 16, the weights used
+    registration_fit.restore(obj, result)   # the weights used
     return result

@@ -7,7 +7,7 @@ periodic cubic spline through the points (interpolating; or smoothing with ``noi
 points' 1-sigma scatter), parametrised by chord length (about arc length, in mm).
 
 Every definition (mean camber line, chords, edge radii, thicknesses, angles, contour errors)
-is written out in docs/airfoil.md; the names here are the fields of result.json's ``airfoil``
+is written out in docs/user-guide.md; the names here are the fields of result.json's ``airfoil``
 block. Lengths in mm, angles in degrees, counter-clockwise positive in the section's 2D frame.
 
 This package's face: the names below are the kernel's public interface; the modules behind

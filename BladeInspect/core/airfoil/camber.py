@@ -13,7 +13,7 @@ END_SKIP = 0.5
 # length fitted to the inscribed-circle centres over this % of the locus back from the end
 # (the last half edge radius left out). A wide window is what conditions the tangent on
 # noisy points (the end centres are the least conditioned); a quartic keeps the window's
-# curvature change from biasing it (docs/airfoil.md gives the figures).
+# curvature change from biasing it (docs/validation.md gives the figures).
 DEFAULT_METAL_ANGLE_WINDOW_PCT = 50.0
 END_DEGREE = 4
 # A centre further from the window's quartic than this many robust sigmas of the centres'
@@ -167,6 +167,6 @@ def closed_end(profile, centres, radii, end, circle, notes, window_pct):
     if bend > _BEND_WARN_DEG:
         notes.append("the camber line turns %.2f deg from its end tangent within its last "
                      "half edge radius near (%.4f, %.4f) mm (the edge is not a circle): the "
-                     "metal angle there depends on the rule (docs/airfoil.md)"
+                     "metal angle there depends on the rule (docs/user-guide.md)"
                      % (bend, c[end][0], c[end][1]))
     return c, r, out, u, point

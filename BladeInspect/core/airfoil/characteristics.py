@@ -100,7 +100,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     point near the leading edge (e.g. on the CAD's named LE face); ``le_upstream``: a 2D
     direction pointing upstream (the LE is the end furthest along it); with neither, the LE is
     the blunter end, or the end upstream along the engine axis when the two edge radii agree
-    within their uncertainty (``le_rule`` says which rule decided, docs/airfoil.md).
+    within their uncertainty (``le_rule`` says which rule decided, docs/user-guide.md).
     ``definition``: an AirfoilDefinition whose fields take the place of chord_method,
     stations_pct, edge_offsets_mm, edge_zone_deg and metal_angle_window_pct (given with it,
     those must keep their defaults), and set the LE rule used when neither le_hint nor

@@ -64,6 +64,17 @@ class AirfoilDefinition:
         if not all(math.isfinite(v) for v in numbers):
             raise InputError("airfoil definition: every number must be finite")
 
+    @classmethod
+    def from_dict(cls, data):
+        """The definition as_dict() wrote, for this kernel: a stored kernel_version is not
+        carried over (what is computed now is this kernel's); unknown fields are an
+        InputError."""
+        fields = {k: v for k, v in data.items() if k != "kernel_version"}
+        unknown = sorted(set(fields) - set(cls.__dataclass_fields__))
+        if unknown:
+            raise InputError("airfoil definition: unknown field(s) %s" % ", ".join(unknown))
+        return cls(**fields)
+
     def as_dict(self):
         """The fields as JSON-ready data (tuples as lists)."""
         return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}

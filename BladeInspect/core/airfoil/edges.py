@@ -1,6 +1,6 @@
 """The edge rule in one place: the edge circle fitted over its zone, the edge point, which
 end is the LE, the radius's uncertainty and the points an edge needs, and edges that are
-corners (docs/airfoil.md)."""
+corners (docs/user-guide.md)."""
 
 from dataclasses import dataclass
 
@@ -11,12 +11,12 @@ from .geometry import cross2, norms, unit
 from .profile import ray_hit
 
 # Edge zone of the LE/TE circle fit: profile points seen from the end of the inscribed-circle
-# locus within this angle of the mean camber line's outward direction (docs/airfoil.md).
+# locus within this angle of the mean camber line's outward direction (docs/user-guide.md).
 DEFAULT_EDGE_ZONE_DEG = 45.0
 
 
 # The blunter end is the LE only when the two edge radii differ by more than this many
-# standard deviations of their difference; else the engine axis decides (docs/airfoil.md).
+# standard deviations of their difference; else the engine axis decides (docs/user-guide.md).
 LE_RADIUS_SIGMAS = 3.0
 
 
@@ -189,7 +189,7 @@ def _zone_range(profile, centre, outward, edge_u, zone_deg):
     return float(a[0]), float(a[1])
 
 
-# The edge point on noisy points (docs/airfoil.md, "LE and TE points"): the input points'
+# The edge point on noisy points (docs/user-guide.md, "LE and TE points"): the input points'
 # distances from the edge circle's centre, a weighted local quadratic in their angle from the
 # camber line's direction over +-_EDGE_POINT_DEG (biweight), read at angle 0.
 _EDGE_POINT_DEG = 15.0
@@ -227,7 +227,7 @@ def edge_point(profile, circle, outward, noise_mm, u_line, p_line):
 
 def leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, noise_mm,
                 le_radius_sigmas=LE_RADIUS_SIGMAS):
-    """Whether end a is the LE, and the rule that decided (docs/airfoil.md)."""
+    """Whether end a is the LE, and the rule that decided (docs/user-guide.md)."""
     if le_hint is not None:
         hint = np.asarray(le_hint, dtype=float).reshape(2)
         return bool(np.linalg.norm(end_a - hint) <= np.linalg.norm(end_b - hint)), "given"
@@ -244,7 +244,7 @@ def leading_end(end_a, end_b, circle_a, circle_b, axis, le_hint, le_upstream, no
 
 
 def edge_radius_sigma(circle, noise_mm=0.0):
-    """1-sigma of a fitted edge radius: sigma_R = s / sqrt(n) * f(alpha) (docs/airfoil.md),
+    """1-sigma of a fitted edge radius: sigma_R = s / sqrt(n) * f(alpha) (docs/user-guide.md),
     s the larger of the points' noise and the fit's rms (a non-circular edge's form counts as
     the radius's definition spread), alpha the zone's half-angle."""
     s = max(float(noise_mm), circle.rms)
@@ -311,7 +311,7 @@ def withhold_corner_edges(measured, nominal):
     why. A corner has no edge circle and no camber-line end for a tangent; the nominal's
     value is its cut's, read at the corner's exact vertex, while a measured profile's smooth
     fit rounds the corner off over the points' spacing and noise, and the same rule then
-    reads the rounding, degrees off on a perfect part. docs/airfoil.md, "Sharp edges"."""
+    reads the rounding, degrees off on a perfect part. docs/user-guide.md, "Sharp edges"."""
     corners = corner_edges(nominal.profile, nominal.le_point, nominal.te_point,
                             nominal.nose_tail_chord_mm)
     for name, angle, radius in (("LE", "inlet_angle_deg", "le_radius_mm"),

@@ -262,7 +262,7 @@ def ray_hit(profile, origin, direction, behind=False):
                      + lam[i] * (profile.length / len(profile.dense)))
 
 
-# The edge point on noisy points (docs/airfoil.md, "LE and TE points"): the input points'
+# The edge point on noisy points (docs/user-guide.md, "LE and TE points"): the input points'
 # distances from the edge circle's centre, a weighted local quadratic in their angle from the
 
 

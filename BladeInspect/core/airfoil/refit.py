@@ -30,7 +30,7 @@ def refit_in_arc_length(pts, first, first_length, noise_mm, nominal=None):
     fitted by least squares on the knots of _knots_from_nominal. Returns the points, their
     parameters and the spline.
 
-    Why (docs/airfoil.md, "Input and representation"): where points lie closer than their noise
+    Why (docs/user-guide.md, "Input and representation"): where points lie closer than their noise
     (the planned edges: 2 um apart, 3.9 um noise) the chord length between consecutive points
     is mostly noise -- a parameter running at up to 3x the arc length, as a random walk -- and
     a parametric fit in it reads the curve biased round the edges (metal angles off by
@@ -92,7 +92,7 @@ def _knots_from_nominal(pts, u, own_knots, nominal, noise_mm):
     when it adds no knot: points spread evenly, or at random (a cloud's band about the plane,
     whose single gaps vary widely but not its runs of them).
 
-    Why (docs/airfoil.md, "Where the points thin out"): a planned section holds its points a
+    Why (docs/user-guide.md, "Where the points thin out"): a planned section holds its points a
     few micrometres apart round the edges and 0.1 mm apart beyond; the smoothing spline
     spends its residual budget where the points are many and puts too few knots where they
     thin out, 0.6-3 mm from the edges, and stays stiff there: edge thicknesses 1 and 2 mm from

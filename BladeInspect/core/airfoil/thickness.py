@@ -43,7 +43,7 @@ def thickness_normal(profile, mcl, s):
     return out
 
 
-# The max-thickness position (docs/airfoil.md, "Thickness"): the vertex of a weighted
+# The max-thickness position (docs/user-guide.md, "Thickness"): the vertex of a weighted
 # least-squares quartic of the exact inscribed radii against their centres' projection on the
 # nose-tail chord, over +-MAX_POS_WINDOW of the chord about the vertex itself (biweight),
 # _MAX_POS_SAMPLES circles a round.
