@@ -74,7 +74,6 @@ class Options:
     # registration's take-up (calibration_fields), instead of calibration_mm's translation
     calibration_axis: dict = None
     seed: int = 0
-    le_rule: str = "engine-axis"    # one of LE_RULES: which end of the nominal is the LE
     decision_rule: str = "iso14253"  # core.decision's rule; report/inspect pass theirs
     # task-specific uncertainty (inspection.airfoil_task): a task file's path (reused when
     # it exists and matches, made there when absent) or an airfoil_task.TaskUncertainty;
