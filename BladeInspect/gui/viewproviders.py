@@ -5,11 +5,13 @@ import FreeCAD
 import FreeCADGui
 
 from ..app import airfoil_objects, objects
+from ..app.objects.base import Stateless
 from . import legend, resources
 from .taskpanels import AirfoilPanel, RegistrationPanel, show_panel
 
 
-class ViewProvider:
+class ViewProvider(Stateless):
+    """Nothing of the view provider is saved: it is made again from the object's type."""
     icon = "BladeInspect"
 
     def __init__(self, vobj):
@@ -23,20 +25,6 @@ class ViewProvider:
 
     def getIcon(self):
         return resources.icon_path(self.icon)
-
-    # Nothing of the view provider is saved: it is made again from the object's type. FreeCAD
-    # 1.0 asks through dumps/loads, FreeCAD 0.20 through __getstate__/__setstate__.
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return self.dumps()
-
-    def __setstate__(self, state):
-        self.loads(state)
 
 
 class ViewProviderNominal(ViewProvider):

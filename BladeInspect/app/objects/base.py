@@ -104,10 +104,27 @@ def check_recomputed(obj):
 
 # ---------------------------------------------------------------- the proxy
 
-class Proxy:
-    """Common plumbing. Proxies keep no state of their own: everything lives in properties, so
-    the document stores nothing for the proxy itself. FreeCAD 1.0 asks a proxy for that state
-    through dumps/loads, FreeCAD 0.20 through __getstate__/__setstate__.
+class Stateless:
+    """A proxy (document object or view provider) that keeps no state of its own: everything
+    lives in properties, so the document stores nothing for the proxy itself. FreeCAD 1.0 asks
+    a proxy for that state through dumps/loads, FreeCAD 0.20 through
+    __getstate__/__setstate__."""
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return self.dumps()
+
+    def __setstate__(self, state):
+        self.loads(state)
+
+
+class Proxy(Stateless):
+    """Common plumbing of the document objects (state: none, Stateless).
 
     A document records each proxy's module and class name and imports them on opening: a
     class keeps its name, and the package app.objects exports it too (see its docstring)."""
@@ -123,18 +140,6 @@ class Proxy:
     def onDocumentRestored(self, obj):
         self.add_properties(obj)
         attach_view(obj)
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return self.dumps()
-
-    def __setstate__(self, state):
-        self.loads(state)
 
 
 # ---------------------------------------------------------------- signatures
