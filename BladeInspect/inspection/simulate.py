@@ -120,7 +120,8 @@ def simulate_measurement(nominal, scan=None, seed=0, pose=None, **fields):
     ``scan`` (SimulatedScan; None: its defaults) with ``fields`` of SimulatedScan replacing
     its values, drawn from ``seed``, moved by ``pose`` (None: a random pose).
 
-    Returns (PointSet, measured_to_cad_truth, info dict)."""
+    Returns (PointSet, measured_to_cad_truth, info dict, mask of the readings without a gross
+    error)."""
     scan = dataclasses.replace(scan or SimulatedScan(), **fields)
     n_points, sides, noise = scan.n_points, scan.sides, scan.noise
     amplitude, sigma, outlier_fraction = scan.amplitude, scan.sigma, scan.outlier_fraction
