@@ -2,8 +2,9 @@
 the inspection.
 
 - NASA Rotor 67 (a blade the project did not design) clamped at a random fixture pose: with
-  the default edge rule the extra points round the thin TE at 90 % span cannot be seen
-  within the sensor's coverage without the sensor meeting the blade. The plan keeps every
+  the default edge rule the extra points round the TE at 90 % span (where the cut leaves the
+  blade through its tip face) cannot be seen within the sensor's coverage without the sensor
+  meeting the blade; before, planning stopped there and `inspect` wrote nothing. The plan keeps every
   other point of the CAD's section (counted here from the section itself), says how many it
   left out, at which section and round which edge, and `inspect` runs to its result with that
   note in result.json and plan.json. With the edge rule off the same pose leaves out a
@@ -190,6 +191,31 @@ class TestSoftLimits(unittest.TestCase):
 
     def test_no_note_when_every_point_is_reached(self):
         self.assertNotIn("unreachable", self.free.info)
+
+
+class TestSectionsJson(unittest.TestCase):
+    """result.json's sections when a planned section has no rows (none of its points could be
+    planned, or none was read): Table 2 then has no section of that label, and each planned
+    section keeps its own figures."""
+
+    def test_an_unmeasured_section_is_named_not_paired_with_the_next(self):
+        from types import SimpleNamespace as NS
+        from BladeInspect.inspection.closed_loop import _sections_json
+
+        def planned(h, n):
+            return NS(height_pct=h, n_points=n, plane_point=np.zeros(3),
+                      plane_normal=np.array([0.0, 0.0, 1.0]))
+
+        def row(label):
+            return NS(source="section column", label=label,
+                      to_json=lambda: {"label": label})
+        plan = NS(sections=[planned(10.0, 0), planned(50.0, 7), planned(90.0, 5)])
+        table = NS(sections=[row("1"), row("2")])
+        out = _sections_json(table, plan)
+        self.assertEqual([d.get("label") for d in out], [None, "1", "2"])
+        self.assertEqual([d["height_pct"] for d in out], [10.0, 50.0, 90.0])
+        self.assertEqual([d["n_planned"] for d in out], [0, 7, 5])
+        self.assertFalse(out[0]["measured"])
 
 
 if __name__ == "__main__":
