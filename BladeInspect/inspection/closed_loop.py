@@ -200,8 +200,21 @@ def _result_from_fit(nominal, pointset, fit, coarse, timing, warnings):
 def _sections_json(table, plan):
     """result.json `sections`: per nominal section its height, plane (CAD frame), the Table 2
     figures and the CMM's, and how many points were planned and measured there."""
+    if all(sec.source == "section column" for sec in table.sections):
+        # a section none of whose points could be planned or read has no row in the table
+        by_label = {sec.label: sec for sec in table.sections}
+        pairs = [(by_label.get(sections_mod.section_label(k)), planned)
+                 for k, planned in enumerate(plan.sections)]
+    else:
+        pairs = list(zip(table.sections, plan.sections))
     out = []
-    for sec, planned in zip(table.sections, plan.sections):
+    for sec, planned in pairs:
+        if sec is None:
+            out.append({"height_pct": planned.height_pct, "n_planned": planned.n_points,
+                        "plane": {"point": planned.plane_point.tolist(),
+                                  "normal": planned.plane_normal.tolist()},
+                        "measured": False})
+            continue
         doc = sec.to_json()
         doc["plane"] = {"point": planned.plane_point.tolist(),
                         "normal": planned.plane_normal.tolist()}
@@ -449,9 +462,12 @@ class _SectionsPhase:
         record["replans"] = state["replans"]
 
     def result_json(self, plan, n_read, state, rig_s, timing):
-        return {"replans": state["replans"], "n_points_by_phase": {"blind": None,
-                                                                    self.name: n_read},
-                "edge_density": plan.info.get("edge_density")}
+        out = {"replans": state["replans"], "n_points_by_phase": {"blind": None,
+                                                                   self.name: n_read},
+               "edge_density": plan.info.get("edge_density")}
+        if plan.info.get("unreachable"):
+            out["unreachable_points"] = plan.info["unreachable"]
+        return out
 
     def summary(self, plan, state, rig_s, timing):
         return {"replans": state["replans"]}
@@ -607,9 +623,13 @@ def _loop(phase, run):
                                      fit, first)
     result.weights = weights_record
     # the plan's edges a sensor spot averages away are said, not hidden
-    edge_rule = (getattr(plan, "info", None) or {}).get("edge_density")
+    plan_info = getattr(plan, "info", None) or {}
+    edge_rule = plan_info.get("edge_density")
     if edge_rule:
         result.warnings += edge_rule["warnings"]
+    # so are the planned points the rig could not reach, left out of the plan
+    if plan_info.get("unreachable"):
+        result.warnings += plan_info["unreachable"]["warnings"]
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(run, result, n_blind, n_measured, span_axis)

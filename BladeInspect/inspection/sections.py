@@ -356,7 +356,7 @@ def classify(profile, xyz, edge_fraction=EDGE_FRACTION):
 
 # ---------------------------------------------------------------- CMM
 
-def _label(value):
+def section_label(value):
     """Section ids as text: 2, 2.0 and '2' are the same section."""
     if value is None:
         return None
@@ -408,7 +408,8 @@ def read_cmm(path):
         if not np.all(np.isfinite(p)):
             raise InputError("%s: line %d: coordinates not finite" % (path, first_line + k))
         xyz.append(p)
-        section.append(_label(row[isec]) if isec is not None and isec < len(row) else None)
+        section.append(section_label(row[isec]) if isec is not None and isec < len(row)
+                       else None)
     if not xyz:
         raise InputError("%s: CMM file has no points" % path)
     return CmmData(xyz=np.asarray(xyz, dtype=float), section=section, source=path)
@@ -437,7 +438,7 @@ def _assign_cmm(cmm, sections):
 
 def _column_sections(result, span_axis, span_range):
     values = np.asarray(result.columns["section"])
-    labels = np.array([_label(v) for v in values], dtype=object)
+    labels = np.array([section_label(v) for v in values], dtype=object)
     out = []
     for lab in sorted(set(x for x in labels if x is not None), key=_sort_key):
         idx = np.flatnonzero(labels == lab)

@@ -414,34 +414,145 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
 
 
 def _finish_section(work, kinematics, sensor, limits):
-    """Each point's angle (the clear chosen one nearest head-on), setpoints, limit checks."""
+    """Each point's angle (the clear chosen one nearest head-on, or the next one where the
+    stages' soft limits forbid it), setpoints and limit checks. Points no chosen angle can serve
+    are left out; returns (PlannedSection of the rest, {reason: boolean mask over the section's
+    points} of those left out)."""
     standoff = float(sensor.standoff)
-    rows = np.argmax(work.score, axis=0)
+    score = work.score.copy()
     idx = np.arange(len(work.target))
-    blocked = ~np.isfinite(work.score[rows, idx])
-    if blocked.any():
-        raise InputError("plan: %d points of the section at %g %% cannot be seen within the "
-                         "sensor's coverage (less %g deg margin) without the sensor meeting "
-                         "the blade" % (int(blocked.sum()), work.height, COVERAGE_MARGIN_DEG))
+    blocked = ~np.isfinite(score.max(axis=0))
+    off_limits = np.zeros(len(idx), bool)
+    limit_errors = []
+    while True:
+        rows = np.argmax(score, axis=0)
+        live = np.isfinite(score[rows, idx])
+        angle = ANGLES[rows]
+        spot = np.empty_like(work.target_t)
+        for a in np.unique(angle[live]):
+            sel = live & (angle == a)
+            spot[sel] = kinematics.machine_point_of_table(work.target_t[sel], a)
+        stage = spot + np.array([0.0, 0.0, standoff])
+        refused = _outside_limits(limits, stage, angle, live, limit_errors)
+        if not refused.any():
+            break
+        # the next clear angle may bring the point within the limits
+        score[rows[refused], idx[refused]] = -np.inf
+        off_limits |= refused & ~np.isfinite(score.max(axis=0))
+    keep = live
     incidence = np.degrees(np.arccos(np.clip(work.cosines[rows, idx], -1.0, 1.0)))
-    angle = ANGLES[rows]
-    spot = np.empty_like(work.target_t)
-    for a in np.unique(angle):
-        sel = angle == a
-        spot[sel] = kinematics.machine_point_of_table(work.target_t[sel], a)
-    stage = spot + np.array([0.0, 0.0, standoff])
-    for a in np.unique(angle):
-        sel = angle == a
+    section = PlannedSection(
+        index=work.index, height_pct=work.height, plane_point=work.plane_point,
+        plane_normal=work.axis.copy(), target_cad=work.target[keep],
+        normal_cad=work.normal[keep], angle_deg=angle[keep], stage_xyz=stage[keep],
+        expected_standoff_mm=work.beam_length[rows, idx][keep], incidence_deg=incidence[keep],
+        expected_snr=expected_snr(sensor, np.radians(incidence[keep])))
+    dropped = {}
+    if blocked.any():
+        dropped["view"] = blocked
+    if off_limits.any():
+        dropped["soft_limits"] = off_limits
+        dropped["soft_limit_example"] = limit_errors[0]
+    return section, keep, dropped
+
+
+def _outside_limits(limits, stage, angle, live, errors):
+    """Mask of the live points whose setpoint at their angle lies outside the soft limits
+    (``errors`` gets each refusal's message); one check per angle while all pass."""
+    refused = np.zeros(len(stage), bool)
+    for a in np.unique(angle[live]):
+        sel = np.flatnonzero(live & (angle == a))
         try:
             limits.check(stage[sel, 0], stage[sel, 1], stage[sel, 2], a)
+            continue
         except DeviceError as exc:
-            raise DeviceError("plan: section at %g %% unreachable within soft limits (%s)"
-                              % (work.height, exc)) from None
-    return PlannedSection(
-        index=work.index, height_pct=work.height, plane_point=work.plane_point,
-        plane_normal=work.axis.copy(), target_cad=work.target, normal_cad=work.normal,
-        angle_deg=angle, stage_xyz=stage, expected_standoff_mm=work.beam_length[rows, idx],
-        incidence_deg=incidence, expected_snr=expected_snr(sensor, np.radians(incidence)))
+            errors.append(str(exc))
+        for i in sel:
+            try:
+                limits.check(stage[i, 0], stage[i, 1], stage[i, 2], a)
+            except DeviceError:
+                refused[i] = True
+    return refused
+
+
+def _kept_contours(contours, keep):
+    """Contours (first, end, closed) of the kept points, renumbered: a contour that lost points
+    is cut into open stretches at each gap, so no path runs across points left out."""
+    if keep.all():
+        return list(contours)
+    new_index = np.cumsum(keep) - 1
+    out = []
+    for first, end, closed in contours:
+        kept = np.flatnonzero(keep[first:end]) + first
+        if len(kept) == end - first:
+            out.append((int(new_index[first]), int(new_index[first]) + len(kept), closed))
+            continue
+        for stretch in np.split(kept, np.flatnonzero(np.diff(kept) != 1) + 1):
+            if len(stretch):
+                out.append((int(new_index[stretch[0]]),
+                            int(new_index[stretch[0]]) + len(stretch), False))
+    return out
+
+
+# Why points are left out of a plan, as the notes say it.
+_DROP_REASONS = {
+    "view": "cannot be seen within the sensor's coverage (less %g deg margin) without the "
+            "sensor meeting the blade" % COVERAGE_MARGIN_DEG,
+    "soft_limits": "are outside the stages' soft limits at every clear angle"}
+
+
+def _places(points, frame_edges):
+    """How many of ``points`` (CAD frame) lie round the LE, round the TE (within
+    EDGE_DENSIFY_REACH radii of the edge circle, where the edge rule adds points) and
+    elsewhere on the profile (the edges' circles ``frame_edges`` as _edge_spacing records
+    them)."""
+    counts, rest = {}, np.ones(len(points), bool)
+    for e in frame_edges:
+        near = rest & (np.linalg.norm(points - np.asarray(e["center_cad"]), axis=1)
+                       <= EDGE_DENSIFY_REACH * e["radius_mm"])
+        counts[e["edge"]] = counts.get(e["edge"], 0) + int(near.sum())
+        rest &= ~near
+    # without the edge rule's circles the plan does not know where its edges are
+    counts["elsewhere" if frame_edges else "on the profile"] = int(rest.sum())
+    return counts
+
+
+def unreachable_info(records):
+    """plan.json's and result.json's record of the planned points left out (None when none
+    was): per section the count, why and where, and one warning line each."""
+    sections, warnings = [], []
+    for rec in records:
+        if not rec["n_dropped"]:
+            continue
+        sections.append(rec)
+        why = "; ".join("%d %s" % (n, _DROP_REASONS[r]) for r, n in rec["by_reason"].items())
+        where = ", ".join("%s %d" % (k, v) for k, v in rec["by_place"].items() if v)
+        if rec["n_planned"] == 0:
+            warnings.append("section at %g %%: not measured, none of its %d points can be "
+                            "planned (%s; %s)" % (rec["height_pct"], rec["n_dropped"], why,
+                                                  where))
+        else:
+            warnings.append("section at %g %%: %d of %d points left out of the plan (%s; "
+                            "where: %s)" % (rec["height_pct"], rec["n_dropped"],
+                                            rec["n_dropped"] + rec["n_planned"], why, where))
+    if not sections:
+        return None
+    return {"warnings": warnings, "sections": sections}
+
+
+def _dropped_record(work, section, dropped, edges):
+    gone = np.zeros(len(work.target), bool)
+    by_reason = {}
+    for reason in ("view", "soft_limits"):
+        if reason in dropped:
+            gone |= dropped[reason]
+            by_reason[reason] = int(dropped[reason].sum())
+    rec = {"height_pct": work.height, "n_planned": section.n_points,
+           "n_dropped": int(gone.sum()), "by_reason": by_reason,
+           "by_place": _places(work.target[gone], edges)}
+    if "soft_limit_example" in dropped:
+        rec["soft_limit_example"] = dropped["soft_limit_example"]
+    return rec
 
 
 def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=None,
@@ -493,11 +604,14 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table)
     sections, paths = [], []
     last_stage = None
-    for work in works:
-        section = _finish_section(work, kinematics, sensor, limits)
+    records = []
+    for work, section_edges in zip(works, edges):
+        section, keep, dropped = _finish_section(work, kinematics, sensor, limits)
+        records.append(_dropped_record(work, section, dropped, section_edges))
         sections.append(section)
         rows = np.searchsorted(ANGLES, section.angle_deg)
-        for run in _runs(rows, work.contours, reverse=bool(work.index % 2)):
+        for run in _runs(rows, _kept_contours(work.contours, keep),
+                         reverse=bool(work.index % 2)):
             run = np.asarray(run, dtype=int)
             # Enter each run from the end nearer to where the stages are.
             stage = section.stage_xyz
@@ -512,10 +626,30 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
             "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections],
             "edge_density": edge_density_info(densify, edges, heights,
                                               float(getattr(sensor, "spot", 0.0)))}
+    _refuse_empty(sections, records)
+    left_out = unreachable_info(records)
+    if left_out is not None:
+        info["unreachable"] = left_out
     return Plan(sections=sections, paths=paths, table_to_cad=table_to_cad, span_axis=axis,
                 span_range=(lo, hi), axis_point=kinematics.axis_point.copy(),
                 axis_direction=kinematics.axis_direction.copy(),
                 standoff_mm=float(sensor.standoff), spacing_mm=float(spacing), info=info)
+
+
+def _refuse_empty(sections, records):
+    """A plan with no point at all is no plan: InputError (the blade cannot be seen), or
+    DeviceError when the stages' soft limits are what left its points out."""
+    if any(s.n_points for s in sections):
+        return
+    limited = [r for r in records if r["by_reason"].get("soft_limits")]
+    if limited:
+        raise DeviceError("plan: section at %g %% unreachable within soft limits (%s)"
+                          % (limited[0]["height_pct"], limited[0]["soft_limit_example"]))
+    first = records[0]
+    raise InputError("plan: %d points of the section at %g %% cannot be seen within the "
+                     "sensor's coverage (less %g deg margin) without the sensor meeting "
+                     "the blade" % (first["n_dropped"], first["height_pct"],
+                                    COVERAGE_MARGIN_DEG))
 
 
 def edge_radius_sigma(value):
