@@ -52,6 +52,25 @@ class ArcSectionClosedForms(unittest.TestCase):
                                    delta=UM)
             self.assertAlmostEqual(ch.axial_chord_mm, sec.extent(axis), delta=UM)
 
+    def test_stagger_is_the_asked_chords(self):
+        """The stagger is the angle of the chord asked for, LE towards TE: the caliper runs
+        through the two edge circles' centres, the tangent chord touches both edge circles on
+        the pressure side (closed forms of the arc section)."""
+        for sec, axis, ch in self.cases:
+            ax = angle_of(axis)
+            pts = sec.points()
+            caliper_dir = rigid(np.atleast_2d(sec.C_te - sec.C_le), sec.angle_deg, (0, 0))[0]
+            tangent_dir = sec.pressure_tangent_dir()
+            tangent_dir = tangent_dir * np.sign(np.dot(tangent_dir, sec.chord_dir()))
+            for method, line in (("caliper", caliper_dir), ("tangent", tangent_dir)):
+                other = airfoil.characteristics(pts, engine_axis=axis, chord_method=method)
+                self.assertLess(angle_diff(other.stagger_deg, angle_of(line) - ax), MILLIDEG,
+                                method)
+                # a line apart from the nose-tail chord's on this cambered section, so that
+                # the nose-tail angle would fail the check above
+                self.assertGreater(angle_diff(other.stagger_deg, ch.stagger_deg), 5 * MILLIDEG,
+                                   method)
+
     def test_angles(self):
         for sec, axis, ch in self.cases:
             ax = angle_of(axis)

@@ -105,7 +105,8 @@ class VerdictLines(unittest.TestCase):
                             ("section 2: chord_mm", "Section 2: Chord (caliper)"),
                             ("section root 1: te_radius_mm (not measured)",
                              "Section root 1: TE radius (not measured)"),
-                            ("section 2: stagger_deg", "Section 2: Stagger angle"),
+                            ("section 2: stagger_deg", "Section 2: Stagger angle (caliper)"),
+                            ("section root 1: stagger_deg", "Section root 1: Stagger angle"),
                             ("something else", "something else")):
             values = {b["label"]: b["nominal"] for b in self.BLOCKS}
             self.assertEqual(names.verdict_entry_name(entry, values), text)
@@ -121,7 +122,8 @@ class VerdictLines(unittest.TestCase):
                          "Section root 1: TE radius (not measured)")
         unproven = {"n_judged": 3, "failed": [], "not_proven": ["section 2: stagger_deg"]}
         self.assertEqual(names.airfoil_verdict_text(unproven, self.BLOCKS),
-                         "Airfoil: NOT PROVEN, 1 of 3 characteristics: Section 2: Stagger angle")
+                         "Airfoil: NOT PROVEN, 1 of 3 characteristics: Section 2: Stagger angle "
+                         "(caliper)")
         self.assertEqual(names.airfoil_verdict_text({"n_judged": 3, "failed": [],
                                                      "not_proven": []}),
                          "Airfoil: PASS (3 characteristics)")

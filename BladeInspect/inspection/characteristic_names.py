@@ -34,10 +34,11 @@ NAMES = {
                        MM,
                        QT_TRANSLATE_NOOP("BladeInspect", "Extent of the profile along the "
                                                          "engine axis")),
-    "stagger_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Stagger angle"),
+    "stagger_deg": (QT_TRANSLATE_NOOP("BladeInspect", "Stagger angle (%s)"),
                     DEG,
-                    QT_TRANSLATE_NOOP("BladeInspect", "Chord line's angle from the engine "
-                                                      "axis in the section plane")),
+                    QT_TRANSLATE_NOOP("BladeInspect", "Angle of the chord named (its method) "
+                                                      "from the engine axis in the section "
+                                                      "plane, LE towards TE")),
     "max_thickness_mm": (QT_TRANSLATE_NOOP("BladeInspect", "Max. thickness"),
                          MM,
                          QT_TRANSLATE_NOOP("BladeInspect", "Diameter of the largest "
@@ -155,7 +156,7 @@ def display_name(key, values=None, tr=_same):
     if entry is None:
         return key
     text = tr(entry[0])
-    if base == "chord_mm":
+    if base in ("chord_mm", "stagger_deg"):   # a chord's length and angle: one line
         method = (values or {}).get("chord_method")
         return text % method if method else text.replace(" (%s)", "")
     if index is not None:

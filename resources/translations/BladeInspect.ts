@@ -97,6 +97,11 @@
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
+        <source>Angle of the chord named (its method) from the engine axis in the section plane, LE towards TE</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Area enclosed by the profile</source>
         <translation type="unfinished"></translation>
     </message>
@@ -292,11 +297,6 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Chord by the method named (nose-tail: LE point to TE point; caliper; tangent)</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>Chord line's angle from the engine axis in the section plane</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -846,7 +846,7 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
-        <source>Stagger angle</source>
+        <source>Stagger angle (%s)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>

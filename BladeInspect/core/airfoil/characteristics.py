@@ -183,6 +183,11 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     if chord is None:
         raise InputError("chord method tangent: the pressure side is not concave, no line "
                          "touches the profile at both edges across it")
+    # The stagger is the angle of the chord asked for, pointing from the LE towards the TE: a
+    # chord's length and its angle describe one line.
+    line = {"nose-tail": chord_dir, "caliper": cal_p2 - cal_p1,
+            "tangent": None if bitangent is None else bitangent[1] - bitangent[0]}[chord_method]
+    stagger_dir = unit(line) * (1.0 if np.dot(line, chord_dir) >= 0 else -1.0)
 
     # Largest inscribed circle: the radius along the camber line is flat at its maximum, so
     # it is zoomed in on twice by exact circles at 9 arc lengths and a parabola through them.
@@ -234,7 +239,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     return Characteristics(
         chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
-        axial_chord_mm=extent(profile, axis), stagger_deg=angle_deg(chord_dir, axis),
+        axial_chord_mm=extent(profile, axis), stagger_deg=angle_deg(stagger_dir, axis),
         max_thickness_mm=max_thickness, max_thickness_pos_pct=max_pos,
         max_thickness_center=c_pos, thickness_stations_pct=stations, thickness_mm=thickness,
         le_radius_mm=le_radius, te_radius_mm=te_radius, le_circle=le_circle,
