@@ -416,8 +416,9 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
 def _finish_section(work, kinematics, sensor, limits):
     """Each point's angle (the clear chosen one nearest head-on, or the next one where the
     stages' soft limits forbid it), setpoints and limit checks. Points no chosen angle can serve
-    are left out; returns (PlannedSection of the rest, {reason: boolean mask over the section's
-    points} of those left out)."""
+    are left out; returns (PlannedSection of the rest, the boolean mask of the points kept,
+    {reason: boolean mask over the section's points} of those left out, with
+    "soft_limit_example" the first refusal's message when the limits left any out)."""
     standoff = float(sensor.standoff)
     score = work.score.copy()
     idx = np.arange(len(work.target))
