@@ -45,10 +45,12 @@ CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "
 # "engine-axis" -- the flow runs along +engine axis, so the LE is the upstream end (the end
 # furthest along -engine axis in the plane); "larger-radius" -- the blunter end (the kernel's
 # rule without a direction; it picks Rotor 67's TE at 10 % span, whose radius is the larger).
-LE_RULES = ("engine-axis", "larger-radius")
+# (the kernel's AirfoilDefinition.LE rules, the stage's default first)
 LE_RULE_TEXT = {"engine-axis": "the upstream end: the flow runs along +engine axis",
                 "larger-radius": "the end with the larger edge radius (the engine axis when "
                                  "the radii agree within their uncertainty)"}
+LE_RULES = tuple(LE_RULE_TEXT)
+assert set(LE_RULES) == set(kernel.LE_RULES)
 # The stage's definition unless one is given: the kernel's, the LE upstream.
 DEFAULT_DEFINITION = kernel.AirfoilDefinition(le_rule="engine-axis")
 
