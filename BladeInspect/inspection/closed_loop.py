@@ -213,20 +213,16 @@ def _sections_json(table, plan):
                      left_out.get("warnings", [])))
     out = []
     for sec, planned in pairs:
-        if sec is None:
-            out.append({"height_pct": planned.height_pct, "n_planned": planned.n_points,
-                        "plane": {"point": planned.plane_point.tolist(),
-                                  "normal": planned.plane_normal.tolist()},
-                        "measured": False,
-                        "reason": notes.get(planned.height_pct) if not planned.n_points
-                        else "section at %g %%: none of its %d planned points was read"
-                        % (planned.height_pct, planned.n_points)})
-            continue
-        doc = sec.to_json()
+        doc = {} if sec is None else sec.to_json()
         doc["plane"] = {"point": planned.plane_point.tolist(),
                         "normal": planned.plane_normal.tolist()}
         doc["height_pct"] = planned.height_pct
         doc["n_planned"] = planned.n_points
+        if sec is None or len(sec.point_index) == 0:
+            doc["measured"] = False
+            doc["reason"] = (notes.get(planned.height_pct) if not planned.n_points
+                             else "section at %g %%: none of its %d planned points was read"
+                             % (planned.height_pct, planned.n_points))
         out.append(doc)
     return out
 

@@ -630,6 +630,10 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
         edges[-1] = [e for e in edges[-1] if e["edge"] is not None]
         works.append(_SectionWork(k, h, plane_point, axis, target, normal, contours,
                                   table_to_cad, kinematics))
+    if not any(len(w.target) for w in works):
+        raise InputError("plan: no section can be measured; the planes at %s %% do not cut "
+                         "the CAD's blade (%s)" % (", ".join("%g" % h for h in heights),
+                                                  no_cut[0]))
     # One set of angles for all sections: fewer rotations between sections, and the exact ray
     # cast's cost is mostly per beam direction.
     _, shared = _choose_angles(np.hstack([w.cosines for w in works]), max_incidence_deg)
