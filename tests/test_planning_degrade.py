@@ -2,7 +2,8 @@
 it never stops the inspection (issue 35, item 5).
 
 - `inspect --complete` on the demo blade with the Y soft limit (the rotary axis; a raster
-  line's Y does not change with the angle) through the top of its span: the raster keeps
+  line's Y does not change with the angle) through the top of its span, or a rotary limit
+  that excludes some of its angles: the raster keeps
   exactly the unrestricted raster's rows at or below the limit (counted from that raster
   alone), says how many it left out, at which angles and span heights, and the inspection
   runs to its result; a section above the limit is reported not measured, with the reason.
@@ -84,6 +85,21 @@ class TestCompleteRasterSoftLimits(unittest.TestCase):
 
     def test_no_note_within_the_limits(self):
         self.assertNotIn("unreachable", self.free.info)
+
+    def test_angles_beyond_the_rotary_limit_are_left_out(self):
+        from BladeInspect.measurement.complete import plan_complete
+        a_hi = 230.0
+        beyond = self.free.angle_deg > a_hi
+        self.assertTrue(beyond.any() and not beyond.all())
+        plan = plan_complete(self.nominal, self.pose, _sensor(),
+                             AxisLimits(a=(0.0, a_hi)), pitch=PITCH)
+        self.assertEqual(plan.n_points, int(np.count_nonzero(~beyond)))
+        self.assertTrue(np.all(plan.angle_deg <= a_hi))
+        info = plan.info["unreachable"]
+        self.assertEqual({a["angle_deg"]: a["n_dropped"] for a in info["angles"]},
+                         {a: int(np.count_nonzero(self.free.angle_deg == a))
+                          for a in np.unique(self.free.angle_deg[beyond])})
+        self.assertIn("A=", info["warnings"][0])
 
     def test_nothing_within_the_limits_is_a_one_line_device_error(self):
         from BladeInspect.core.errors import DeviceError
