@@ -429,9 +429,10 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
 def _finish_section(work, kinematics, sensor, limits):
     """Each point's angle (the clear chosen one nearest head-on, or the next one where the
     stages' soft limits forbid it), setpoints and limit checks. Points no chosen angle can serve
-    are left out, and all of them when fewer than MIN_SECTION_POINTS would remain; returns (PlannedSection of the rest, the boolean mask of the points kept,
-    {reason: boolean mask over the section's points} of those left out, with
-    "soft_limit_example" the first refusal's message when the limits left any out)."""
+    are left out, and all of them when fewer than MIN_SECTION_POINTS would remain; returns
+    (PlannedSection of the rest, the boolean mask of the points kept, {reason: boolean mask
+    over the section's points} of those left out, with "soft_limit_example" the first
+    refusal's message when the limits left any out)."""
     standoff = float(sensor.standoff)
     score = work.score.copy()
     idx = np.arange(len(work.target))
@@ -719,8 +720,9 @@ def edge_density_info(densify, edges, heights, spot_mm, failures=None):
     from ..core import airfoil
     noise, target = densify
     failures = failures or [[] for _ in heights]
-    warnings = ["section at %g %%: no extra edge points planned, the edges of its cut could "
-                "not be found (%s); its edge radii are not measured to the rule's sigma"
+    warnings = ["section at %g %%: no extra edge points planned on a loop of its cut whose "
+                "edges could not be found (%s); edge radii there are not measured to the "
+                "rule's sigma"
                 % (h, "; ".join(why)) for h, why in zip(heights, failures) if why]
     warnings += ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
                 "reading averages the edge over its spot, so this edge's radius, edge point "
