@@ -245,6 +245,9 @@ def run():
         check("the note names the ICP weights result.json records",
               panel is not None and "ICP weights: %s," % written["weights"]["model"]
               in panel.form.findChildren(QtGui.QLabel)[0].text(), written.get("weights"))
+        check("the note shows result.json's warnings (the planning notes among them)",
+              panel is not None and all(w in panel.form.findChildren(QtGui.QLabel)[0].text()
+                                        for w in written["warnings"]), written["warnings"])
         for o in doc.Objects:
             if o.ViewObject is not None:
                 o.ViewObject.Visibility = o == dmap[0]

@@ -207,7 +207,7 @@ class TestSectionsJson(unittest.TestCase):
                       plane_normal=np.array([0.0, 0.0, 1.0]))
 
         def row(label):
-            return NS(source="section column", label=label,
+            return NS(source="section column", label=label, point_index=np.arange(3),
                       to_json=lambda: {"label": label})
         plan = NS(sections=[planned(10.0, 0), planned(50.0, 7), planned(90.0, 5)])
         table = NS(sections=[row("1"), row("2")])
@@ -216,6 +216,7 @@ class TestSectionsJson(unittest.TestCase):
         self.assertEqual([d["height_pct"] for d in out], [10.0, 50.0, 90.0])
         self.assertEqual([d["n_planned"] for d in out], [0, 7, 5])
         self.assertFalse(out[0]["measured"])
+        self.assertEqual([d.get("measured", True) for d in out[1:]], [True, True])
 
 
 if __name__ == "__main__":

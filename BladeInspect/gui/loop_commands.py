@@ -80,11 +80,12 @@ def _hide_measured_frame(measurement):
         measurement.ViewObject.Visibility = False
 
 
-def _show_table(title, table, note, sensitivity=None):
-    """Table 2 in a panel; when the airfoil stage ran on the table, a button to its
-    characteristics (the Airfoil command's panel)."""
+def _show_table(title, table, note, sensitivity=None, warnings=()):
+    """Table 2 in a panel under ``note``, the result's ``warnings`` (result.json's, the
+    planner's notes among them) and the table's; when the airfoil stage ran on the table, a
+    button to its characteristics (the Airfoil command's panel)."""
     header, rows = section_rows(table)
-    notes = [note] + list(table.warnings)
+    notes = list(dict.fromkeys([note] + list(warnings) + list(table.warnings)))
     panel = taskpanels.TablePanel(title, header, rows, "; ".join(n for n in notes if n),
                                   sensitivity)
     stage = getattr(table, "airfoil", None)
@@ -294,7 +295,8 @@ class Inspect(Command):
                    summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
         return _show_table(
             translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
-            summary["sections"], note, summary["result"].fit_sensitivity)
+            summary["sections"], note, summary["result"].fit_sensitivity,
+            summary["result"].warnings)
 
 
 class Calibrate(Command):

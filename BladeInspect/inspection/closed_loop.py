@@ -207,19 +207,22 @@ def _sections_json(table, plan):
                  for k, planned in enumerate(plan.sections)]
     else:
         pairs = list(zip(table.sections, plan.sections))
+    # the plan's note on a section left wholly out is why it has no row (one line each)
+    left_out = (getattr(plan, "info", None) or {}).get("unreachable") or {}
+    notes = dict(zip([rec["height_pct"] for rec in left_out.get("sections", [])],
+                     left_out.get("warnings", [])))
     out = []
     for sec, planned in pairs:
-        if sec is None:
-            out.append({"height_pct": planned.height_pct, "n_planned": planned.n_points,
-                        "plane": {"point": planned.plane_point.tolist(),
-                                  "normal": planned.plane_normal.tolist()},
-                        "measured": False})
-            continue
-        doc = sec.to_json()
+        doc = {} if sec is None else sec.to_json()
         doc["plane"] = {"point": planned.plane_point.tolist(),
                         "normal": planned.plane_normal.tolist()}
         doc["height_pct"] = planned.height_pct
         doc["n_planned"] = planned.n_points
+        if sec is None or len(sec.point_index) == 0:
+            doc["measured"] = False
+            doc["reason"] = (notes.get(planned.height_pct) if not planned.n_points
+                             else "section at %g %%: none of its %d planned points was read"
+                             % (planned.height_pct, planned.n_points))
         out.append(doc)
     return out
 
@@ -526,9 +529,15 @@ class _RasterPhase:
 
     @staticmethod
     def sections_json(table, plan):
-        return [dict(sec.to_json(), height_pct=sec.height_pct,
-                     plane={"point": sec.origin.tolist(), "normal": sec.normal.tolist()})
-                for sec in table.sections]
+        out = []
+        for sec in table.sections:
+            doc = dict(sec.to_json(), height_pct=sec.height_pct,
+                       plane={"point": sec.origin.tolist(), "normal": sec.normal.tolist()})
+            if len(sec.point_index) == 0:
+                doc.update(measured=False, reason="section at %g %%: no raster point lies "
+                           "within %g mm of its plane" % (sec.height_pct, table.band))
+            out.append(doc)
+        return out
 
     def scan_json(self, plan, n_read, state, rig_s, timing):
         return {"points": n_read, "planned_points": plan.n_points,
@@ -542,9 +551,12 @@ class _RasterPhase:
         pass
 
     def result_json(self, plan, n_read, state, rig_s, timing):
-        return {"n_points_by_phase": {"blind": None, self.name: n_read},
-                "complete": {"pitch_mm": plan.pitch_mm, "rig_s": rig_s,
-                             "simulated_s": timing["complete_scan"]}}
+        out = {"n_points_by_phase": {"blind": None, self.name: n_read},
+               "complete": {"pitch_mm": plan.pitch_mm, "rig_s": rig_s,
+                            "simulated_s": timing["complete_scan"]}}
+        if plan.info.get("unreachable"):
+            out["unreachable_points"] = plan.info["unreachable"]
+        return out
 
     def summary(self, plan, state, rig_s, timing):
         return {"complete_rig_s": rig_s, "complete_simulated_s": timing["complete_scan"]}
@@ -626,10 +638,11 @@ def _loop(phase, run):
     plan_info = getattr(plan, "info", None) or {}
     edge_rule = plan_info.get("edge_density")
     if edge_rule:
-        result.warnings += edge_rule["warnings"]
+        result.planning_notes += edge_rule["warnings"]
     # so are the planned points the rig could not reach, left out of the plan
     if plan_info.get("unreachable"):
-        result.warnings += plan_info["unreachable"]["warnings"]
+        result.planning_notes += plan_info["unreachable"]["warnings"]
+    result.warnings += result.planning_notes
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
     table, verdict = _judge_after_blind(run, result, n_blind, n_measured, span_axis)

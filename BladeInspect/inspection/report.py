@@ -36,6 +36,8 @@ from .run_options import ReportSources, RunOptions
 MAX_VIEW_POINTS = 120000
 MAX_WHISKERS = 1500
 PDF_DPI = 150
+# The PDF's first page lists at most this many planning notes (the HTML has them all).
+MAX_PDF_NOTES = 8
 
 PAGE_TITLES = ("Summary", "Decision rule, uncertainty and fit", "Deviation map",
                "Deviation histogram (Table 3)", "Section profile errors (Table 2)")
@@ -393,6 +395,12 @@ def _verdict_lines(verdict, table):
 
 # ---------------------------------------------------------------- the report
 
+def planning_notes(result):
+    """The planner's notes of a result (what it left out and why), one line each, in the
+    order given and without repeats: the report's "Planning notes" list."""
+    return list(dict.fromkeys(str(n) for n in getattr(result, "planning_notes", None) or ()))
+
+
 def write_report(out, result, nominal, sections, verdict, tolerance, magnification=None,
                  title=None):
     """report.html and report.pdf for a registration, its section table and verdict. Written
@@ -427,8 +435,13 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
              "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in verdict_lines) + "</ul>",
              "<h2>Pose and its uncertainty</h2>", html_table(["Quantity", "Value"], p_rows)]
     parts += _fit_parts(result, verdict)
+    notes = planning_notes(result)
+    if notes:
+        parts += ["<h2>Planning notes</h2>",
+                  "<ul>" + "".join("<li>%s</li>" % html.escape(x) for x in notes) + "</ul>"]
     for w in list(result.warnings) + list(table.warnings):
-        parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
+        if w not in notes:
+            parts.append("<p class='note'>Warning: %s</p>" % html.escape(str(w)))
 
     pdf_path = output.path("report.pdf")
     n_pages = 0
@@ -444,6 +457,13 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
         for line in verdict_lines[:24]:
             fig.text(0.06, y, line, fontsize=8, wrap=True)
             y -= 0.018
+        if notes:
+            fig.text(0.06, y, "Planning notes", fontsize=9, weight="bold")
+            y -= 0.018
+            more = ["(%d more in report.html and result.json)" % (len(notes) - MAX_PDF_NOTES)]
+            for line in notes[:MAX_PDF_NOTES] + (more if len(notes) > MAX_PDF_NOTES else []):
+                fig.text(0.06, y, "- " + line, fontsize=7, wrap=True)
+                y -= 0.03
         pdf_table(fig, [0.06, 0.05, 0.88, max(0.1, y - 0.1)], ["Quantity", "Value"], p_rows,
                   TableStyle(7.5, cell_loc="left", col_widths=[0.45, 0.55]),
                   title="Pose and its uncertainty")

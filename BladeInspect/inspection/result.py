@@ -49,6 +49,9 @@ class RegistrationResult:
     # Where the fine ICP's robust weights reach 0 (core.icp.InlierCut), for the censored
     # model of the part's worst inlier (inspection.uncertainty); not written to files.
     inlier_cut: Optional[object] = None
+    # The planner's notes (points or sections it left out, edges it could not plan densely),
+    # also among ``warnings``; the report lists them apart as its "Planning notes".
+    planning_notes: list = field(default_factory=list)
 
     def planned_rows(self, rows):
         """The result restricted to some rows (an inspection's points measured after its blind

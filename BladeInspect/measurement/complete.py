@@ -139,8 +139,8 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
     ``pitch``: mm between raster lines along the rotary axis; ``spacing``: mm between readings
     along a line; ``angles_deg``: the rotary angles (default: ``n_angles`` evenly spaced, turned
     to serve the blade faces' worst normal best).
-    Returns a CompletePlan. InputError for bad steps, DeviceError when a setpoint is outside
-    the soft limits."""
+    Returns a CompletePlan. InputError for bad steps. Setpoints outside the soft limits are
+    left out with a note (``info["unreachable"]``); DeviceError only when that leaves none."""
     pitch = check_step(pitch, "--pitch")
     spacing = check_step(spacing, "complete scan spacing")
     kinematics = kinematics if kinematics is not None else RigKinematics()
@@ -171,7 +171,7 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
     stage_inverse = np.linalg.inv(kinematics.stage_matrix)
 
     cols = {k: [] for k in ("line", "angle", "stage", "target", "normal", "face", "cos")}
-    passes = []
+    passes, left_out = [], []
     info = {"rays_cast": 0, "dropped_not_best": 0, "dropped_off_blade": 0,
             "dropped_coverage": 0, "dropped_body": 0}
     for ai, a in enumerate(angles):
@@ -205,11 +205,15 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         keep = np.flatnonzero(seen)[clear]
         spot = spot[clear]
         stage = (spot + np.array([0.0, 0.0, standoff])) @ stage_inverse.T
-        try:
-            limits.check(stage[:, 0], stage[:, 1], stage[:, 2], a)
-        except DeviceError as exc:
-            raise DeviceError("complete scan: the raster at A=%g deg is unreachable within "
-                              "the soft limits (%s)" % (a, exc)) from None
+        # Setpoints beyond the soft limits are left out with a note; the rest are measured.
+        beyond, example = outside_soft_limits(limits, stage, a)
+        if beyond.any():
+            left_out.append({"angle_deg": float(a), "n_dropped": int(beyond.sum()),
+                             "soft_limit_example": example,
+                             "target_cad": tf.apply_transform(T, spot[beyond])})
+            keep, stage, spot = keep[~beyond], stage[~beyond], spot[~beyond]
+        if len(keep) == 0:
+            continue
         start = sum(len(c) for c in cols["line"])
         # Boustrophedon: the grid is line-major with X increasing; every other line reversed.
         order = np.lexsort((np.where(li[keep] % 2 == 1, -xi[keep], xi[keep]), li[keep]))
@@ -223,16 +227,63 @@ def plan_complete(nominal, table_to_cad, sensor, limits, pitch=DEFAULT_PITCH_MM,
         cols["cos"].append(cos_here[ai, keep])
         passes += _passes(float(a), li[keep], start)
     if not passes:
+        if left_out:
+            raise DeviceError("complete scan: every raster point is outside the soft limits "
+                              "(%s)" % left_out[0]["soft_limit_example"])
         raise InputError("complete scan: no point of the CAD's blade faces is in view")
     cat = {k: np.concatenate(v) for k, v in cols.items()}
     incidence = np.degrees(np.arccos(np.clip(cat["cos"], -1.0, 1.0)))
     info["cast_reach_mm"] = CAST_REACH_MM
+    if left_out:
+        info["unreachable"] = unreachable_raster_info(left_out, nominal, len(cat["line"]))
     return CompletePlan(
         pitch_mm=pitch, spacing_mm=spacing, angles_deg=np.asarray(angles, dtype=float),
         line_y=line_y, line=cat["line"], angle_deg=cat["angle"], stage_xyz=cat["stage"],
         target_cad=cat["target"], normal_cad=cat["normal"], face=cat["face"],
         incidence_deg=incidence, expected_snr=expected_snr(sensor, np.radians(incidence)),
         passes=passes, table_to_cad=table_to_cad, standoff_mm=standoff, info=info)
+
+
+def outside_soft_limits(limits, stage, angle_deg):
+    """(mask of the setpoints (N, 3) at rotary angle ``angle_deg`` outside the soft limits,
+    the first refusal's message or None). The limits' own check decides; its bounds are read
+    per point only once the whole set fails it."""
+    try:
+        limits.check(stage[:, 0], stage[:, 1], stage[:, 2], angle_deg)
+        return np.zeros(len(stage), bool), None
+    except DeviceError as exc:
+        message = str(exc)
+    a_range = getattr(limits, "a", None)
+    if a_range is not None and not a_range[0] <= angle_deg <= a_range[1]:
+        return np.ones(len(stage), bool), message
+    beyond = np.zeros(len(stage), bool)
+    for k, name in enumerate("xyz"):
+        lo, hi = getattr(limits, name)
+        beyond |= (stage[:, k] < lo - 1e-9) | (stage[:, k] > hi + 1e-9)
+    return beyond, message
+
+
+def unreachable_raster_info(left_out, nominal, n_planned):
+    """plan.json's and result.json's record of the raster points left out (the soft limits):
+    per angle how many and between which span heights (% of the blade faces' span), and one
+    warning line."""
+    from .planning import span_axis_of
+    axis, origin, lo, hi = span_axis_of(nominal)
+    angles, total = [], 0
+    for rec in left_out:
+        height = 100.0 * (((rec["target_cad"] - origin) @ axis) - lo) / (hi - lo)
+        total += rec["n_dropped"]
+        angles.append({"angle_deg": rec["angle_deg"], "n_dropped": rec["n_dropped"],
+                       "span_pct": [round(float(height.min()), 1),
+                                    round(float(height.max()), 1)],
+                       "soft_limit_example": rec["soft_limit_example"]})
+    where = ", ".join("%d at A=%g deg between %g and %g %% span"
+                      % (r["n_dropped"], r["angle_deg"], r["span_pct"][0], r["span_pct"][1])
+                      for r in angles)
+    warning = ("complete scan: %d of %d raster points left out of the plan (outside the "
+               "stages' soft limits, e.g. %s; where: %s)"
+               % (total, total + n_planned, angles[0]["soft_limit_example"], where))
+    return {"warnings": [warning], "n_dropped": total, "angles": angles}
 
 
 def _passes(angle, lines, start, max_points=MAX_PASS_POINTS):

@@ -43,6 +43,9 @@ SECTION_TOLERANCE_MM = 1e-6
 NORMAL_PROBE_MM = 0.01
 # Consecutive section points farther apart than this many spacings start a new path.
 PATH_GAP_SPACINGS = 3.0
+# A section needs at least this many points to define its plane (inspection.sections fits
+# one to them) and a profile; fewer are left out of the plan with a note.
+MIN_SECTION_POINTS = 3
 
 
 @dataclass
@@ -237,7 +240,9 @@ def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=No
     on the plane, with outward normals, in contour order. Returns (points, normals, contours),
     contours a list of (first index, end index, closed). InputError when the plane misses.
     ``edge_densify`` = (noise_mm, radius_sigma_mm): closed contours get points closer round
-    their LE and TE (``_edge_spacing``, which adds each edge to the list ``edge_record``)."""
+    their LE and TE (``_edge_spacing``, which adds each edge to the list ``edge_record``); a
+    contour whose edges the airfoil kernel cannot find keeps the even spacing and adds
+    {"edge": None, "failed": why} to ``edge_record``."""
     from ..cad.sections import cut   # cad/ needs FreeCAD; measurement/ imports without it
     n = np.asarray(plane_normal, dtype=float)
     n = n / np.linalg.norm(n)
@@ -245,9 +250,17 @@ def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=No
     pts, contours, start = [], [], 0
     for line in cut(nominal.shape, o, n):
         closed = len(line) > 2 and np.linalg.norm(line[0] - line[-1]) < 1e-9
+        h = None
         if closed and edge_densify is not None:
-            p = _resample_graded(line[:-1], _edge_spacing(line[:-1], o, n, spacing,
-                                                          *edge_densify, record=edge_record))
+            try:
+                h = _edge_spacing(line[:-1], o, n, spacing, *edge_densify, record=edge_record)
+            except InputError as exc:
+                # A loop the airfoil kernel cannot read (a tip cap, a hub fillet's ring, a
+                # profile too coarse for it) keeps the even spacing; the plan says so.
+                if edge_record is not None:
+                    edge_record.append({"edge": None, "failed": str(exc)})
+        if h is not None:
+            p = _resample_graded(line[:-1], h)
         else:
             p = _resample(line[:-1] if closed else line, closed, spacing)
         contours.append((start, start + len(p), closed))
@@ -416,9 +429,10 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
 def _finish_section(work, kinematics, sensor, limits):
     """Each point's angle (the clear chosen one nearest head-on, or the next one where the
     stages' soft limits forbid it), setpoints and limit checks. Points no chosen angle can serve
-    are left out; returns (PlannedSection of the rest, the boolean mask of the points kept,
-    {reason: boolean mask over the section's points} of those left out, with
-    "soft_limit_example" the first refusal's message when the limits left any out)."""
+    are left out, and all of them when fewer than MIN_SECTION_POINTS would remain; returns
+    (PlannedSection of the rest, the boolean mask of the points kept, {reason: boolean mask
+    over the section's points} of those left out, with "soft_limit_example" the first
+    refusal's message when the limits left any out)."""
     standoff = float(sensor.standoff)
     score = work.score.copy()
     idx = np.arange(len(work.target))
@@ -440,7 +454,10 @@ def _finish_section(work, kinematics, sensor, limits):
         # the next clear angle may bring the point within the limits
         score[rows[refused], idx[refused]] = -np.inf
         off_limits |= refused & ~np.isfinite(score.max(axis=0))
-    keep = live
+    keep = live.copy()
+    too_few = np.zeros(len(idx), bool)
+    if 0 < keep.sum() < MIN_SECTION_POINTS:
+        too_few, keep = keep, np.zeros(len(idx), bool)
     incidence = np.degrees(np.arccos(np.clip(work.cosines[rows, idx], -1.0, 1.0)))
     section = PlannedSection(
         index=work.index, height_pct=work.height, plane_point=work.plane_point,
@@ -454,6 +471,8 @@ def _finish_section(work, kinematics, sensor, limits):
     if off_limits.any():
         dropped["soft_limits"] = off_limits
         dropped["soft_limit_example"] = limit_errors[0]
+    if too_few.any():
+        dropped["too_few"] = too_few
     return section, keep, dropped
 
 
@@ -499,7 +518,9 @@ def _kept_contours(contours, keep):
 _DROP_REASONS = {
     "view": "cannot be seen within the sensor's coverage (less %g deg margin) without the "
             "sensor meeting the blade" % COVERAGE_MARGIN_DEG,
-    "soft_limits": "are outside the stages' soft limits at every clear angle"}
+    "soft_limits": "are outside the stages' soft limits at every clear angle",
+    "too_few": "were too few to measure the section once the rest were left out (%d "
+               "needed)" % MIN_SECTION_POINTS}
 
 
 def _places(points, frame_edges):
@@ -523,6 +544,11 @@ def unreachable_info(records):
     was): per section the count, why and where, and one warning line each."""
     sections, warnings = [], []
     for rec in records:
+        if rec.get("no_cut"):
+            sections.append(rec)
+            warnings.append("section at %g %%: not measured, the plane does not cut the "
+                            "CAD's blade (%s)" % (rec["height_pct"], rec["no_cut"]))
+            continue
         if not rec["n_dropped"]:
             continue
         sections.append(rec)
@@ -544,7 +570,7 @@ def unreachable_info(records):
 def _dropped_record(work, section, dropped, edges):
     gone = np.zeros(len(work.target), bool)
     by_reason = {}
-    for reason in ("view", "soft_limits"):
+    for reason in ("view", "soft_limits", "too_few"):
         if reason in dropped:
             gone |= dropped[reason]
             by_reason[reason] = int(dropped[reason].sum())
@@ -564,8 +590,11 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     ``table_to_cad`` maps rotary-table points into the CAD frame (the registration's
     measured_to_cad for points in the table frame); ``kinematics`` supplies the rotary axis
     (None: the nominal axis through the origin along +Y); ``limits`` an AxisLimits.
-    Returns a Plan. Raises InputError for heights outside 0-100 or a plane that misses the
-    CAD, DeviceError when a setpoint is unreachable within the soft limits.
+    Returns a Plan. Raises InputError for heights outside 0-100. What a blade or the rig
+    cannot allow (a plane that misses the CAD, points out of view or beyond the soft limits,
+    too few points left, edges the edge rule cannot find) leaves those points or sections out
+    with a note in ``info`` ("unreachable", "edge_density"); only a plan left with no point
+    at all is refused (DeviceError when the soft limits are why, else InputError).
     ``edge_radius_sigma_mm`` (None: off): points round each section's LE and
     TE closer, so that its fitted edge radius's 1-sigma at the sensor's reference noise
     (sensor.sigma_ref) is at most this (docs/user-guide.md, "Edges measured densely enough")."""
@@ -586,7 +615,7 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     edge_radius_sigma_mm = edge_radius_sigma(edge_radius_sigma_mm)
     densify = (None if edge_radius_sigma_mm is None
                else (float(sensor.sigma_ref), edge_radius_sigma_mm))
-    works, edges = [], []
+    works, edges, edge_failures, no_cut = [], [], [], {}
     for k, h in enumerate(heights):
         plane_point = origin + axis * (lo + (hi - lo) * h / 100.0)
         edges.append([])
@@ -594,9 +623,18 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
             target, normal, contours = nominal_section(nominal, plane_point, axis, spacing,
                                                        densify, edges[-1])
         except InputError as exc:
-            raise InputError("--section-heights %g: %s" % (h, exc)) from None
+            # A height where this blade has no section to measure (past a tip, through a
+            # gap): that section is not measured, the others are.
+            no_cut[k] = str(exc)
+            target, normal, contours = np.zeros((0, 3)), np.zeros((0, 3)), []
+        edge_failures.append([e["failed"] for e in edges[-1] if e["edge"] is None])
+        edges[-1] = [e for e in edges[-1] if e["edge"] is not None]
         works.append(_SectionWork(k, h, plane_point, axis, target, normal, contours,
                                   table_to_cad, kinematics))
+    if not any(len(w.target) for w in works):
+        raise InputError("plan: no section can be measured; the planes at %s %% do not cut "
+                         "the CAD's blade (%s)" % (", ".join("%g" % h for h in heights),
+                                                  no_cut[0]))
     # One set of angles for all sections: fewer rotations between sections, and the exact ray
     # cast's cost is mostly per beam direction.
     _, shared = _choose_angles(np.hstack([w.cosines for w in works]), max_incidence_deg)
@@ -609,6 +647,8 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
     for work, section_edges in zip(works, edges):
         section, keep, dropped = _finish_section(work, kinematics, sensor, limits)
         records.append(_dropped_record(work, section, dropped, section_edges))
+        if work.index in no_cut:
+            records[-1]["no_cut"] = no_cut[work.index]
         sections.append(section)
         rows = np.searchsorted(ANGLES, section.angle_deg)
         for run in _runs(rows, _kept_contours(work.contours, keep),
@@ -626,7 +666,8 @@ def plan_sections(nominal, table_to_cad, heights_pct, sensor, limits, span_axis=
             "body_radius_mm": BODY_RADIUS_MM,
             "angles_per_section": [len(np.unique(s.angle_deg)) for s in sections],
             "edge_density": edge_density_info(densify, edges, heights,
-                                              float(getattr(sensor, "spot", 0.0)))}
+                                              float(getattr(sensor, "spot", 0.0)),
+                                              edge_failures)}
     _refuse_empty(sections, records)
     left_out = unreachable_info(records)
     if left_out is not None:
@@ -646,11 +687,9 @@ def _refuse_empty(sections, records):
     if limited:
         raise DeviceError("plan: section at %g %% unreachable within soft limits (%s)"
                           % (limited[0]["height_pct"], limited[0]["soft_limit_example"]))
-    first = records[0]
-    raise InputError("plan: %d points of the section at %g %% cannot be seen within the "
-                     "sensor's coverage (less %g deg margin) without the sensor meeting "
-                     "the blade" % (first["n_dropped"], first["height_pct"],
-                                    COVERAGE_MARGIN_DEG))
+    info = unreachable_info(records)
+    raise InputError("plan: no section can be measured; %s"
+                     % (info["warnings"][0] if info else "no section has a point to plan"))
 
 
 def edge_radius_sigma(value):
@@ -670,15 +709,22 @@ def edge_radius_sigma(value):
     return v
 
 
-def edge_density_info(densify, edges, heights, spot_mm):
+def edge_density_info(densify, edges, heights, spot_mm, failures=None):
     """plan.json's and result.json's record of the edge rule a plan used (None: off), with a
-    warning for each edge whose radius is under EDGE_MIN_SPOTS sensor spots: the rule counts
-    readings as independent points, a real reading averages the surface over its spot."""
+    warning for each edge whose radius is under EDGE_MIN_SPOTS sensor spots (the rule counts
+    readings as independent points, a real reading averages the surface over its spot) and
+    for each section whose edges could not be found (``failures``: per section the reasons),
+    which keeps its even spacing."""
     if densify is None:
         return None
     from ..core import airfoil
     noise, target = densify
-    warnings = ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
+    failures = failures or [[] for _ in heights]
+    warnings = ["section at %g %%: no extra edge points planned on a loop of its cut whose "
+                "edges could not be found (%s); edge radii there are not measured to the "
+                "rule's sigma"
+                % (h, "; ".join(why)) for h, why in zip(heights, failures) if why]
+    warnings += ["section at %g %%: %s radius %.3f mm is under %g sensor spots (%.3f mm): a "
                 "reading averages the edge over its spot, so this edge's radius, edge point "
                 "and the chord through it are not measured by this sensor, however dense "
                 "the points"
@@ -692,7 +738,8 @@ def edge_density_info(densify, edges, heights, spot_mm):
             "rule": "n = ceil((noise / radius_sigma * f(zone))^2) points in each +-zone edge "
                     "zone, times margin, spread within reach_radii edge radii of the edge "
                     "circle's centre (docs/user-guide.md)",
-            "sections": edges}
+            "sections": edges,
+            "sections_without_edges": [h for h, why in zip(heights, failures) if why]}
 
 
 def _cad_from_machine(table_to_cad, kinematics, angle_deg):
