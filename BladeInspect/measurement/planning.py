@@ -155,7 +155,8 @@ def span_frame(nominal, span_axis=None):
     """core.span.Span of the nominal: the one span rule of the planner and the analysis."""
     s = nominal.samples
     n_faces, planar = face_count_and_planes(nominal)
-    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis)
+    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis,
+                         s.normal)
 
 
 def span_axis_of(nominal, span_axis=None):
