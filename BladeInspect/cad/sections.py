@@ -59,6 +59,9 @@ def _join(pieces, closed):
 # place along the curve to this (mm), far below the micrometre the cut is promised to.
 EXACT_TOL = 1e-10
 EXACT_ITERATIONS = 30
+# A Newton point farther than this from its slice point (mm) is another branch of the cut
+# (the far side of a thin profile), not the point: the slice strays micrometres, never this.
+EXACT_REACH = 0.05
 
 
 def exact_cut(shape, point, normal, spacing=DEFAULT_SPACING):
@@ -90,17 +93,21 @@ def exact_cut(shape, point, normal, spacing=DEFAULT_SPACING):
 def _onto_face(surf, pts, normal, d):
     out = pts.copy()
     n = FreeCAD.Vector(*normal)
+    try:
+        bounds = surf.bounds()
+    except Exception:
+        bounds = (-np.inf, np.inf, -np.inf, np.inf)
     uv = None
     for k, p in enumerate(pts):
         target = FreeCAD.Vector(*p)
-        got = None if uv is None else _newton(surf, uv, target, n, d)
-        if got is None:
+        got = None if uv is None else _newton(surf, bounds, uv, target, n, d)
+        if got is None or np.linalg.norm(got[1] - p) > EXACT_REACH:
             try:
                 uv = surf.parameter(target)
             except Exception:
                 uv = None
-            got = None if uv is None else _newton(surf, uv, target, n, d)
-        if got is not None:
+            got = None if uv is None else _newton(surf, bounds, uv, target, n, d)
+        if got is not None and np.linalg.norm(got[1] - p) <= EXACT_REACH:
             uv, out[k] = got
     return out
 
@@ -110,7 +117,7 @@ def _nearest_face(faces, p):
     best, best_d = 0, np.inf
     for i, face in enumerate(faces):
         box = face.BoundBox
-        box.enlarge(1e-2)
+        box.enlarge(0.1)        # the slice strays micrometres off the face
         if box.isValid() and not box.isInside(vertex.Point):
             continue
         dist = face.distToShape(vertex)[0]
@@ -119,15 +126,12 @@ def _nearest_face(faces, p):
     return best
 
 
-def _newton(surf, uv, target, n, d):
+def _newton(surf, bounds, uv, target, n, d):
     """((u, v), xyz) of the point of surf on the plane x . n = d at target's place along the
-    curve (target - S) . T = 0, T = n x N; None when it does not settle on the surface."""
+    curve (target - S) . T = 0, T = n x N, (u, v) kept within ``bounds``; None when it does
+    not settle on the surface."""
     u, v = uv
-    try:
-        u0, u1, v0, v1 = surf.bounds()
-    except Exception:
-        u0 = v0 = -np.inf
-        u1 = v1 = np.inf
+    u0, u1, v0, v1 = bounds
     for _ in range(EXACT_ITERATIONS):
         s = surf.value(u, v)
         su = surf.getDN(u, v, 1, 0)

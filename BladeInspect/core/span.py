@@ -4,8 +4,9 @@ analysed section at 50 % are the same plane (the planner and the analysis once h
 3.3° apart on the demo blade and 19° on Rotor 67 when the planner chose its own axis, and both
 measured the extent over every face, so a root block below the hub moved every section).
 
-Inputs are the nominal's area-weighted surface samples (xyz, weight, face index), its face
-roles, and which faces are planes; nothing here knows FreeCAD.
+Inputs are the nominal's area-weighted surface samples (xyz, weight, face index, and their
+normals for the geometric axis), its face roles, and which faces are planes; nothing here
+knows FreeCAD.
 """
 from dataclasses import dataclass
 
@@ -21,7 +22,7 @@ AIRFOIL_ROLES = ("suction", "pressure", "leading_edge", "trailing_edge")
 # centres and fall short of the ends, a cap lies on them, and a root block or a platform
 # stands clear of them.
 CAP_REACH = 0.02
-# A hub fitted plane farther than this from square to the principal axis is no reference.
+# A hub fitted plane farther than this from square to the geometric axis is no reference.
 HUB_SQUARE_COS = 0.9
 
 
@@ -51,9 +52,9 @@ def span(xyz, weight, face, roles, planar_faces, n_faces, span_axis=None, normal
     fitted to them (a swept or leaned blade's principal axis tilts by the sweep, while a CMM
     and the rig's rotary axis cut it square to the hub); else geometric_axis (the hub and tip
     caps' normal, or the stacking direction), never the longest extent: a turbine vane's chord
-    is often longer than its span. It points from the hub to the tip when they are named, else so that
-    its largest component is positive (+Z for a blade modelled along Z); a given axis is
-    turned to point hub -> tip when those are named.
+    is often longer than its span. It points from the hub to the tip when they are named,
+    else so that its largest component is positive (+Z for a blade modelled along Z); a given
+    axis is turned to point hub -> tip when those are named.
     ``normals``: the samples' unit normals (without them the stacking direction is the
     longest principal axis).
     Extent: the airfoil faces and the hub and tip caps (named, or unnamed planes lying at the
