@@ -55,17 +55,30 @@ def plane_frame(origin, normal, engine_axis=(1.0, 0.0, 0.0)):
     return PlaneFrame(origin, e1, np.cross(normal, e1), normal)
 
 
+class NotAirfoilSection(InputError):
+    """The plane's cut is not the airfoil's profile (it runs over faces that are not blade
+    faces): the section is refused, the run goes on."""
+
+
 def airfoil_section(shape, origin, normal, engine_axis=(1.0, 0.0, 0.0),
-                    spacing=AIRFOIL_SPACING, polylines=None):
+                    spacing=AIRFOIL_SPACING, polylines=None, faces=None, blade_faces=None,
+                    face_roles=None):
     """(ordered (N, 2) profile, PlaneFrame) of the CAD shape cut by the plane: the closed loop
-    enclosing the largest area (the airfoil; other loops, e.g. of a fillet or a shroud, are
-    left out), without its repeated closing point, counter-clockwise about the normal.
-    InputError when the plane misses the shape or cuts no closed loop. ``polylines``: this
-    plane's cut at ``spacing`` when already made (the section table's): OCC's slice, half the
-    airfoil stage's time without draws, is not run again."""
+    enclosing the largest area, without its repeated closing point, counter-clockwise about
+    the normal; its points lie on the exact intersection of the faces and the plane
+    (sections.exact_cut). InputError when the plane misses the shape or cuts no closed loop.
+    ``polylines``, ``faces``: this plane's exact cut at ``spacing`` and its points' faces when
+    already made (the section table's): the cut, half the airfoil stage's time without draws,
+    is not made again. ``blade_faces``: indices of the faces that make the airfoil; a cut
+    with a point on any other face (a hub, platform, root block, fillet or shroud, or a cap
+    the plane crosses the blade through) raises NotAirfoilSection naming them, by
+    ``face_roles`` ({index: role}) when given: such a loop is another profile than the
+    airfoil's, and a loop beside it shares the plane's band of measured points with it."""
     frame = plane_frame(origin, normal, engine_axis)
     if not polylines:
-        polylines = sections.cut(shape, frame.origin, frame.normal, spacing)
+        polylines, faces = sections.exact_cut(shape, frame.origin, frame.normal, spacing)
+    if blade_faces is not None and faces is not None:
+        _check_blade_faces(faces, blade_faces, face_roles or {})
     loops = [p for p in polylines
              if len(p) >= 4 and np.linalg.norm(p[-1] - p[0]) < 1e-9]
     if not loops:
@@ -82,3 +95,13 @@ def airfoil_section(shape, origin, normal, engine_axis=(1.0, 0.0, 0.0),
 def _signed_area(xy):
     x, y = xy[:, 0], xy[:, 1]
     return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _check_blade_faces(faces, blade_faces, face_roles):
+    found = set(int(i) for f in faces for i in np.asarray(f).ravel() if i >= 0)
+    other = sorted(found - set(int(i) for i in blade_faces))
+    if other:
+        names = ", ".join("%d (%s)" % (i, face_roles.get(i, "no airfoil role")) for i in other)
+        raise NotAirfoilSection("the plane's cut runs over face%s %s, not blade faces (hub, "
+                                "platform, fillet, shroud or an end cap): not the airfoil's "
+                                "profile" % ("s" if len(other) > 1 else "", names))

@@ -22,6 +22,7 @@ from ..core import contracts
 from ..core import decision as decision_mod
 from ..core.atomic_file import atomic_write
 from ..core.errors import InputError
+from ..measurement.planning import blade_faces
 from . import airfoil_task
 from . import uncertainty as uncertainty_mod
 from .airfoil_measure import SectionMeasurement, measure_at, section_points
@@ -35,6 +36,11 @@ DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
 # both edges and both sides).
 MIN_SECTION_POINTS = 60
+# A section whose measured points leave a stretch of the nominal profile longer than this
+# share of its perimeter without a point is refused: the profile fitted to them would close
+# the stretch by a guess (a scan of the blade alone where the cut is closed by a hub, or of one
+# side only), so every characteristic across it would be measured against another loop.
+MAX_COVERAGE_GAP = 0.15
 # A measured point is round an edge within this many edge radii of the edge circle's centre.
 EDGE_NEIGHBOURHOOD = 1.5
 CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
@@ -233,9 +239,10 @@ class Plane:
     height_pct: float
     le_hint_3d: np.ndarray = None     # the CAD's LE when its faces name it
     point_index: np.ndarray = None
-    # the CAD's cut in this plane when the section table made it (cad.sections.cut at the
-    # airfoil spacing); None: the stage cuts the CAD itself
+    # the CAD's exact cut in this plane when the section table made it (cad.sections.exact_cut
+    # at the airfoil spacing) and its points' faces; None: the stage cuts the CAD itself
     cut_polylines: list = None
+    cut_faces: list = None
 
 
 def planes_of_table(table):
@@ -244,8 +251,9 @@ def planes_of_table(table):
         hint = s.profile.le if (s.profile is not None
                                 and s.profile.le_rule == "CAD face roles") else None
         polylines = s.profile.polylines if s.profile is not None else None
+        faces = s.profile.faces if s.profile is not None else None
         out.append(Plane(s.label, s.origin, s.normal, s.height_pct, hint, s.point_index,
-                         polylines or None))
+                         polylines or None, faces if polylines else None))
     return out
 
 
@@ -347,15 +355,51 @@ def clear_nominal_cache():
     _NOMINAL_CACHE.clear()
 
 
+def coverage_gap(pts, loop):
+    """(longest stretch of the closed ``loop`` (N, 2) with none of ``pts`` (M, 2) nearest to
+    it, the loop's perimeter), mm."""
+    from scipy.spatial import cKDTree
+    seg = np.linalg.norm(np.diff(np.vstack([loop, loop[:1]]), axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(seg)])
+    perimeter = float(arc[-1])
+    if len(pts) == 0:
+        return perimeter, perimeter
+    at = np.unique(arc[cKDTree(loop).query(pts)[1]])
+    gaps = np.diff(np.concatenate([at, [at[0] + perimeter]]))
+    return float(gaps.max()), perimeter
+
+
+def _blade_faces(nominal):
+    """(indices of the faces that make the airfoil, {index: role} of the others)."""
+    blade = set(blade_faces(nominal))
+    roles = {int(i): name for name, idx in (getattr(nominal, "roles", None) or {}).items()
+             for i in idx if int(i) not in blade}
+    return blade, roles
+
+
+def _refused(plane, reason, nominal_values=None, le_rule=None):
+    """A section the stage will not measure: its block says why, the run goes on."""
+    sr = SectionResult(plane=plane, frame=None, nominal=None,
+                       notes=["section refused: %s" % reason])
+    sr.block = {"label": plane.label, "height_pct": plane.height_pct, "le_rule": le_rule,
+                "nominal": nominal_values, "measured": None, "deviation": None,
+                "uncertainty": None, "refused": reason}
+    return sr
+
+
 def _section(nominal, plane, opts, result, rng, counted=None, task=None):
-    from ..cad.airfoil_sections import airfoil_section
+    from ..cad.airfoil_sections import NotAirfoilSection, airfoil_section
+    blade, roles = _blade_faces(nominal)
     try:
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis,
-                                    polylines=plane.cut_polylines)
+                                    polylines=plane.cut_polylines, faces=plane.cut_faces,
+                                    blade_faces=blade, face_roles=roles)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
         upstream = UPSTREAM_2D if opts.definition.le_rule == "engine-axis" else None
         nom = nominal_characteristics(xy, opts.definition, hint, upstream,
                                       None if task is None else task.nominal)
+    except NotAirfoilSection as exc:
+        return _refused(plane, str(exc))
     except InputError as exc:
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
@@ -376,6 +420,16 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         sr.notes.append("measured: %d points in the section, %d needed"
                         % (len(idx), MIN_SECTION_POINTS))
         return sr
+    gap = coverage_gap(frame.to_2d(result.points_cad[idx]), xy)
+    if gap[0] > MAX_COVERAGE_GAP * gap[1]:
+        refused = _refused(plane, "the measured points cover only part of the profile: none "
+                           "along %.1f mm of its %.1f mm perimeter (%.0f %%, at most %.0f %% "
+                           "allowed)" % (gap[0], gap[1], 100.0 * gap[0] / gap[1],
+                                         100.0 * MAX_COVERAGE_GAP),
+                           nominal_values, nom.le_rule)
+        refused.frame, refused.nominal = frame, nom
+        refused.notes = sr.notes + refused.notes
+        return refused
     try:
         ch, fit, cont, ordered, noise = measure_at(result.points_cad[idx], result.normal[idx],
                                                     frame, nom, opts)

@@ -60,6 +60,7 @@ class Profile:
     le_rule: str                   # how the leading edge was told from the trailing edge
     side_tree: Optional[cKDTree] = None    # resampled profile halves, 2D chord coordinates
     side_label: Optional[np.ndarray] = None  # 'suction' / 'pressure' per tree point
+    faces: Optional[list] = None   # (K,) face index per polyline point (the exact cut's)
 
 
 @dataclass
@@ -482,7 +483,9 @@ def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, w
     """Table 2 for a registration: one Section per section plane with the optical figures (and
     the CMM's beside them when ``cmm`` — a path or CmmData — is given). See the module notes
     for where sections, edges and sides are."""
-    from ..cad.sections import cut   # cad/ needs FreeCAD; inspection/ imports without it
+    # cad/ needs FreeCAD; inspection/ imports without it
+    from ..cad.airfoil_sections import AIRFOIL_SPACING
+    from ..cad.sections import exact_cut
     for name, value in (("band", band), ("within", within), ("edge_fraction", edge_fraction)):
         if not np.isfinite(value) or value <= 0:
             raise InputError("section table: %s must be positive, got %r" % (name, value))
@@ -502,11 +505,13 @@ def section_table(result, nominal, heights_pct=SECTION_HEIGHTS_PCT, band=0.25, w
     sections = []
     for source, label, origin, normal, height, idx in specs:
         try:
-            polylines = cut(nominal.shape, origin, normal)
+            polylines, faces = exact_cut(nominal.shape, origin, normal, AIRFOIL_SPACING)
         except InputError:
-            polylines = []
+            polylines, faces = [], None
             warnings.append("section %s: the plane misses the CAD" % label)
         profile = build_profile(nominal, polylines, normal, result.points_cad[idx], origin)
+        if profile is not None and faces is not None and all(len(p) >= 2 for p in polylines):
+            profile.faces = faces
         zone = classify(profile, result.points_cad[idx], edge_fraction)
         sec = Section(label=label, source=source, origin=np.asarray(origin, dtype=float),
                       normal=np.asarray(normal, dtype=float), height_pct=float(height),

@@ -145,7 +145,18 @@ def face_count_and_planes(nominal):
     faces = getattr(nominal, "faces", None)
     if faces is None:
         return int(np.max(nominal.samples.face)) + 1, []
-    return len(faces), [i for i, f in enumerate(faces) if "Plane" in type(f.Surface).__name__]
+    return len(faces), [i for i, f in enumerate(faces) if _is_planar(f)]
+
+
+def _is_planar(face):
+    """A plane, or a B-spline face that is one (a STEP writer's or toNurbs's planar cap)."""
+    surf = face.Surface
+    if "Plane" in type(surf).__name__:
+        return True
+    try:
+        return bool(surf.isPlanar())
+    except Exception:
+        return False
 
 
 def blade_faces(nominal):
@@ -158,7 +169,8 @@ def span_frame(nominal, span_axis=None):
     """core.span.Span of the nominal: the one span rule of the planner and the analysis."""
     s = nominal.samples
     n_faces, planar = face_count_and_planes(nominal)
-    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis)
+    return span_mod.span(s.xyz, s.weight, s.face, nominal.roles, planar, n_faces, span_axis,
+                         s.normal)
 
 
 def span_axis_of(nominal, span_axis=None):
