@@ -1,0 +1,73 @@
+"""The profile's two edges found as edges: where its two sides meet at the ends of the camber
+line, whatever the caliper diameter does.
+
+The caliper diameter's ends are the edges of a lightly cambered profile, but on a strongly
+turned one (a turbine vane) or one with a long non-circular nose, an end sits on a side's
+shoulder: the camber line between sides split there stops short of the nose. So the split is
+moved to where the camber line's end tangents, extended, leave the profile, the camber line
+worked out again between the new sides, and so on until the split points stop moving. On an
+exact circular edge that fixed point is the edge point itself (the tangent through the edge
+circle's centre); once a split point is in the nose the camber line no longer depends on
+where exactly (its end is set by the edge, medial.py), so the rounds stop when the split
+points move by less than a small fraction of the edge's size.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from .camber import line_end
+from .chords import farthest_pair
+from .medial import medial_axis, side_samples
+from .profile import ray_hit
+
+# The split is settled when neither point moves by more than this fraction of its end's
+# last inscribed radius (well inside the nose, where the camber line does not depend on it)
+# nor by more than _SETTLED_MM.
+_SETTLED_FRACTION = 0.02
+_SETTLED_MM = 1e-3
+_ROUNDS = 12
+
+
+@dataclass
+class EdgeSplit:
+    """The two sides between the edges and the camber line's inscribed circles between them
+    (centres ordered from side a's start, at u_a, to its end, at u_b)."""
+    u_a: float
+    u_b: float
+    side_a: object
+    side_b: object
+    centres: np.ndarray
+    radii: np.ndarray
+    rounds: int
+
+
+def edge_split(profile, window_pct):
+    """The profile split into its two sides at its edges: from the caliper diameter's ends,
+    re-split where the camber line's end tangents (the metal angle rule's, ``window_pct``)
+    leave the profile until the split settles. InputError when it does not settle."""
+    L = profile.length
+    u_a, u_b = (u % L for u in farthest_pair(profile)[:2])
+    for rounds in range(1, _ROUNDS + 1):
+        side_a, side_b = side_samples(profile, u_a, u_b), side_samples(profile, u_b, u_a)
+        centres, radii = medial_axis(profile, side_a, side_b)
+        new = []
+        for end, u_old in ((0, u_a), (-1, u_b)):
+            out = line_end(centres, radii, end, window_pct=window_pct)[2]
+            u_hit = ray_hit(profile, centres[end], out, behind=True)[0][0] % L
+            step = abs((u_hit - u_old + L / 2) % L - L / 2)
+            new.append((u_hit, step, radii[end]))
+        settled = all(step <= max(_SETTLED_MM, _SETTLED_FRACTION * r) for _, step, r in new)
+        if settled:
+            return EdgeSplit(u_a, u_b, side_a, side_b, centres, radii, rounds)
+        (u_a, _, _), (u_b, _, _) = new
+        if _cyclic_gap(u_a, u_b, L) < 0.05 * L:
+            break
+    raise InputError("airfoil profile: its edges could not be found (the camber line's ends "
+                     "do not settle on two separate edges); not an airfoil-like profile")
+
+
+def _cyclic_gap(u, v, length):
+    d = abs(u - v) % length
+    return min(d, length - d)
