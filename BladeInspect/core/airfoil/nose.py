@@ -8,8 +8,9 @@ moved to where the camber line's end tangents, extended, leave the profile, the 
 worked out again between the new sides, and so on until the split points stop moving. On an
 exact circular edge that fixed point is the edge point itself (the tangent through the edge
 circle's centre); once a split point is in the nose the camber line no longer depends on
-where exactly (its end is set by the edge, medial.py), so the rounds stop when the split
-points move by less than a small fraction of the edge's size.
+where exactly (its end is set by the edge, medial.py), so the rounds stop as soon as both
+split points are in the nose: seen from the camber line's end within NOSE_HALF_ANGLE_DEG of
+its outward tangent. On a lightly cambered profile the caliper's ends already are.
 """
 
 from dataclasses import dataclass
@@ -22,11 +23,9 @@ from .chords import farthest_pair
 from .medial import medial_axis, side_samples
 from .profile import ray_hit
 
-# The split is settled when neither point moves by more than this fraction of its end's
-# last inscribed radius (well inside the nose, where the camber line does not depend on it)
-# nor by more than _SETTLED_MM.
-_SETTLED_FRACTION = 0.02
-_SETTLED_MM = 1e-3
+# A split point is in the nose when, seen from its end of the camber line, it lies within
+# this angle of the line's outward end tangent; there the camber line no longer depends on it.
+NOSE_HALF_ANGLE_DEG = 20.0
 _ROUNDS = 12
 
 
@@ -49,19 +48,19 @@ def edge_split(profile, window_pct):
     leave the profile until the split settles. InputError when it does not settle."""
     L = profile.length
     u_a, u_b = (u % L for u in farthest_pair(profile)[:2])
+    cos_nose = np.cos(np.radians(NOSE_HALF_ANGLE_DEG))
     for rounds in range(1, _ROUNDS + 1):
         side_a, side_b = side_samples(profile, u_a, u_b), side_samples(profile, u_b, u_a)
         centres, radii = medial_axis(profile, side_a, side_b)
-        new = []
-        for end, u_old in ((0, u_a), (-1, u_b)):
+        settled, hits = True, []
+        for end, u in ((0, u_a), (-1, u_b)):
             out = line_end(centres, radii, end, window_pct=window_pct)[2]
-            u_hit = ray_hit(profile, centres[end], out, behind=True)[0][0] % L
-            step = abs((u_hit - u_old + L / 2) % L - L / 2)
-            new.append((u_hit, step, radii[end]))
-        settled = all(step <= max(_SETTLED_MM, _SETTLED_FRACTION * r) for _, step, r in new)
+            seen = profile.eval([u])[0] - centres[end]
+            settled &= bool(out @ seen >= cos_nose * np.linalg.norm(seen))
+            hits.append(ray_hit(profile, centres[end], out, behind=True)[0][0] % L)
         if settled:
             return EdgeSplit(u_a, u_b, side_a, side_b, centres, radii, rounds)
-        (u_a, _, _), (u_b, _, _) = new
+        u_a, u_b = hits
         if _cyclic_gap(u_a, u_b, L) < 0.05 * L:
             break
     raise InputError("airfoil profile: its edges could not be found (the camber line's ends "
