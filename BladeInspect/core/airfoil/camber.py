@@ -164,19 +164,25 @@ class _EndFit:
         return (self._design(s, 1) @ self.coef).reshape(-1, 2)[0] if np.ndim(s) == 0 \
             else (self._design(s, 1) @ self.coef).reshape(-1, 2)
 
-    def turning(self, s0):
-        """Signed turning (rad) of the fitted curve's tangent from arc length s0 to 0."""
-        a, b = self.slope(float(s0)), self.slope(0.0)
-        return float(np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b))
+    def mean_curvature(self):
+        """The slope of a straight line fitted to the fitted curve's tangent angle over the
+        window (a grid of arc lengths): its mean curvature, weighted to the window's middle
+        rather than read off its ends, where a fit is least sure of its slope."""
+        grid = np.linspace(-self.width, 0.0, 33)
+        d = self.slope(grid)
+        angle = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+        return float(np.polyfit(grid, angle, 1)[0])
 
 
-def _window_fit(s, c, sel):
-    """The end fit over the window's centres, its arc's curvature the window's mean turning
-    (a plain quartic's first, then the fit's own, twice)."""
-    width = max(float(-s[sel][0]), 1e-9)
+def _window_fit(s, c, sel, width):
+    """The end fit over the window's centres, its arc's curvature the mean curvature over the
+    window's ``width`` back from the end (a plain quartic's first, then the fit's own, twice).
+    The width is the window's nominal span, not its first centre's: a centre entering the
+    window must not move the curvature by a step."""
+    width = max(float(width), 1e-9)
     fit = _EndFit(s[sel], c[sel], 0.0, width)
     for _ in range(2):
-        fit = _EndFit(s[sel], c[sel], fit.turning(s[sel][0]) / width, width)
+        fit = _EndFit(s[sel], c[sel], fit.mean_curvature(), width)
     return fit
 
 
@@ -196,11 +202,12 @@ def _end_quartic(c, r, edge, window_pct):
         sel = (s >= -(skip + window)) & (s <= -skip)
         if sel.sum() < 2 * END_DEGREE:
             sel = np.arange(len(s)) >= len(s) - 2 * END_DEGREE
-        return sel
+            return sel, -s[sel][0]
+        return sel, skip + window
 
-    sel = window_of(s)
+    sel, width = window_of(s)
     for _ in range(_END_OUTLIER_ROUNDS):
-        fit = _window_fit(s, c, sel)
+        fit = _window_fit(s, c, sel, width)
         off = norms(c - fit.point(s))
         spread = 1.4826 * np.median(off[sel])
         stray = sel & (off > max(_END_OUTLIER_SIGMAS * spread, _END_OUTLIER_FLOOR_MM))
@@ -208,8 +215,8 @@ def _end_quartic(c, r, edge, window_pct):
             break
         c, r = c[~stray], r[~stray]
         s = _arc_from_end(c)
-        sel = window_of(s)
-    return c, r, s, sel, _window_fit(s, c, sel)
+        sel, width = window_of(s)
+    return c, r, s, sel, _window_fit(s, c, sel, width)
 
 
 def closed_end(profile, centres, radii, end, circle, notes, window_pct):

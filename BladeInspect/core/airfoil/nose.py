@@ -47,7 +47,7 @@ def edge_split(profile, window_pct):
     re-split where the camber line's end tangents (the metal angle rule's, ``window_pct``)
     leave the profile until the split settles. InputError when it does not settle."""
     L = profile.length
-    u_a, u_b = (u % L for u in farthest_pair(profile)[:2])
+    u_a, u_b = sorted(u % L for u in farthest_pair(profile)[:2])
     cos_nose = np.cos(np.radians(NOSE_HALF_ANGLE_DEG))
     for rounds in range(1, _ROUNDS + 1):
         side_a, side_b = side_samples(profile, u_a, u_b), side_samples(profile, u_b, u_a)
