@@ -157,12 +157,12 @@ class _EndFit:
         return a.reshape(2 * n, -1)
 
     def point(self, s):
-        return (self._design(s) @ self.coef).reshape(-1, 2)[0] if np.ndim(s) == 0 \
-            else (self._design(s) @ self.coef).reshape(-1, 2)
+        xy = (self._design(s) @ self.coef).reshape(-1, 2)
+        return xy[0] if np.ndim(s) == 0 else xy
 
     def slope(self, s):
-        return (self._design(s, 1) @ self.coef).reshape(-1, 2)[0] if np.ndim(s) == 0 \
-            else (self._design(s, 1) @ self.coef).reshape(-1, 2)
+        d = (self._design(s, 1) @ self.coef).reshape(-1, 2)
+        return d[0] if np.ndim(s) == 0 else d
 
     def mean_curvature(self):
         """The slope of a straight line fitted to the fitted curve's tangent angle over the
