@@ -84,26 +84,29 @@ def line_end(centres, radii, end, edge=None, window_pct=DEFAULT_METAL_ANGLE_WIND
     if edge is not None:
         far = np.linalg.norm(c - edge.center, axis=1) >= _EDGE_CORE * edge.radius
         c, r = c[far], r[far]
-    c, r, s, sel, full = _end_quartic(c, r, edge, window_pct)
+    c, r, s, sel, fit = _end_quartic(c, r, edge, window_pct)
     skip = END_SKIP * (r[-1] if edge is None else edge.radius)
-    deriv = np.column_stack([np.polyder(full[:, k]) for k in range(2)])
-    tangent = unit(full[-2])
+    tangent = unit(fit.slope(0.0))
     # How far the last stretch turns from that tangent: the metal angle's definition spread.
     last = s >= -skip
     bend = 0.0
     if last.sum() >= 2 and np.linalg.norm(c[-1] - c[last][0]) > 0:
         chord = unit(c[-1] - c[last][0])
         bend = float(np.degrees(np.arccos(np.clip(chord @ tangent, -1.0, 1.0))))
+        # the turn of the fitted line itself over that stretch (a curved camber line's own)
+        # is not a spread of the definition
+        own = unit(fit.point(0.0) - fit.point(float(s[last][0])))
+        bend = max(0.0, bend - float(np.degrees(np.arccos(np.clip(own @ tangent, -1.0,
+                                                                     1.0)))))
     if edge is not None:
-        # The line ends on the fitted quartic (not at the last, least conditioned centre),
+        # The line ends on the fitted curve (not at the last, least conditioned centre),
         # at its point abreast of the edge circle's centre, ahead of the last centre or behind.
         reach = 0.0
         for _ in range(8):
-            p = np.array([np.polyval(full[:, k], reach) for k in range(2)])
-            d = unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+            p, d = fit.point(reach), unit(fit.slope(reach))
             reach = float(np.clip(reach + (edge.center - p) @ d, s[sel][0], edge.radius))
-        tip = np.array([np.polyval(full[:, k], reach) for k in range(2)])
-        tangent = unit(np.array([np.polyval(deriv[:, k], reach) for k in range(2)]))
+        tip = fit.point(reach)
+        tangent = unit(fit.slope(reach))
         keep = s < reach - 1e-9
         c, r = np.vstack([c[keep], tip]), np.concatenate([r[keep], [edge.radius]])
     if end == 0:
@@ -117,13 +120,78 @@ def _arc_from_end(c):
     return s - s[-1]
 
 
+class _EndFit:
+    """The end window's curve: an arc of curvature ``kappa`` through the end (arc length 0)
+    plus a quartic in arc length, least squares to the centres. The arc takes up the window's
+    mean turning, so a camber line of constant curvature (a circular arc, as on a high-turning
+    profile) is fitted exactly, and the quartic only the change of curvature; with kappa = 0
+    it is the plain quartic in arc length."""
+
+    def __init__(self, s, c, kappa, width):
+        self.kappa, self.width = float(kappa), float(width)
+        a = self._design(s)
+        self.coef = np.linalg.lstsq(a, c.reshape(-1), rcond=None)[0]
+
+    def _arc(self, s):
+        # sin(k s)/k and (1 - cos(k s))/k, and their slopes, finite at k = 0
+        ks = self.kappa * s
+        sin_ = s * np.sinc(ks / np.pi)
+        vers = 0.5 * self.kappa * s * s * np.sinc(ks / (2.0 * np.pi)) ** 2
+        return sin_, vers, np.cos(ks), np.sin(ks)
+
+    def _design(self, s, der=0):
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        sin_, vers, dsin, dvers = self._arc(s)
+        q = s / self.width
+        n = len(s)
+        a = np.zeros((n, 2, 2 + 2 + 2 * (END_DEGREE - 1)))
+        a[:, 0, 0] = a[:, 1, 1] = 1.0 if der == 0 else 0.0
+        f, g = (sin_, vers) if der == 0 else (dsin, dvers)
+        # the arc's tangent e at the end: S e + V J e, J the quarter turn
+        a[:, 0, 2], a[:, 0, 3] = f, -g
+        a[:, 1, 2], a[:, 1, 3] = g, f
+        for k in range(2, END_DEGREE + 1):
+            col = 4 + 2 * (k - 2)
+            term = q ** k if der == 0 else k * q ** (k - 1) / self.width
+            a[:, 0, col] = a[:, 1, col + 1] = term
+        return a.reshape(2 * n, -1)
+
+    def point(self, s):
+        xy = (self._design(s) @ self.coef).reshape(-1, 2)
+        return xy[0] if np.ndim(s) == 0 else xy
+
+    def slope(self, s):
+        d = (self._design(s, 1) @ self.coef).reshape(-1, 2)
+        return d[0] if np.ndim(s) == 0 else d
+
+    def mean_curvature(self):
+        """The slope of a straight line fitted to the fitted curve's tangent angle over the
+        window (a grid of arc lengths): its mean curvature, weighted to the window's middle
+        rather than read off its ends, where a fit is least sure of its slope."""
+        grid = np.linspace(-self.width, 0.0, 33)
+        d = self.slope(grid)
+        angle = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+        return float(np.polyfit(grid, angle, 1)[0])
+
+
+def _window_fit(s, c, sel, width):
+    """The end fit over the window's centres, its arc's curvature the mean curvature over the
+    window's ``width`` back from the end (a plain quartic's first, then the fit's own, twice).
+    The width is the window's nominal span, not its first centre's: a centre entering the
+    window must not move the curvature by a step."""
+    width = max(float(width), 1e-9)
+    fit = _EndFit(s[sel], c[sel], 0.0, width)
+    for _ in range(2):
+        fit = _EndFit(s[sel], c[sel], fit.mean_curvature(), width)
+    return fit
+
+
 def _end_quartic(c, r, edge, window_pct):
-    """The end window's quartic of the centres (ordered towards the end), the centres off the
-    locus dropped first: a centre refined onto a wrong foot (inscribed, but far off the locus)
-    would tilt the end tangent by tens of mdeg. Returns the
-    kept centres and radii, their arc lengths, the window's selection of them and the
-    quartic's coefficients (np.polyfit's, one column per axis). On the exact nominal no centre
-    is dropped."""
+    """The end window's fit (_EndFit) of the centres (ordered towards the end), the centres
+    off the locus dropped first: a centre refined onto a wrong foot (inscribed, but far off
+    the locus) would tilt the end tangent by tens of mdeg. Returns the kept centres and radii,
+    their arc lengths, the window's selection of them and the fit. On the exact nominal no
+    centre is dropped."""
     s = _arc_from_end(c)
     # The last stretch of the locus bends towards the centre of curvature of the edge's
     # tightest point when the edge is not a circle: it is left out of the fit.
@@ -134,21 +202,21 @@ def _end_quartic(c, r, edge, window_pct):
         sel = (s >= -(skip + window)) & (s <= -skip)
         if sel.sum() < 2 * END_DEGREE:
             sel = np.arange(len(s)) >= len(s) - 2 * END_DEGREE
-        return sel
+            return sel, -s[sel][0]
+        return sel, skip + window
 
-    sel = window_of(s)
+    sel, width = window_of(s)
     for _ in range(_END_OUTLIER_ROUNDS):
-        fit = np.polyfit(s[sel], c[sel], END_DEGREE)
-        off = norms(c - np.column_stack([np.polyval(fit[:, k], s) for k in range(2)]))
+        fit = _window_fit(s, c, sel, width)
+        off = norms(c - fit.point(s))
         spread = 1.4826 * np.median(off[sel])
         stray = sel & (off > max(_END_OUTLIER_SIGMAS * spread, _END_OUTLIER_FLOOR_MM))
         if not stray.any():
             break
         c, r = c[~stray], r[~stray]
         s = _arc_from_end(c)
-        sel = window_of(s)
-    full = np.polyfit(s[sel], c[sel], END_DEGREE)
-    return c, r, s, sel, full
+        sel, width = window_of(s)
+    return c, r, s, sel, _window_fit(s, c, sel, width)
 
 
 def closed_end(profile, centres, radii, end, circle, notes, window_pct):

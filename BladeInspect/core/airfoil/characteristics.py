@@ -12,7 +12,8 @@ from .chords import CHORD_METHODS, extent, farthest_pair, pressure_bitangent
 from .edges import (CircleFit2D, DEFAULT_EDGE_ZONE_DEG, LE_RADIUS_SIGMAS, corner_edges,
                     corner_warnings, edge_circle, edge_point, leading_end)
 from .geometry import angle_deg, norms, unit
-from .medial import medial_axis, refine_centres, side_range, side_samples
+from .medial import refine_centres, side_range
+from .nose import edge_split
 from .profile import Profile, area_centroid, ray_hit
 from .thickness import (MAX_POS_WINDOW, max_thickness_position, stations_to_arc,
                         thickness_normal)
@@ -130,12 +131,13 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         raise InputError("metal angle window: %r %% of the camber line must be in (0, 100]"
                          % (metal_angle_window_pct,))
 
-    # Sides split at the caliper diameter's ends (the edges of an airfoil), then the circles.
-    cal_u1, cal_u2, cal_p1, cal_p2 = farthest_pair(profile)
+    # The caliper chord is the caliper diameter; the sides are split at the edges (nose.py),
+    # not at its ends, which sit on a shoulder of a strongly turned profile.
+    _, _, cal_p1, cal_p2 = farthest_pair(profile)
     caliper = float(np.linalg.norm(cal_p2 - cal_p1))
-    u1, u2 = sorted([cal_u1 % L, cal_u2 % L])
-    side_a, side_b = side_samples(profile, u1, u2), side_samples(profile, u2, u1 + L)
-    centres, radii = medial_axis(profile, side_a, side_b)
+    split = edge_split(profile, metal_angle_window_pct)
+    side_a, side_b = split.side_a, split.side_b
+    centres, radii = split.centres, split.radii
 
     # Camber line end tangents, extended to the profile: the two edge points.
     # First the edge circles about the locus's ends, then the ends closed onto circular edges.

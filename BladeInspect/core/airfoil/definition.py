@@ -20,7 +20,7 @@ from .characteristics import DEFAULT_EDGE_OFFSETS_MM
 from .chords import CHORD_METHODS
 from .edges import DEFAULT_EDGE_ZONE_DEG, LE_RADIUS_SIGMAS
 
-KERNEL_VERSION = 2
+KERNEL_VERSION = 3
 # Which end is the LE when neither a point near it nor an upstream direction is given:
 # "larger-radius" -- the blunter end, or the end upstream along the engine axis when the two
 # radii agree within le_radius_sigmas of their difference; "engine-axis" -- the end upstream

@@ -96,8 +96,12 @@ def stations_to_arc(mcl, le, chord_dir, chord, stations_pct):
     out = []
     for pct in stations_pct:
         target = pct / 100.0 * chord
-        if not (x.min() <= target <= x.max()):
+        # (0 % and 100 % are the edge points, whose projections are 0 and the chord but for
+        # rounding)
+        slack = 1e-12 * chord
+        if not (x.min() - slack <= target <= x.max() + slack):
             raise InputError("thickness station %g %% lies outside the chord" % pct)
+        target = float(np.clip(target, x.min(), x.max()))
         si = float(np.interp(target, x, s))
         for _ in range(8):
             p, t = mcl.at([si])
