@@ -36,7 +36,9 @@ ENGINE_AXIS = (1.0, 0.0, 0.0)        # CAD +X: the engine axis of a blade modell
 ZONE_HEIGHTS_PCT = tuple(np.arange(5.0, 100.0, 10.0))
 DEFAULT_OBJECTIVE = "least-squares"
 DATUM = "datum"
-OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM,)
+SIZE = fits.SIZE_OBJECTIVE
+OBJECTIVE_NAMES = fits.OBJECTIVES + (SIZE, DATUM)
+LEAST_SQUARES_NAMES = ("least-squares", SIZE)
 DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
 
 
@@ -73,9 +75,10 @@ class FitChoice:
         if self.free is not None:
             fits.parse_free(self.free, _axes((0.0, 0.0, 1.0), self.engine_axis))
         if self.weights_by_zone is not None:
-            if self.objective != "least-squares":
+            if self.objective not in LEAST_SQUARES_NAMES:
                 raise InputError("--weights-by-zone: region weights apply to --fit "
-                                 "least-squares only, not to %s" % self.objective)
+                                 "least-squares or %s only, not to %s"
+                                 % (SIZE, self.objective))
             self.zone_weights()
 
     def zone_weights(self):
@@ -102,7 +105,9 @@ def add_arguments(parser):
     """--fit, --free, --weights-by-zone, --decision-rule and --weights on a subcommand."""
     parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=OBJECTIVE_NAMES,
                         help="fit objective after the robust least-squares ICP "
-                             "(default least-squares: the ICP's pose)")
+                             "(default least-squares: the ICP's pose; %s: least squares "
+                             "with a uniform normal offset, reported as the part's size "
+                             "deviation, that no longer moves the pose)" % SIZE)
     parser.add_argument("--datum-faces", default=None,
                         help="--fit datum: primary,secondary,tertiary CAD faces by index or "
                              "role name (default the CAD's datum_primary,datum_secondary,"
@@ -247,7 +252,7 @@ def _run(objective, result, nominal, choice, tolerance, free, labels, closest):
         return None
     weights = fit_weights(result)
     multipliers = None
-    if objective == "least-squares" and choice.weights_by_zone is not None:
+    if objective in LEAST_SQUARES_NAMES and choice.weights_by_zone is not None:
         multipliers = fits.per_zone(labels, choice.zone_weights())
     lower = upper = None
     if objective == "tolerance":
@@ -267,10 +272,12 @@ def _tolerance_of_minimax(minimax, tolerance):
                                fits=bool(margin >= 0))
 
 
-def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None):
+def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None,
+          sensor=None):
     """Move ``result`` (in place) to the pose of the chosen fit and record it in result.fit;
     with ``all_objectives`` also fit every other objective from the same start, for
-    sensitivity(). Returns the FitRuns."""
+    sensitivity(). ``sensor``: the rig.sensor.SensorModel whose stated accuracy enters the
+    size deviation's U (None: the default sensor). Returns the FitRuns."""
     choice = choice or FitChoice()
     progress = progress or (lambda f, m: None)
     free = free_of(choice, nominal)
@@ -316,10 +323,77 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
             inlier = np.asarray(result.inlier, bool)
             record.update(max_abs_deviation_mm=float(np.max(np.abs(
                 result.deviation[inlier]))), rms_mm=result.rms_mm)
+        if choice.objective == SIZE:
+            record["size_deviation"] = size_deviation(chosen, sensor)
+            # The pose's scatter is the size fit's: without the offset the screw along the
+            # span that mimics a size error is held by the size and looks well determined.
+            result.pose_covariance = np.asarray(chosen.covariance, dtype=float)
+            result.center = np.asarray(chosen.center, dtype=float)
         seconds["deviations"] = time.perf_counter() - t0
+    if choice.objective == "least-squares":
+        record["size_take_up"] = size_take_up(result, free)
     record["timing_s"] = seconds
     result.fit = record
     return out
+
+
+K = 2.0   # coverage factor of the size deviation's U
+SIZE_RULE = ("uniform offset of the surface along its normals fitted with the pose (--fit %s; "
+             "+ is material added, the part oversize); U (k = 2) combines its least-squares "
+             "standard deviation with the sensor's stated accuracy as a rectangular bias of "
+             "every reading, taken whole: a reading bias reads as a size error, which the "
+             "fit cannot tell apart" % SIZE)
+
+
+def size_deviation(run, sensor=None):
+    """result.json's fit.size_deviation of a size fit (core.fits.FitResult of SIZE): the
+    offset with its U (k = 2); U null when the points do not determine it."""
+    from ..rig.sensor import SensorModel
+    accuracy = (sensor or SensorModel()).accuracy
+    variance = run.size_variance
+    statistical = float(np.sqrt(variance)) if np.isfinite(variance) else None
+    systematic = float(accuracy / np.sqrt(3.0))
+    U = (None if statistical is None
+         else float(K * np.sqrt(statistical ** 2 + systematic ** 2)))
+    return {"value_mm": float(run.size), "U_mm": U, "k": K,
+            "u_statistical_mm": statistical, "u_systematic_mm": systematic, "rule": SIZE_RULE}
+
+
+# The size error the take-up note gives its figures for (a typical profile tolerance's tenth).
+TAKE_UP_EXAMPLE_MM = 0.02
+
+
+def size_take_up(result, free=None):
+    """The plain least-squares pose's take-up of a uniform size error, stated (result.json's
+    fit.size_take_up): core.fits.size_take_up's r per mm of size about the inliers' weighted
+    centroid (in the span of the free degrees of freedom ``free``), how far it moves the
+    points and the deviations per mm of size (largest over the inliers, and the deviations'
+    median), and a note with the figures at TAKE_UP_EXAMPLE_MM. Linearised: a take-up of
+    tenths of a mm slides points past the blade's ends, and the real one is then smaller but
+    of that order. None with too few inliers."""
+    weights = fit_weights(result)
+    points = np.asarray(result.points_cad, dtype=float)
+    normals = np.asarray(result.normal, dtype=float)
+    usable = (weights > 0) & np.all(np.isfinite(normals), axis=1)
+    if np.count_nonzero(usable) <= 7:
+        return None
+    w, p, n = weights[usable], points[usable], normals[usable]
+    center = w @ p / w.sum()
+    r = fits.size_take_up(p, n, w, center, free)
+    motion = float(np.max(np.linalg.norm(r[:3] + np.cross(r[3:], p - center), axis=1)))
+    change = np.abs(np.hstack([n, np.cross(p - center, n)]) @ r)
+    deviation, median = float(np.max(change)), float(np.median(change))
+    example = TAKE_UP_EXAMPLE_MM
+    note = ("the least-squares pose takes up part of a uniform size error (to first order): "
+            "%.3f mm of size would move the pose by up to %.3f mm at the points and the "
+            "deviations by %.3f mm (median) to %.3f mm, so a thickness or chord by up to "
+            "%.3f mm; --fit %s (or a datum fit on a root block) keeps size out of the pose"
+            % (example, example * motion, example * median, example * deviation,
+               2 * example * deviation, SIZE))
+    return {"per_mm": {"t_mm": r[:3].tolist(), "w_rad": r[3:].tolist()},
+            "center_mm": center.tolist(), "pose_motion_mm_per_mm": motion,
+            "deviation_mm_per_mm": deviation, "deviation_median_mm_per_mm": median,
+            "note": note}
 
 
 def _move(result, nominal, chosen):
