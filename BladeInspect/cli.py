@@ -381,10 +381,10 @@ def cmd_airfoil(args):
                          "points (--points) only")
     # the fit's named directions (t_engine, r_engine) and the verdicts follow the airfoil's
     choice = dataclasses.replace(choice, engine_axis=tuple(opts.engine_axis))
-    opts = dataclasses.replace(opts, decision_rule=choice.decision_rule)
+    opts = dataclasses.replace(opts, decision_rule=choice.decision_rule, fit_choice=choice)
     summary = run_airfoil(args.cad, args.out, points_path=args.points,
                           heights_pct=args.section_heights, opts=opts,
-                          seed=args.seed, progress=Progress(), fit_choice=choice)
+                          seed=args.seed, progress=Progress())
     sys.stdout.write("airfoil: %d sections -> %s\n%s\n"
                      % (len(summary["stage"].blocks), args.out,
                         summary["stage"].verdict["summary"]))
