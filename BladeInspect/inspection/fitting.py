@@ -37,7 +37,8 @@ ZONE_HEIGHTS_PCT = tuple(np.arange(5.0, 100.0, 10.0))
 DEFAULT_OBJECTIVE = "least-squares"
 DATUM = "datum"
 SIZE = fits.SIZE_OBJECTIVE
-OBJECTIVE_NAMES = fits.OBJECTIVES + (SIZE, DATUM)
+# SIZE after DATUM: a saved document's Fit enumeration keeps its earlier entries' places
+OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM, SIZE)
 LEAST_SQUARES_NAMES = ("least-squares", SIZE)
 DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
 
@@ -327,8 +328,7 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
             record["size_deviation"] = size_deviation(chosen, sensor)
             # The pose's scatter is the size fit's: without the offset the screw along the
             # span that mimics a size error is held by the size and looks well determined.
-            result.pose_covariance = np.asarray(chosen.covariance, dtype=float)
-            result.center = np.asarray(chosen.center, dtype=float)
+            _take_size_fit_covariance(result, nominal, chosen)
         seconds["deviations"] = time.perf_counter() - t0
     if choice.objective == "least-squares":
         record["size_take_up"] = size_take_up(result, free)
@@ -394,6 +394,21 @@ def size_take_up(result, free=None):
             "center_mm": center.tolist(), "pose_motion_mm_per_mm": motion,
             "deviation_mm_per_mm": deviation, "deviation_median_mm_per_mm": median,
             "note": note}
+
+
+def _take_size_fit_covariance(result, nominal, run):
+    """The result's pose covariance, and the pose uncertainty it states, the size fit's."""
+    from ..core import icp
+    result.pose_covariance = np.asarray(run.covariance, dtype=float)
+    result.center = np.asarray(run.center, dtype=float)
+    statistical = float(icp.pose_uncertainty(result.pose_covariance, result.center,
+                                             nominal.bbox_corners))
+    stated = statistical
+    if getattr(result, "pose_uncertainty_includes_rival", False):
+        # the rival's distance, which the ICP's stated figure covered, stays covered
+        stated = max(statistical, float(result.pose_uncertainty_mm))
+    result.pose_uncertainty_statistical_mm = statistical
+    result.pose_uncertainty_mm = stated
 
 
 def _move(result, nominal, chosen):
