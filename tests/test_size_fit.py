@@ -175,6 +175,65 @@ class DemoBlade(unittest.TestCase):
         self.assertLess(np.abs(np.array(sizes) - delta).max(), 4.0 * np.mean(sigmas))
 
 
+class ApplyToAResult(unittest.TestCase):
+    """inspection.fitting.apply on a registration result of an oversize part whose pose is off
+    by a known motion: the result moved to the true pose, the size deviation and its U, the
+    stated pose uncertainty the size fit's, and the size fit among the sensitivity's fits."""
+
+    def result(self, delta, motion):
+        from BladeInspect.core import stats
+        from BladeInspect.inspection.result import RegistrationResult
+        nominal = demo_nominal()
+        rng = np.random.default_rng(21)
+        faces = nominal.roles["suction"] + nominal.roles["pressure"]
+        idx = rng.choice(np.flatnonzero(np.isin(nominal.samples.face, faces)), 3000,
+                         replace=False)
+        q, n = nominal.samples.xyz[idx], nominal.samples.normal[idx]
+        xyz = tf.apply_transform(motion, q + delta * n)
+        dist = nominal.signed_distance(xyz)
+        result = RegistrationResult(
+            measured_to_cad=motion, points_cad=xyz, deviation=dist.distance,
+            inlier=np.ones(len(xyz), bool), closest=dist.closest, normal=dist.normal,
+            face=dist.face, snr=None, columns={}, n_rows_skipped=0, rms_mm=0.0,
+            pose_covariance=np.zeros((6, 6)), center=xyz.mean(axis=0),
+            pose_uncertainty_mm=0.0, deviation_stats=stats.deviation_statistics(dist.distance),
+            coarse={})
+        return nominal, result, q
+
+    def test_size_fit_moves_the_result_and_records_the_size(self):
+        from BladeInspect.core import icp
+        from BladeInspect.inspection import fitting
+        from BladeInspect.rig.sensor import SensorModel
+        delta = 0.03
+        motion = tf.make_transform(tf.rotation_from_vector([2e-3, -1e-3, 3e-3]),
+                                   [0.05, -0.02, 0.1])
+        nominal, result, q = self.result(delta, motion)
+        runs = fitting.apply(result, nominal, fitting.FitChoice(objective=fits.SIZE_OBJECTIVE),
+                             0.04, all_objectives=True)
+        self.assertEqual(set(runs.runs), set(fits.OBJECTIVES) | {fits.SIZE_OBJECTIVE})
+        # the measured points were q + delta n moved by ``motion``: the fitted pose undoes it
+        pose = np.asarray(result.measured_to_cad) @ motion
+        self.assertLess(np.abs(tf.apply_transform(pose, q) - q).max(), 1e-4)
+        size = result.fit["size_deviation"]
+        self.assertAlmostEqual(size["value_mm"], delta, delta=1e-6)
+        accuracy = SensorModel().accuracy
+        self.assertAlmostEqual(size["U_mm"], 2.0 * np.sqrt(size["u_statistical_mm"] ** 2
+                                                           + accuracy ** 2 / 3.0), delta=1e-12)
+        np.testing.assert_allclose(result.deviation, delta, atol=1e-6)
+        self.assertAlmostEqual(result.pose_uncertainty_mm, icp.pose_uncertainty(
+            np.asarray(result.fit["covariance"]), result.center, nominal.bbox_corners))
+        self.assertNotIn("size_take_up", result.fit)
+
+    def test_plain_fit_records_its_take_up(self):
+        from BladeInspect.inspection import fitting
+        nominal, result, q = self.result(0.01, np.eye(4))
+        fitting.apply(result, nominal, fitting.FitChoice(), 0.04)
+        take_up = result.fit["size_take_up"]
+        self.assertNotIn("size_deviation", result.fit)
+        self.assertIn("0.020 mm of size would move the pose by up to %.3f mm"
+                      % (0.02 * take_up["pose_motion_mm_per_mm"]), take_up["note"])
+
+
 class Choices(unittest.TestCase):
     def test_every_command_offers_the_size_fit(self):
         from BladeInspect import cli

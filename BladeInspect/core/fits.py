@@ -551,8 +551,9 @@ def tolerance_fit(points, closest_fn, init, weights, lower, upper, free=None, ce
 
 def fit(objective, points, closest_fn, init, weights, free=None, center=None, multipliers=None,
         lower=None, upper=None, options=None, at_init=None):
-    """The fit named by ``objective`` (one of OBJECTIVES, as ``--fit`` names it); region
-    multipliers belong to least squares, tolerance zones to the tolerance fit."""
+    """The fit named by ``objective`` (one of OBJECTIVES or SIZE_OBJECTIVE, as ``--fit``
+    names it); region multipliers belong to the least-squares fits, tolerance zones to the
+    tolerance fit."""
     if objective not in OBJECTIVES + (SIZE_OBJECTIVE,):
         raise InputError("--fit: unknown objective '%s' (use %s)"
                          % (objective, ", ".join(OBJECTIVES + (SIZE_OBJECTIVE,))))
