@@ -211,8 +211,9 @@ class ApplyToAResult(unittest.TestCase):
         runs = fitting.apply(result, nominal, fitting.FitChoice(objective=fits.SIZE_OBJECTIVE),
                              0.04, all_objectives=True)
         self.assertEqual(set(runs.runs), set(fits.OBJECTIVES) | {fits.SIZE_OBJECTIVE})
-        # the measured points were q + delta n moved by ``motion``: the fitted pose undoes it
-        pose = np.asarray(result.measured_to_cad) @ motion
+        # the measured points are q + delta n in the CAD's own frame, which the start pose
+        # ``motion`` moved off: the fitted pose is the identity
+        pose = np.asarray(result.measured_to_cad)
         self.assertLess(np.abs(tf.apply_transform(pose, q) - q).max(), 1e-4)
         size = result.fit["size_deviation"]
         self.assertAlmostEqual(size["value_mm"], delta, delta=1e-6)
