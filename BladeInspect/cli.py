@@ -388,6 +388,11 @@ def cmd_airfoil(args):
     sys.stdout.write("airfoil: %d sections -> %s\n%s\n"
                      % (len(summary["stage"].blocks), args.out,
                         summary["stage"].verdict["summary"]))
+    size = (summary["doc"].get("fit") or {}).get("size_deviation")
+    if size:
+        sys.stdout.write("size deviation %+.4f mm, U (k=%g) %s\n" % (
+            size["value_mm"], size["k"],
+            "not determined" if size["U_mm"] is None else "%.4f mm" % size["U_mm"]))
 
 
 def cmd_report(args, cad=None, points=None):

@@ -293,13 +293,13 @@ class AirfoilCommand(unittest.TestCase):
     def airfoil(cls, fit):
         from BladeInspect import cli
         out = os.path.join(cls.tmp, fit)
-        with contextlib.redirect_stdout(io.StringIO()), \
-                contextlib.redirect_stderr(io.StringIO()):
+        stdout = io.StringIO()
+        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(io.StringIO()):
             code = cli.main(["airfoil", "--points", cls.points, "--out", out,
                              "--section-heights", "30,70", "--fit", fit])
         assert code == 0, code
         with open(os.path.join(out, "airfoil.json")) as fh:
-            return json.load(fh)
+            return dict(json.load(fh), stdout=stdout.getvalue())
 
     def pose_error(self, doc):
         G = np.asarray(doc["measured_to_cad"]) @ tf.invert_transform(self.truth)
@@ -312,6 +312,8 @@ class AirfoilCommand(unittest.TestCase):
         self.assertEqual(size["k"], 2.0)
         self.assertGreater(size["U_mm"], abs(size["value_mm"] - self.DELTA))
         self.assertLess(self.pose_error(doc), 2 * UM)
+        self.assertIn("size deviation %+.4f mm, U (k=2) %.4f mm"
+                      % (size["value_mm"], size["U_mm"]), doc["stdout"])
         for block in doc["airfoil"]:
             deviation = block["deviation"]
             # an offset profile: both sides and both ends move out by delta

@@ -328,8 +328,8 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
                 result.deviation[inlier]))), rms_mm=result.rms_mm)
         if choice.objective == SIZE:
             record["size_deviation"] = size_deviation(chosen, sensor)
-            # The pose's scatter is the size fit's: without the offset the screw along the
-            # span that mimics a size error is held by the size and looks well determined.
+            # The pose covariance the deviations' U propagates is the size fit's own: with
+            # the offset free the screw along the span is determined by the form alone.
             _take_size_fit_covariance(result, nominal, chosen)
         seconds["deviations"] = time.perf_counter() - t0
     if choice.objective == "least-squares":
@@ -370,9 +370,9 @@ def size_take_up(result, free=None):
     fit.size_take_up): core.fits.size_take_up's r per mm of size about the inliers' weighted
     centroid (in the span of the free degrees of freedom ``free``), how far it moves the
     points and the deviations per mm of size (largest over the inliers, and the deviations'
-    median), and a note with the figures at TAKE_UP_EXAMPLE_MM. Linearised: a take-up of
-    tenths of a mm slides points past the blade's ends, and the real one is then smaller but
-    of that order. None with too few inliers."""
+    median), and a note with the figures at TAKE_UP_EXAMPLE_MM. Linearised: where the take-up
+    slides points by tenths of a mm along the span, past the blade's ends, the real one is
+    smaller but of that order. None with too few inliers."""
     weights = fit_weights(result)
     points = np.asarray(result.points_cad, dtype=float)
     normals = np.asarray(result.normal, dtype=float)
@@ -387,11 +387,11 @@ def size_take_up(result, free=None):
     deviation, median = float(np.max(change)), float(np.median(change))
     example = TAKE_UP_EXAMPLE_MM
     note = ("the least-squares pose takes up part of a uniform size error (to first order): "
-            "%.3f mm of size would move the pose by up to %.3f mm at the points and the "
-            "deviations by %.3f mm (median) to %.3f mm, so a thickness or chord by up to "
-            "%.3f mm; --fit %s (or a datum fit on a root block) keeps size out of the pose"
-            % (example, example * motion, example * median, example * deviation,
-               2 * example * deviation, SIZE))
+            "%.3f mm of size would move the pose by up to %.3f mm at the points and change "
+            "the deviations by %.4f mm (median) to %.4f mm, and the sizes measured across "
+            "the blade (thickness, chord) with them; --fit %s (or a datum fit on a root "
+            "block) keeps size out of the pose"
+            % (example, example * motion, example * median, example * deviation, SIZE))
     return {"per_mm": {"t_mm": r[:3].tolist(), "w_rad": r[3:].tolist()},
             "center_mm": center.tolist(), "pose_motion_mm_per_mm": motion,
             "deviation_mm_per_mm": deviation, "deviation_median_mm_per_mm": median,
