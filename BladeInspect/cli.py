@@ -209,6 +209,7 @@ def build_parser():
                    help="section planes in %% of span (default 10,30,50,70,90)")
     a.add_argument("--seed", type=_seed, default=0)
     _airfoil_arguments(a, always=True)
+    fitting_args(a)
     for parser in (rp, i, b):
         _airfoil_arguments(parser, always=False)
 
@@ -371,13 +372,27 @@ def _airfoil_options(args):
 
 
 def cmd_airfoil(args):
+    import dataclasses
     from .inspection.airfoil_stage import run_airfoil
+    opts = _airfoil_options(args)
+    choice = _fit_choice(args)
+    if args.points is None and not (choice.is_icp and choice.weights is None):
+        raise InputError("--fit, --free, --weights-by-zone and --weights: for the measured "
+                         "points (--points) only")
+    # the fit's named directions (t_engine, r_engine) and the verdicts follow the airfoil's
+    choice = dataclasses.replace(choice, engine_axis=tuple(opts.engine_axis))
+    opts = dataclasses.replace(opts, decision_rule=choice.decision_rule, fit_choice=choice)
     summary = run_airfoil(args.cad, args.out, points_path=args.points,
-                          heights_pct=args.section_heights, opts=_airfoil_options(args),
+                          heights_pct=args.section_heights, opts=opts,
                           seed=args.seed, progress=Progress())
     sys.stdout.write("airfoil: %d sections -> %s\n%s\n"
                      % (len(summary["stage"].blocks), args.out,
                         summary["stage"].verdict["summary"]))
+    size = (summary["doc"].get("fit") or {}).get("size_deviation")
+    if size:
+        sys.stdout.write("size deviation %+.4f mm, U (k=%g) %s\n" % (
+            size["value_mm"], size["k"],
+            "not determined" if size["U_mm"] is None else "%.4f mm" % size["U_mm"]))
 
 
 def cmd_report(args, cad=None, points=None):

@@ -23,6 +23,13 @@ Parametrisation (what a locked degree of freedom means)
 Objectives (d_i the signed deviation of inlier i at T(xi))
     least squares  min sum w_i z_i d_i^2, w_i the ICP's weights and z_i region (zone)
                    multipliers (per_zone), by Gauss-Newton.
+    least squares with size (SIZE_OBJECTIVE)  min sum w_i z_i (d_i - s)^2 over the pose and
+                   a uniform offset s of the whole surface along its normals (mm, + is
+                   material added: the part oversize all round). Without s, a uniform size
+                   error is partly taken up by the pose (on a twisted blade, a screw along the
+                   span; size_take_up); with it the pose is that of the part's form and s is
+                   its size deviation. Gauss-Newton with one more Jacobian column, -1 for
+                   every point.
     minimax        min max |d_i| (the Chebyshev or minimum-zone fit; unweighted: every inlier
                    must lie in the zone).
     tolerance      max min s_i with s_i = min(d_i - lower_i, upper_i - d_i) the slack of point i
@@ -45,6 +52,8 @@ rows and columns)
                    variance of a unit-weight residual: the weights w are the noise model's
                    (inverse variances), so with all z = 1 this is ICP's s^2 H^-1; zone
                    multipliers are not the noise model and the sandwich keeps it honest.
+    least squares with size  the same sandwich over the k + 1 parameters; the pose block is
+                   ``covariance`` and s's variance ``size_variance``.
     minimax, tolerance  the same least-squares covariance (z = 1) of the same free degrees of
                    freedom at the fit's pose. It states what the measurement determines, not the
                    scatter of the Chebyshev estimator, which for Gaussian noise is larger (it
@@ -62,6 +71,9 @@ from .errors import InputError
 from .transforms import make_transform, rotation_from_vector
 
 OBJECTIVES = ("least-squares", "minimax", "tolerance")
+# Not among OBJECTIVES, which are fitted side by side for the fit-sensitivity table: the size
+# fit answers another question (form and size apart), asked by name.
+SIZE_OBJECTIVE = "least-squares-size"
 DOF_NAMES = ("tx", "ty", "tz", "rx", "ry", "rz")
 COVARIANCE_LEAST_SQUARES = "weighted least squares"
 COVARIANCE_OF_LEAST_SQUARES = ("weighted least squares of the same free degrees of freedom at "
@@ -254,20 +266,25 @@ class _Problem:
 
     def covariance(self, J, distances, multipliers):
         """6x6 covariance of the module docstring (inf when the points do not fix the free
-        degrees of freedom)."""
+        degrees of freedom); (6 + e)x(6 + e) when J has e columns after the pose's (the size
+        offset, in mm, whose rows and columns come last)."""
         keep = self.inlier
-        n, k = int(np.count_nonzero(keep)), self.free.size
+        n, k = int(np.count_nonzero(keep)), J.shape[1]
+        extra = k - self.free.size
+        full = 6 + extra
         if n <= k:
-            return np.full((6, 6), np.inf)
+            return np.full((full, full), np.inf)
         b, z, Jk, r = self.weights[keep], multipliers[keep], J[keep], distances[keep]
         H = (Jk * (b * z)[:, None]).T @ Jk
         d = np.sqrt(np.diag(H))
         if np.any(d == 0) or np.linalg.cond(H / np.outer(d, d)) > 1e12:
-            return np.full((6, 6), np.inf)
+            return np.full((full, full), np.inf)
         s2 = float(np.sum(b * r ** 2)) / (n - k)
         Hinv = np.linalg.inv(H)
         meat = (Jk * (b * z ** 2)[:, None]).T @ Jk
-        unscale = self.free.basis / self.scale        # d xi / d theta_scaled
+        unscale = np.zeros((full, k))                 # d (xi, s) / d (theta_scaled, s)
+        unscale[:6, :self.free.size] = self.free.basis / self.scale
+        unscale[6:, self.free.size:] = np.eye(extra)
         return unscale @ (s2 * Hinv @ meat @ Hinv) @ unscale.T
 
 
@@ -301,6 +318,8 @@ class FitResult:
     covariance_kind: str
     margin: Optional[float] = None     # tolerance: smallest slack (mm); < 0 is a violation
     fits: Optional[bool] = None        # tolerance: margin >= 0
+    size: Optional[float] = None       # least squares with size: the offset s (mm)
+    size_variance: Optional[float] = None   # its variance (mm^2; inf when not determined)
 
     @property
     def violation(self):
@@ -320,32 +339,45 @@ class FitResult:
                 "iterations": self.iterations, "converged": self.converged,
                 "covariance": np.reshape(plain(self.covariance), (6, 6)).tolist(),
                 "covariance_kind": self.covariance_kind, "margin_mm": self.margin,
-                "fits": self.fits, "violation_mm": self.violation}
+                "fits": self.fits, "violation_mm": self.violation,
+                **({} if self.size is None else {
+                    "size_mm": float(self.size),
+                    "size_sigma_mm": (float(np.sqrt(self.size_variance))
+                                      if np.isfinite(self.size_variance) else None)})}
 
 
 def _result(problem, objective, theta, distances, J, multipliers, iterations, converged,
-            kind, margin=None):
+            kind, margin=None, size=None):
     keep = problem.inlier
     d = distances[keep]
+    if size is not None:
+        # The covariance over pose and size (J's last column is the offset's, -1): its
+        # residuals are d - s.
+        full = problem.covariance(J, distances - size, multipliers)
+        covariance, size_variance = full[:6, :6], float(full[6, 6])
     return FitResult(
         objective=objective, transform=problem.transform(theta), distances=distances,
         inlier=keep.copy(), free=problem.free.names, twist=problem.twist(theta),
         center=problem.center.copy(), max_abs_deviation=float(np.max(np.abs(d))),
         rms=float(np.sqrt(np.mean(d ** 2))), iterations=iterations, converged=converged,
-        covariance=problem.covariance(J, distances, multipliers), covariance_kind=kind,
+        covariance=(problem.covariance(J, distances, multipliers) if size is None
+                    else covariance), covariance_kind=kind,
         margin=None if margin is None else float(margin),
-        fits=None if margin is None else bool(margin >= 0))
+        fits=None if margin is None else bool(margin >= 0),
+        size=None if size is None else float(size),
+        size_variance=None if size is None else size_variance)
 
 
 # ---------------------------------------------------------------- least squares
 
 def least_squares_fit(points, closest_fn, init, weights, free=None, multipliers=None,
-                      center=None, options=None, at_init=None):
+                      center=None, options=None, at_init=None, size=False):
     """min sum w z d^2 over the free degrees of freedom (FreeDOF; None = all six), z the
     region multipliers (per_zone; None = 1). Gauss-Newton on the exact Jacobian,
     halving a step that raises the objective. ``at_init``: (distances, normals) of the points
     at ``init`` when the caller has them (ICPResult.distances and the normals), which saves a
-    closest-point evaluation; likewise for the other fits."""
+    closest-point evaluation; likewise for the other fits. ``size``: fit a uniform normal
+    offset s as well, min sum w z (d - s)^2 (SIZE_OBJECTIVE; FitResult.size)."""
     options = options or FitOptions()
     problem = _Problem(points, closest_fn, init, weights, free, center)
     z = (np.ones(len(problem.weights)) if multipliers is None
@@ -353,30 +385,67 @@ def least_squares_fit(points, closest_fn, init, weights, free=None, multipliers=
     if z.shape != problem.weights.shape or not np.all(np.isfinite(z)) or np.any(z < 0):
         raise InputError("fit: region multipliers must be finite, >= 0 and one per point")
     w = np.where(problem.inlier, problem.weights * z, 0.0)
-    if np.count_nonzero(w) <= problem.free.size:
+    k = problem.free.size + int(bool(size))
+    if np.count_nonzero(w) <= k:
         raise InputError("fit: the region weights leave %d points, more than %d needed"
-                         % (np.count_nonzero(w), problem.free.size))
+                         % (np.count_nonzero(w), k))
     sw = np.sqrt(w[w > 0])
-    theta = np.zeros(problem.free.size)
-    distances, J, _ = problem.evaluate(theta, at_init)
-    cost = float(np.sum(w * distances ** 2))
+
+    def evaluate(params, known=None):
+        distances, J, _ = problem.evaluate(params[:problem.free.size], known)
+        if size:
+            J = np.hstack([J, -np.ones((len(J), 1))])
+            return distances, J, distances - params[-1]
+        return distances, J, distances
+
+    params = np.zeros(k)
+    distances, J, residual = evaluate(params, at_init)
+    cost = float(np.sum(w * residual ** 2))
     iterations, converged = int(at_init is None), False
     while iterations < options.max_iter:
-        step = np.linalg.lstsq(J[w > 0] * sw[:, None], -distances[w > 0] * sw, rcond=1e-12)[0]
+        step = np.linalg.lstsq(J[w > 0] * sw[:, None], -residual[w > 0] * sw, rcond=1e-12)[0]
         if np.abs(step).sum() < options.step_tol_mm:
             converged = True
             break
         while iterations < options.max_iter:
-            trial = theta + step
-            d_trial, J_trial, _ = problem.evaluate(trial)
+            trial = params + step
+            d_trial, J_trial, r_trial = evaluate(trial)
             iterations += 1
-            trial_cost = float(np.sum(w * d_trial ** 2))
+            trial_cost = float(np.sum(w * r_trial ** 2))
             if trial_cost <= cost or np.abs(step).sum() < options.step_tol_mm:
-                theta, distances, J, cost = trial, d_trial, J_trial, trial_cost
+                params, distances, J, residual, cost = trial, d_trial, J_trial, r_trial, \
+                    trial_cost
                 break
             step = 0.5 * step
+    theta = params[:problem.free.size]
+    if size:
+        return _result(problem, SIZE_OBJECTIVE, theta, distances, J, z, iterations, converged,
+                       COVARIANCE_LEAST_SQUARES, size=params[-1])
     return _result(problem, "least-squares", theta, distances, J, z, iterations, converged,
                    COVARIANCE_LEAST_SQUARES)
+
+
+def size_take_up(points, normals, weights, center, free=None):
+    """(6,) r = (t mm, w rad) per mm of uniform normal offset: the rigid motion about
+    ``center`` a plain weighted least-squares fit makes to take up a part uniformly oversize
+    by 1 mm (to first order), min_r sum w_i (1 - J_i r)^2, J_i = [n_i, (p_i - c) x n_i].
+    For a size error delta the plain fit's twist (FitResult.twist, moving point p by
+    t + w x (p - c)) is -delta r: it moves the points back by what a rigid motion can take
+    up, and each deviation reads delta (1 - J_i r) instead of delta (as core.bias_take_up's
+    r for a reading bias, with beta_i = 1). ``free``: the fit's FreeDOF (None: all six); r
+    then lies in their span."""
+    points = np.asarray(points, dtype=float)
+    normals = np.asarray(normals, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    keep = (w > 0) & np.all(np.isfinite(points), axis=1) & np.all(np.isfinite(normals), axis=1)
+    if not np.any(keep):
+        return np.zeros(6)
+    J = np.hstack([normals[keep], np.cross(points[keep] - np.asarray(center, float),
+                                           normals[keep])])
+    basis = free_dof().basis if free is None else free.basis
+    JB = J @ basis
+    JW = JB.T * w[keep]
+    return basis @ np.linalg.lstsq(JW @ JB, JW @ np.ones(int(keep.sum())), rcond=1e-12)[0]
 
 
 # ---------------------------------------------------------------- Chebyshev fits
@@ -482,21 +551,23 @@ def tolerance_fit(points, closest_fn, init, weights, lower, upper, free=None, ce
 
 def fit(objective, points, closest_fn, init, weights, free=None, center=None, multipliers=None,
         lower=None, upper=None, options=None, at_init=None):
-    """The fit named by ``objective`` (one of OBJECTIVES, as ``--fit`` names it); region
-    multipliers belong to least squares, tolerance zones to the tolerance fit."""
-    if objective not in OBJECTIVES:
+    """The fit named by ``objective`` (one of OBJECTIVES or SIZE_OBJECTIVE, as ``--fit``
+    names it); region multipliers belong to the least-squares fits, tolerance zones to the
+    tolerance fit."""
+    if objective not in OBJECTIVES + (SIZE_OBJECTIVE,):
         raise InputError("--fit: unknown objective '%s' (use %s)"
-                         % (objective, ", ".join(OBJECTIVES)))
-    if multipliers is not None and objective != "least-squares":
+                         % (objective, ", ".join(OBJECTIVES + (SIZE_OBJECTIVE,))))
+    least_squares = objective in ("least-squares", SIZE_OBJECTIVE)
+    if multipliers is not None and not least_squares:
         raise InputError("--weights-by-zone: region weights apply to the least-squares fit "
                          "only, not to %s" % objective)
     if (lower is None or upper is None) == (objective == "tolerance"):
         raise InputError("--fit %s: tolerance zones are %s" % (
             objective, "needed" if objective == "tolerance" else "for --fit tolerance only"))
     common = dict(free=free, center=center, options=options, at_init=at_init)
-    if objective == "least-squares":
+    if least_squares:
         return least_squares_fit(points, closest_fn, init, weights, multipliers=multipliers,
-                                 **common)
+                                 size=objective == SIZE_OBJECTIVE, **common)
     if objective == "minimax":
         return minimax_fit(points, closest_fn, init, weights, **common)
     return tolerance_fit(points, closest_fn, init, weights, lower, upper, **common)

@@ -88,6 +88,9 @@ class Options:
     # None: every section's u from its own re-fit (``draws``)
     task_uncertainty: object = None
     task_draws: int = 48            # re-fits when a task is made (airfoil_task)
+    # the `airfoil` command's fit of its measured points (inspection.fitting.FitChoice; None:
+    # the ICP's pose); report, inspect and batch fit before the stage, by their own choice
+    fit_choice: object = None
 
 
 @dataclass
@@ -645,7 +648,8 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
                 progress=None, nominal=None):
     """The `airfoil` command: DIR/airfoil.json and DIR/airfoil.csv, atomically. Without
     ``points_path`` the CAD's characteristics alone; with it the points are registered first
-    (their frame is unknown, as for `register`) and measured per section."""
+    (their frame is unknown, as for `register`), moved to the pose of ``opts.fit_choice``
+    and measured per section."""
     from . import pipeline
     from . import sections as sections_mod
     from .checks import check_out_dir
@@ -661,11 +665,13 @@ def run_airfoil(cad_path, out_dir, points_path=None, heights_pct=None, opts=None
         points = pipeline.load_points(points_path)
         result = pipeline.register(nominal, points, seed=seed,
                                    progress=lambda f, m: progress(0.6 * f, m),
-                                   cad_source=cad_path or "the demo blade")
+                                   cad_source=cad_path or "the demo blade",
+                                   fit_choice=opts.fit_choice)
         table = sections_mod.section_table(result, nominal, heights_pct=heights)
         planes, span_axis = planes_of_table(table), table.span_axis
         doc.update(measured_to_cad=np.asarray(result.measured_to_cad).tolist(),
-                   pose_uncertainty_mm=result.pose_uncertainty_mm, rms_mm=result.rms_mm)
+                   pose_uncertainty_mm=result.pose_uncertainty_mm, rms_mm=result.rms_mm,
+                   fit=getattr(result, "fit", None))
     else:
         planes, span_axis = nominal_planes(nominal, heights), None
     check_sections(opts, planes)

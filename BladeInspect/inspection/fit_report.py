@@ -77,6 +77,13 @@ def fit_lines(result):
                         ", least violation %.4f mm" % fit["violation_mm"]))
     if fit.get("zone_rule"):
         lines.append("zones: %s %s" % (fit["zone_rule"], fit.get("zone_counts")))
+    size = fit.get("size_deviation")
+    if size:
+        lines.append("size deviation (uniform offset along the normals, + oversize): %+.4f mm, "
+                     "U (k=%g) %s mm" % (size["value_mm"], size["k"], _u(size["U_mm"])))
+    take_up = fit.get("size_take_up")
+    if take_up:
+        lines.append("size take-up: " + take_up["note"])
     return lines
 
 

@@ -36,7 +36,10 @@ ENGINE_AXIS = (1.0, 0.0, 0.0)        # CAD +X: the engine axis of a blade modell
 ZONE_HEIGHTS_PCT = tuple(np.arange(5.0, 100.0, 10.0))
 DEFAULT_OBJECTIVE = "least-squares"
 DATUM = "datum"
-OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM,)
+SIZE = fits.SIZE_OBJECTIVE
+# SIZE after DATUM: a saved document's Fit enumeration keeps its earlier entries' places
+OBJECTIVE_NAMES = fits.OBJECTIVES + (DATUM, SIZE)
+LEAST_SQUARES_NAMES = ("least-squares", SIZE)
 DATUM_ROLES = ("datum_primary", "datum_secondary", "datum_tertiary")
 
 
@@ -73,9 +76,10 @@ class FitChoice:
         if self.free is not None:
             fits.parse_free(self.free, _axes((0.0, 0.0, 1.0), self.engine_axis))
         if self.weights_by_zone is not None:
-            if self.objective != "least-squares":
+            if self.objective not in LEAST_SQUARES_NAMES:
                 raise InputError("--weights-by-zone: region weights apply to --fit "
-                                 "least-squares only, not to %s" % self.objective)
+                                 "least-squares or %s only, not to %s"
+                                 % (SIZE, self.objective))
             self.zone_weights()
 
     def zone_weights(self):
@@ -102,7 +106,9 @@ def add_arguments(parser):
     """--fit, --free, --weights-by-zone, --decision-rule and --weights on a subcommand."""
     parser.add_argument("--fit", default=DEFAULT_OBJECTIVE, choices=OBJECTIVE_NAMES,
                         help="fit objective after the robust least-squares ICP "
-                             "(default least-squares: the ICP's pose)")
+                             "(default least-squares: the ICP's pose; %s: least squares "
+                             "with a uniform normal offset, reported as the part's size "
+                             "deviation, that no longer moves the pose)" % SIZE)
     parser.add_argument("--datum-faces", default=None,
                         help="--fit datum: primary,secondary,tertiary CAD faces by index or "
                              "role name (default the CAD's datum_primary,datum_secondary,"
@@ -247,7 +253,7 @@ def _run(objective, result, nominal, choice, tolerance, free, labels, closest):
         return None
     weights = fit_weights(result)
     multipliers = None
-    if objective == "least-squares" and choice.weights_by_zone is not None:
+    if objective in LEAST_SQUARES_NAMES and choice.weights_by_zone is not None:
         multipliers = fits.per_zone(labels, choice.zone_weights())
     lower = upper = None
     if objective == "tolerance":
@@ -267,16 +273,20 @@ def _tolerance_of_minimax(minimax, tolerance):
                                fits=bool(margin >= 0))
 
 
-def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None):
+def apply(result, nominal, choice, tolerance, all_objectives=False, progress=None,
+          sensor=None):
     """Move ``result`` (in place) to the pose of the chosen fit and record it in result.fit;
     with ``all_objectives`` also fit every other objective from the same start, for
-    sensitivity(). Returns the FitRuns."""
+    sensitivity(). ``sensor``: the rig.sensor.SensorModel whose stated accuracy enters the
+    size deviation's U (None: the default sensor). Returns the FitRuns."""
     choice = choice or FitChoice()
     progress = progress or (lambda f, m: None)
     free = free_of(choice, nominal)
     labels = zones_of(result, nominal) if choice.weights_by_zone is not None else None
     closest = exact_closest_fn(nominal)
-    wanted = fits.OBJECTIVES if all_objectives else (choice.objective,)
+    # The size fit among them: the sensitivity table then shows what a uniform size error the
+    # other fits take up does to every judged value and airfoil characteristic.
+    wanted = fits.OBJECTIVES + (SIZE,) if all_objectives else (choice.objective,)
     if choice.objective not in wanted:
         wanted = wanted + (choice.objective,)
     runs, seconds = {}, {}
@@ -316,10 +326,91 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
             inlier = np.asarray(result.inlier, bool)
             record.update(max_abs_deviation_mm=float(np.max(np.abs(
                 result.deviation[inlier]))), rms_mm=result.rms_mm)
+        if choice.objective == SIZE:
+            record["size_deviation"] = size_deviation(chosen, sensor)
+            # The pose covariance the deviations' U propagates is the size fit's own: with
+            # the offset free the screw along the span is determined by the form alone.
+            _take_size_fit_covariance(result, nominal, chosen)
         seconds["deviations"] = time.perf_counter() - t0
+    if choice.objective == "least-squares":
+        record["size_take_up"] = size_take_up(result, free)
     record["timing_s"] = seconds
     result.fit = record
     return out
+
+
+K = 2.0   # coverage factor of the size deviation's U
+SIZE_RULE = ("uniform offset of the surface along its normals fitted with the pose (--fit %s; "
+             "+ is material added, the part oversize); U (k = 2) combines its least-squares "
+             "standard deviation with the sensor's stated accuracy as a rectangular bias of "
+             "every reading, taken whole: a reading bias reads as a size error, which the "
+             "fit cannot tell apart" % SIZE)
+
+
+def size_deviation(run, sensor=None):
+    """result.json's fit.size_deviation of a size fit (core.fits.FitResult of SIZE): the
+    offset with its U (k = 2); U null when the points do not determine it."""
+    from ..rig.sensor import SensorModel
+    accuracy = (sensor or SensorModel()).accuracy
+    variance = run.size_variance
+    statistical = float(np.sqrt(variance)) if np.isfinite(variance) else None
+    systematic = float(accuracy / np.sqrt(3.0))
+    U = (None if statistical is None
+         else float(K * np.sqrt(statistical ** 2 + systematic ** 2)))
+    return {"value_mm": float(run.size), "U_mm": U, "k": K,
+            "u_statistical_mm": statistical, "u_systematic_mm": systematic, "rule": SIZE_RULE}
+
+
+# The size error the take-up note gives its figures for (a typical profile tolerance's tenth).
+TAKE_UP_EXAMPLE_MM = 0.02
+
+
+def size_take_up(result, free=None):
+    """The plain least-squares pose's take-up of a uniform size error, stated (result.json's
+    fit.size_take_up): core.fits.size_take_up's r per mm of size about the inliers' weighted
+    centroid (in the span of the free degrees of freedom ``free``), how far it moves the
+    points and the deviations per mm of size (largest over the inliers, and the deviations'
+    median), and a note with the figures at TAKE_UP_EXAMPLE_MM. Linearised: where the take-up
+    slides points by tenths of a mm along the span, past the blade's ends, the real one is
+    smaller but of that order. None with too few inliers."""
+    weights = fit_weights(result)
+    points = np.asarray(result.points_cad, dtype=float)
+    normals = np.asarray(result.normal, dtype=float)
+    usable = (weights > 0) & np.all(np.isfinite(normals), axis=1)
+    if np.count_nonzero(usable) <= 7:
+        return None
+    w, p, n = weights[usable], points[usable], normals[usable]
+    center = w @ p / w.sum()
+    r = fits.size_take_up(p, n, w, center, free)
+    motion = float(np.max(np.linalg.norm(r[:3] + np.cross(r[3:], p - center), axis=1)))
+    change = np.abs(np.hstack([n, np.cross(p - center, n)]) @ r)
+    deviation, median = float(np.max(change)), float(np.median(change))
+    example = TAKE_UP_EXAMPLE_MM
+    note = ("the least-squares pose takes up part of a uniform size error (to first order): "
+            "%.3f mm of size would move the pose by up to %.3f mm at the points and change "
+            "the deviations by %.4f mm (median) to %.4f mm, and the sizes measured across "
+            "the blade (thickness, chord) with them; --fit %s (or a datum fit on a root "
+            "block) keeps size out of the pose"
+            % (example, example * motion, example * median, example * deviation, SIZE))
+    return {"per_mm": {"t_mm": r[:3].tolist(), "w_rad": r[3:].tolist()},
+            "center_mm": center.tolist(), "pose_motion_mm_per_mm": motion,
+            "deviation_mm_per_mm": deviation, "deviation_median_mm_per_mm": median,
+            "note": note}
+
+
+def _take_size_fit_covariance(result, nominal, run):
+    """The result's pose covariance, and the pose uncertainty it states, the size fit's."""
+    from ..core import icp
+    result.pose_covariance = np.asarray(run.covariance, dtype=float)
+    result.center = np.asarray(run.center, dtype=float)
+    statistical = float(icp.pose_uncertainty(result.pose_covariance, result.center,
+                                             nominal.bbox_corners))
+    stated = statistical
+    if getattr(result, "pose_uncertainty_includes_rival", False):
+        # the rival's distance, which the ICP's stated figure covered, stays covered
+        stated = max(statistical, float(result.pose_uncertainty_mm))
+    result.pose_uncertainty_statistical_mm = statistical
+    result.pose_uncertainty_mm = stated
 
 
 def _move(result, nominal, chosen):
