@@ -12,9 +12,9 @@ its centre about the ellipse's end tangent), not by the kernel.
   never pass, never fail. On the old kernel the radius was fitted to the smoothing spline and
   reported (0.03 mm low on a 200k-point scan), with a U of a few micrometres.
 - Enough points: the radius is reported and lies within its U (k = 2) of the closed form.
-- A round LE of 0.05 mm cut every 0.02-0.045 mm turns by over 20 deg a vertex: still a round
-  edge (its radius within 0.2 % of the closed form), while a sharp and a square TE are
-  corners.
+- A round LE of 0.03-0.1 mm cut by 4-8 points over its half circle turns by 22-44 deg a
+  vertex: still a round edge (its radius within 1 % of the closed form), while a sharp and a
+  square TE are corners (and test_airfoil's NACA 0012 closed to a point).
 """
 import types
 import unittest
@@ -180,6 +180,20 @@ def small_le_section(radius):
     return sec(brentq(lambda x: sec(x).r_le - radius, -81.0, -64.0))
 
 
+def coarse_le_points(radius, n_le):
+    """small_le_section(radius) with n_le points on its LE arc (about 180 deg: 44 deg a vertex
+    for 4), the rest every 0.02 mm."""
+    sec = small_le_section(radius)
+    out = []
+    for k, (c, r, a0, a1) in enumerate(sec._pieces()):
+        if k == 1:
+            a = np.linspace(a0, a1, n_le, endpoint=False)
+            out.append(c + r * np.column_stack([np.cos(a), np.sin(a)]))
+        else:
+            out.append(_arc_points(c, r, a0, a1, 0.02))
+    return np.vstack(out)
+
+
 def square_te_points(spacing=0.02, x_cut=24.0):
     """The default ArcSection cut flat at x = x_cut: two square corners at the TE."""
     pts = ArcSection().points(spacing)
@@ -195,14 +209,15 @@ def square_te_points(spacing=0.02, x_cut=24.0):
 
 class CoarseRoundEdgeIsNotACorner(unittest.TestCase):
     def test_small_round_le_cut_coarsely(self):
-        for radius, spacing in ((0.05, 0.02), (0.05, 0.045), (0.03, 0.02), (0.1, 0.05)):
-            sec = small_le_section(radius)
-            ch = airfoil.characteristics(sec.points(spacing), le_upstream=(-1.0, 0.0))
-            # the cut does turn by more than the corner threshold at a vertex
-            self.assertGreater(len(ch.profile.corners), 0)
-            self.assertIsNotNone(ch.le_radius_mm, (radius, spacing, ch.warnings))
-            self.assertAlmostEqual(ch.le_radius_mm, radius, delta=0.002 * radius)
-            self.assertFalse(any("corner" in w for w in ch.warnings), ch.warnings)
+        for radius in (0.03, 0.05, 0.1):
+            for n_le in (4, 5, 8):
+                ch = airfoil.characteristics(coarse_le_points(radius, n_le),
+                                             le_upstream=(-1.0, 0.0))
+                # the cut does turn by more than the corner threshold at a vertex
+                self.assertGreater(len(ch.profile.corners), 0)
+                self.assertIsNotNone(ch.le_radius_mm, (radius, n_le, ch.warnings))
+                self.assertAlmostEqual(ch.le_radius_mm, radius, delta=0.01 * radius)
+                self.assertFalse(any("corner" in w for w in ch.warnings), ch.warnings)
 
     def test_sharp_te_is_a_corner(self):
         pts, _, corner = sharp_te_section()

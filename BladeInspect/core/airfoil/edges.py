@@ -294,22 +294,29 @@ def edge_spacing_mm(radius_mm, noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_
 
 # A turn of the input polyline flagged as a corner (profile._corners) is a round edge's when
 # the edge circle fitted there is a circle (rms within _ROUND_RMS of its radius), the vertex
-# and its two neighbours lie on it (within _ROUND_ON of its radius) and the vertex turns by no
-# more than _ROUND_TURN times the turn of a polyline inscribed in that circle with the same
-# segment lengths: a small-radius edge cut at a spacing of a fair part of its radius turns by
-# tens of degrees per vertex and is still round.
-_ROUND_RMS, _ROUND_ON, _ROUND_TURN = 0.02, 0.05, 1.25
+# and its two neighbours lie on it (within _ROUND_ON of its radius), no input point near it
+# lies inside it (an edge's circle is inscribed: its flanks leave it outwards, where a spline
+# rounding off a point overshoots the points round it), and the vertex turns by no more than
+# _ROUND_TURN times the turn of a polyline inscribed in that circle with the same segments: a
+# small-radius edge cut at a spacing of a fair part of its radius turns by tens of degrees
+# per vertex and is still round.
+_ROUND_RMS, _ROUND_ON, _ROUND_TURN = 0.02, 0.02, 1.25
+_ROUND_REACH = 3.0            # radii from the centre within which no point may lie inside
 
 
 def round_vertex(points, i, circle):
-    """Whether vertex i of the closed polyline ``points`` is a vertex of a polyline inscribed
-    in ``circle`` (a CircleFit2D), turning as such a polyline does (above)."""
+    """Whether vertex i of the closed polyline ``points`` is a vertex of a round edge cut
+    coarsely: of a polyline inscribed in ``circle`` (a CircleFit2D) and turning as such a
+    polyline does, the points round it outside the circle (above)."""
     if circle is None or not circle.radius > 0 or circle.rms > _ROUND_RMS * circle.radius:
         return False
     n = len(points)
     prev, p, nxt = points[(i - 1) % n], points[i], points[(i + 1) % n]
     c, r = np.asarray(circle.center, dtype=float), float(circle.radius)
     if np.max(np.abs(norms(np.array([prev, p, nxt]) - c) - r)) > _ROUND_ON * r:
+        return False
+    dist = norms(points - c)
+    if np.any(dist[dist <= _ROUND_REACH * r] < (1.0 - _ROUND_ON) * r):
         return False
     d1, d2 = p - prev, nxt - p
     turn = abs(np.arctan2(cross2(d1, d2), d1 @ d2))
