@@ -396,8 +396,8 @@ def edge_zone_withheld(ch, noise_mm):
     out = {}
     for name, n in sparse_edges(ch, noise_mm).items():
         circle = ch.le_circle if name == "LE" else ch.te_circle
-        reason = ("%d measured points in the %s zone (+-%g deg), %d needed"
-                  % (n, name, circle.zone_deg, ZONE_MIN_POINTS))
+        reason = ("%d measured point%s in the %s zone (+-%g deg), %d needed"
+                  % (n, "" if n == 1 else "s", name, circle.zone_deg, ZONE_MIN_POINTS))
         fields = EDGE_FIELDS[name] + CHORD_FIELDS
         if _axial_extreme_in_zone(ch, circle, ch.le_point if name == "LE" else ch.te_point):
             fields += ("axial_chord_mm",)
