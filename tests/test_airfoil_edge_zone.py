@@ -236,3 +236,57 @@ class CoarseRoundEdgeIsNotACorner(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class StageOnASparseSection(unittest.TestCase):
+    """The stage on the demo blade's 50 % section sampled every 0.1 mm (its edge zones hold a
+    handful of points): the block names what it withholds and why, its first notes say so,
+    its summary counts it, and a tolerance on a withheld value leaves the verdict not proven."""
+
+    @classmethod
+    def setUpClass(cls):
+        from BladeInspect.inspection import sections as sections_mod
+        from BladeInspect.measurement.planning import nominal_section
+        from tests.helpers import demo_nominal
+        from tests.test_airfoil_pipeline import SENSOR_SIGMA, _noisy, _result
+        nominal = demo_nominal()
+        planes = stage_mod.nominal_planes(nominal, (50.0,))
+        section = nominal_section(nominal, planes[0].origin, planes[0].normal, 0.1)[:2]
+        result = _result(nominal, np.vstack(_noisy([section], SENSOR_SIGMA, 3)))
+        table = sections_mod.section_table(result, nominal, heights_pct=(50.0,), band=0.01)
+        rows = [stage_mod.Tolerance("te_radius_mm", "all", -0.05, 0.05, None, 2),
+                stage_mod.Tolerance("max_thickness_mm", "all", -0.05, 0.05, None, 3)]
+        opts = stage_mod.Options(draws=0, tolerances=rows, decision_rule="simple")
+        cls.stage = stage_mod.run_stage(nominal, stage_mod.planes_of_table(table), opts,
+                                        result, table.span_axis)
+        cls.block = cls.stage.blocks[0]
+
+    def test_the_block_names_what_it_withholds(self):
+        b = self.block
+        self.assertIn("te_radius_mm", b["withheld"])
+        self.assertIsNone(b["measured"]["te_radius_mm"])
+        self.assertIsNone(b["deviation"]["te_radius_mm"])
+        self.assertIsNotNone(b["measured"]["max_thickness_mm"])
+        reason = b["withheld"]["te_radius_mm"]
+        self.assertRegex(reason, r"^\d+ measured points? in the TE zone \(\+-45 deg\), 12 "
+                                 r"needed$")
+        first = [n for n in b["notes"] if "not measured" in n]
+        self.assertTrue(first and b["notes"][:len(first)] == first, b["notes"])
+        self.assertEqual(len(b["notes"]), len(set(b["notes"])))
+        n_missing = sum(1 for k in values.flat(b["nominal"])
+                        if k not in values.flat(b["measured"]))
+        self.assertTrue(b["summary"].startswith("%d of %d characteristics not measured: "
+                                                % (n_missing, len(values.flat(b["nominal"])))),
+                        b["summary"])
+        self.assertIn(reason, b["summary"])
+
+    def test_the_verdict_is_not_proven(self):
+        b = self.block
+        self.assertEqual(b["verdicts"]["te_radius_mm"], "not measured")
+        self.assertEqual(b["verdicts"]["max_thickness_mm"], "pass")
+        self.assertEqual(b["verdict"], "not proven")
+        v = self.stage.verdict
+        self.assertEqual(v["verdict"], "not proven")
+        self.assertEqual(v["failed"], [])
+        self.assertEqual(v["not_proven"], ["section %s: te_radius_mm (not measured)"
+                                           % b["label"]])
