@@ -369,8 +369,8 @@ def corner_warnings(profile, le, te, chord, circles=None):
 # What rests on each edge's fit (docs/user-guide.md, "Edges measured or not"): its circle, its
 # camber-line end (the metal angle) and its edge point (the edge thicknesses, measured along the
 # camber line from it), and, through the edge point, every chord and the stagger (the chord's
-# angle). The axial chord rests on an edge when its extreme along the engine axis lies in that
-# edge's zone (edge_zone_withheld). The thickness stations and the largest thickness's
+# angle). The axial chord rests on an edge when its extreme along the engine axis lies on that
+# edge's round (_axial_extreme_at_edge). The thickness stations and the largest thickness's
 # position move with an edge point only by its bias times the thickness's slope there, far
 # below their U: they are kept.
 EDGE_FIELDS = {"LE": ("le_radius_mm", "inlet_angle_deg", "le_thickness_mm"),
@@ -399,23 +399,28 @@ def edge_zone_withheld(ch, noise_mm):
         reason = ("%d measured point%s in the %s zone (+-%g deg), %d needed"
                   % (n, "" if n == 1 else "s", name, circle.zone_deg, ZONE_MIN_POINTS))
         fields = EDGE_FIELDS[name] + CHORD_FIELDS
-        if _axial_extreme_in_zone(ch, circle, ch.le_point if name == "LE" else ch.te_point):
+        if _axial_extreme_at_edge(ch, circle, ch.le_point if name == "LE" else ch.te_point):
             fields += ("axial_chord_mm",)
         for f in fields:
             out.setdefault(f, reason)
     return out
 
 
-def _axial_extreme_in_zone(ch, circle, edge_pt):
+# The axial chord's end rests on an edge when it lies on the edge's round: seen from the edge
+# circle's centre on the outward half (within 90 deg of the camber line's end direction, wider
+# than the zone: on a staggered blade the extreme along the axis lies on the round outside
+# the zone) and within _AXIAL_REACH radii of it.
+_AXIAL_REACH = 3.0
+
+
+def _axial_extreme_at_edge(ch, circle, edge_pt):
     """Whether one of the profile's two extremes along the engine axis (the axial chord's
-    ends) is seen from the edge circle's centre within its zone."""
+    ends) lies on the round of the edge of ``circle`` (above)."""
     outward = unit(np.asarray(edge_pt, dtype=float) - circle.center)
     along = ch.profile.dense @ ch.engine_axis
-    reach = 0.25 * np.linalg.norm(ch.te_point - ch.le_point)
     for p in ch.profile.dense[[int(np.argmin(along)), int(np.argmax(along))]]:
         v = p - circle.center
-        if np.linalg.norm(v) <= reach and \
-                unit(v) @ outward >= np.cos(np.radians(circle.zone_deg)):
+        if np.linalg.norm(v) <= _AXIAL_REACH * circle.radius and v @ outward >= 0.0:
             return True
     return False
 
