@@ -161,7 +161,7 @@ def add_pages(pdf, parts, table):
                   TableStyle(6.5, title_size=10, loc="upper center", col_widths=TABLE_WIDTHS),
                   title="Airfoil characteristics, section %s (%.1f %% span): %s%s"
                   % (block["label"], block["height_pct"], block.get("verdict", "-"),
-                     "\n" + textwrap.fill(block["summary"], 120) if block.get("summary")
+                     "\n" + textwrap.fill(block["summary"], 100) if block.get("summary")
                      else ""))
         pdf.savefig(fig)
         plt.close(fig)

@@ -36,7 +36,7 @@ __all__ = [
     "LE_RULES", "MIN_CONTACT_ANGLE_DEG", "Profile", "SectionFit", "ZONES", "ZONE_MIN_POINTS",
     "area_centroid", "characteristics", "characteristics_from_state", "characteristics_state",
     "circle_radius_factor", "contour", "contour_zones", "edge_points_needed",
-    "edge_radius_sigma", "edge_spacing_mm", "edge_zone_withheld", "extent", "fit_circle_2d", "fit_section",
-    "lean_bow", "order_by_nominal", "signed_deviation", "sparse_edges",
+    "edge_radius_sigma", "edge_spacing_mm", "edge_zone_withheld", "extent", "fit_circle_2d",
+    "fit_section", "lean_bow", "order_by_nominal", "signed_deviation", "sparse_edges",
     "withhold_corner_edges", "zone_points_enough",
 ]
