@@ -125,13 +125,13 @@ def main():
                 read.append((len(result.points_cad), plan.n_points))
                 if counts is None:
                     counts = edge_zone_counts(plan, nominal, stage)
-                for b, sr in zip(stage.blocks, stage.sections):
+                for b in stage.blocks:
                     for key in KEYS:
                         m = (b["measured"] or {}).get(key)
                         values.setdefault((b["label"], key), []).append(
                             np.nan if m is None else m - b["nominal"][key])
                     values.setdefault((b["label"], "notes"), []).append(
-                        len([n for n in sr.notes if "points within" in n]))
+                        len(b.get("withheld") or {}))
             wall = time.perf_counter() - t0
             print("\n%s, edge rule %s, spacing %g mm, sensor accuracy %g mm (sigma_ref %.2f "
                   "um), %s, %d scans, %.0f s; planned %d points, read %d"
@@ -160,7 +160,7 @@ def main():
                           % (b["label"], key, np.mean(d), np.std(d, ddof=1) if len(d) > 1
                              else np.nan, np.max(np.abs(d)), b["nominal"][key],
                              "" if zone is None else " / %d pts, <= %.0f deg" % zone))
-                print("%-6s sparse-edge notes in %d of %d scans"
+                print("%-6s values withheld at a sparse edge in %d of %d scans"
                       % (b["label"], int(np.sum(np.asarray(values[(b["label"], "notes")]) > 0)),
                          args.scans))
 

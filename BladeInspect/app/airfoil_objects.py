@@ -142,8 +142,9 @@ class CamberLine(_SectionGeometry):
         xyz = frame.to_3d(ch.mcl.sample(MCL_SAMPLES))
         obj.Shape = Part.makePolygon([_vector(p) for p in xyz])
         obj.LengthMm = float(ch.mcl.length)
-        obj.ChordMm = float(ch.chord_mm)
-        # a measured sharp edge's metal angle is not measured (None): NaN, as the table's "-"
+        # a value not measured (None: a sharp edge's metal angle, a sparse edge's chord): NaN,
+        # as the table's "-"
+        obj.ChordMm = np.nan if ch.chord_mm is None else float(ch.chord_mm)
         obj.InletAngleDeg = np.nan if ch.inlet_angle_deg is None else float(ch.inlet_angle_deg)
         obj.OutletAngleDeg = (np.nan if ch.outlet_angle_deg is None
                               else float(ch.outlet_angle_deg))

@@ -238,9 +238,11 @@ def airfoil_rows(blocks):
         block = by_label[r["section"]]
         if r["section"] != shown:
             shown = r["section"]
-            rows.append([tr("Section %s, %.1f %% span: %s") % (
-                shown, block["height_pct"], tr(block.get("verdict") or "")),
-                block.get("verdict")])
+            line = tr("Section %s, %.1f %% span: %s") % (
+                shown, block["height_pct"], tr(block.get("verdict") or ""))
+            if block.get("summary"):    # what is not measured and why, in one line
+                line += " \u2014 " + block["summary"]
+            rows.append([line, block.get("verdict")])
         u = r["uncertainty"]
         expanded = r.get("U_k2") if r.get("U_k2") is not None else (
             None if u is None else 2.0 * u)

@@ -4,6 +4,7 @@ few inscribed circles, the LE/TE circles and the chord line; then shift and twis
 span. Drawn from the stage inspection.airfoil_stage attached to the section table."""
 
 import html
+import textwrap
 
 import numpy as np
 
@@ -149,6 +150,8 @@ def add_pages(pdf, parts, table):
                   % (html.escape(block["label"]), block["height_pct"],
                      html.escape(block.get("verdict", "-"))),
                   html_table(TABLE_HEADER, rows)]
+        if block.get("summary"):
+            parts.append("<p><b>%s</b></p>" % html.escape(block["summary"]))
         parts += ["<p class='note'>%s</p>" % html.escape(n) for n in block.get("notes", [])]
         if section.nominal is None:
             continue
@@ -156,8 +159,10 @@ def add_pages(pdf, parts, table):
         pdf_table(fig, [0.04, 0.04, 0.92, 0.9], TABLE_HEADER,
                   rows or [["-"] * len(TABLE_HEADER)],
                   TableStyle(6.5, title_size=10, loc="upper center", col_widths=TABLE_WIDTHS),
-                  title="Airfoil characteristics, section %s (%.1f %% span): %s"
-                  % (block["label"], block["height_pct"], block.get("verdict", "-")))
+                  title="Airfoil characteristics, section %s (%.1f %% span): %s%s"
+                  % (block["label"], block["height_pct"], block.get("verdict", "-"),
+                     "\n" + textwrap.fill(block["summary"], 100) if block.get("summary")
+                     else ""))
         pdf.savefig(fig)
         plt.close(fig)
         fig = figure_profile(section)

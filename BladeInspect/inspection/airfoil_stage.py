@@ -27,7 +27,8 @@ from . import airfoil_task
 from . import uncertainty as uncertainty_mod
 from .airfoil_measure import SectionMeasurement, measure_at, section_points
 from .airfoil_uncertainty import refit_uncertainty
-from .airfoil_values import CHARACTERISTICS, LISTS, base_name, char_values, flat
+from .airfoil_values import (CHARACTERISTICS, LISTS, base_name, char_values, flat,
+                             ordered_notes, section_summary, withheld_values)
 from .airfoil_verdicts import (COVERAGE_FACTOR, NO_U_RULE, add_to_sensitivity,
                                check_sections, judge, stage_verdict)
 
@@ -41,8 +42,6 @@ MIN_SECTION_POINTS = 60
 # the stretch by a guess (a scan of the blade alone where the cut is closed by a hub, or of one
 # side only), so every characteristic across it would be measured against another loop.
 MAX_COVERAGE_GAP = 0.15
-# A measured point is round an edge within this many edge radii of the edge circle's centre.
-EDGE_NEIGHBOURHOOD = 1.5
 CSV_HEADER = ("section", "characteristic", "nominal", "measured", "deviation", "uncertainty",
               "lower", "upper", "U_k2", "decision_rule", "verdict")
 
@@ -276,22 +275,6 @@ def nominal_planes(nominal, heights_pct):
 
 # ---------------------------------------------------------------- per section
 
-def _sparse_edges(pts, nom):
-    """Notes for an edge with fewer measured points round it than the kernel fits a circle
-    to directly: the smoothing spline then rounds the edge off, a bias of the edge radius,
-    edge point, chord and metal angle that the stated uncertainty does not cover."""
-    notes = []
-    for name, circle in (("LE", nom.le_circle), ("TE", nom.te_circle)):
-        n = int(np.count_nonzero(np.linalg.norm(pts - circle.center, axis=1)
-                                 <= circle.radius * EDGE_NEIGHBOURHOOD))
-        if n < kernel.ZONE_MIN_POINTS:
-            notes.append("measured: %d points within %.1f edge radii of the %s circle's "
-                         "centre (%d wanted): the %s radius, edge point, chord and metal "
-                         "angle are biased by the smoothing, beyond the stated uncertainty"
-                         % (n, EDGE_NEIGHBOURHOOD, name, kernel.ZONE_MIN_POINTS, name))
-    return notes
-
-
 @dataclass
 class SectionResult:
     plane: Plane
@@ -407,14 +390,15 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         # A plane past the blade's end, or a profile the kernel cannot read: said, not fatal.
         sr = SectionResult(plane=plane, frame=None, nominal=None, notes=["nominal: %s" % exc])
         sr.block = {"label": plane.label, "height_pct": plane.height_pct, "le_rule": None,
-                    "nominal": None, "measured": None, "deviation": None, "uncertainty": None}
+                    "nominal": None, "measured": None, "deviation": None, "uncertainty": None,
+                    "withheld": {}}
         return sr
     sr = SectionResult(plane=plane, frame=frame, nominal=nom)
     sr.notes += ["nominal: %s" % w for w in nom.warnings]
     nominal_values = char_values(nom, frame)
     block = {"label": plane.label, "height_pct": plane.height_pct,
              "le_rule": nom.le_rule, "nominal": nominal_values, "measured": None,
-             "deviation": None, "uncertainty": None}
+             "deviation": None, "uncertainty": None, "withheld": {}}
     sr.block = block
     if result is None:
         return sr
@@ -441,7 +425,7 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         return sr
     sr.measured, sr.fit, sr.contour, sr.points_2d, sr.noise_mm = ch, fit, cont, ordered, noise
     sr.notes += ["measured: %s" % w for w in ch.warnings]
-    sr.notes += _sparse_edges(ordered, nom)
+    block["withheld"] = withheld_values(ch, noise)
     measured_values = char_values(ch, frame, fit, cont)
     measured_values["noise_mm"] = noise
     measured_values["n_points"] = int(len(idx))
@@ -528,7 +512,8 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
         f, n = judge(r.block, opts.tolerances, result is not None, opts.decision_rule)
         failed += ["section %s: %s" % (r.plane.label, k) for k in f]
         unproven += ["section %s: %s" % (r.plane.label, k) for k in n]
-        r.block["notes"] = list(r.notes)
+        r.block["notes"] = ordered_notes(r.notes)
+        r.block["summary"] = section_summary(r.block)
     verdict = stage_verdict(results, failed, unproven)
     if result is not None and opts.calibration_axis is not None and \
             uncertainty_mod.reading_angles(result) is not None:

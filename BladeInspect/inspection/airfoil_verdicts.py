@@ -12,7 +12,7 @@ from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
 from .airfoil_measure import measure_at, section_points
-from .airfoil_values import SCALARS, base_name, char_values, flat, unflat
+from .airfoil_values import SCALARS, base_name, char_values, flat, unflat, withheld_values
 
 
 def _tolerance_for(tolerances, label, key):
@@ -89,9 +89,14 @@ def judge(block, tolerances, measured_part=True, rule="iso14253"):
             verdicts[key] = "not judged"
             continue
         if key not in deviation:
-            # A toleranced characteristic that could not be measured cannot be signed off.
             verdicts[key] = "not measured"
-            failed.append(key + " (not measured)")
+            if _withheld(block, key):
+                # withheld for a stated reason (too few points at its edge): not signed off,
+                # and not failed on a number that was never read
+                unproven.append(key + " (not measured)")
+            else:
+                # a toleranced characteristic that could not be measured cannot be signed off
+                failed.append(key + " (not measured)")
             continue
         decisions[key] = decision(deviation[key], sd.get(key), t, rule)
         verdicts[key] = decisions[key]["verdict"]
@@ -105,10 +110,28 @@ def judge(block, tolerances, measured_part=True, rule="iso14253"):
     block["tolerance"] = tol_out
     block["verdicts"] = verdicts
     block["decisions"] = decisions
-    judged = [v for v in verdicts.values() if v in JUDGED]
-    block["verdict"] = (decision_mod.combine([decision_mod.FAIL if v == "not measured" else v
-                                              for v in judged]) if judged else "not judged")
+    judged = combinable(block)
+    block["verdict"] = decision_mod.combine(judged) if judged else "not judged"
     return failed, unproven
+
+
+def _withheld(block, key):
+    withheld = block.get("withheld") or {}
+    return key in withheld or base_name(key) in withheld
+
+
+def combinable(block):
+    """The block's judged verdicts as core.decision combines them: a toleranced value not
+    measured fails, unless it was withheld for a stated reason (the block's ``withheld``):
+    then it is not proven -- a verdict never passes or fails on a withheld value."""
+    out = []
+    for key, v in (block.get("verdicts") or {}).items():
+        if v not in JUDGED:
+            continue
+        if v == "not measured":
+            v = decision_mod.NOT_PROVEN if _withheld(block, key) else decision_mod.FAIL
+        out.append(v)
+    return out
 
 
 def stage_verdict(results, failed, unproven):
@@ -179,12 +202,13 @@ def add_to_sensitivity(doc, stage, result, opts):
                 continue
             idx = section_points(r.plane, stage.counted)
             try:
-                ch, fit, cont, _, _ = measure_at(view.points_cad[idx], view.normal[idx],
-                                                  r.frame, r.nominal, quiet)
+                ch, fit, cont, _, noise = measure_at(view.points_cad[idx], view.normal[idx],
+                                                      r.frame, r.nominal, quiet)
             except InputError:
                 continue
             b = {"label": r.block["label"], "nominal": dict(r.block["nominal"]),
                  "measured": char_values(ch, r.frame, fit, cont),
+                 "withheld": withheld_values(ch, noise),
                  "uncertainty": r.block.get("uncertainty")}
             judge(b, opts.tolerances, True, opts.decision_rule)
             blocks[r.plane.label] = b
@@ -225,8 +249,6 @@ def add_to_sensitivity(doc, stage, result, opts):
                                           "u is stated")
     by_fit = {}
     for objective, blocks in per_fit.items():
-        verdicts = [v for b in blocks.values() for v in b.get("verdicts", {}).values()
-                    if v in JUDGED]
         by_fit[objective] = decision_mod.combine(
-            [decision_mod.FAIL if v == "not measured" else v for v in verdicts])
+            [v for b in blocks.values() for v in combinable(b)])
     doc["airfoil_verdict_by_fit"] = by_fit

@@ -23,7 +23,8 @@ from .contour import (CONTOUR_EDGE_FRACTION, ZONES, SectionFit, contour, contour
 from .definition import KERNEL_VERSION, LE_RULES, AirfoilDefinition
 from .edges import (DEFAULT_EDGE_ZONE_DEG, LE_RADIUS_SIGMAS, ZONE_MIN_POINTS, CircleFit2D,
                     circle_radius_factor, edge_points_needed, edge_radius_sigma,
-                    edge_spacing_mm, fit_circle_2d, withhold_corner_edges)
+                    edge_spacing_mm, edge_zone_withheld, fit_circle_2d, sparse_edges,
+                    withhold_corner_edges, zone_points_enough)
 from .medial import MIN_CONTACT_ANGLE_DEG
 from .profile import Profile, area_centroid
 from .state import characteristics_from_state, characteristics_state
@@ -35,6 +36,7 @@ __all__ = [
     "LE_RULES", "MIN_CONTACT_ANGLE_DEG", "Profile", "SectionFit", "ZONES", "ZONE_MIN_POINTS",
     "area_centroid", "characteristics", "characteristics_from_state", "characteristics_state",
     "circle_radius_factor", "contour", "contour_zones", "edge_points_needed",
-    "edge_radius_sigma", "edge_spacing_mm", "extent", "fit_circle_2d", "fit_section",
-    "lean_bow", "order_by_nominal", "signed_deviation", "withhold_corner_edges",
+    "edge_radius_sigma", "edge_spacing_mm", "edge_zone_withheld", "extent", "fit_circle_2d",
+    "fit_section", "lean_bow", "order_by_nominal", "signed_deviation", "sparse_edges",
+    "withhold_corner_edges", "zone_points_enough",
 ]

@@ -10,7 +10,8 @@ from ..errors import InputError
 from .camber import CamberLine, DEFAULT_METAL_ANGLE_WINDOW_PCT, closed_end, line_end
 from .chords import CHORD_METHODS, extent, farthest_pair, pressure_bitangent
 from .edges import (CircleFit2D, DEFAULT_EDGE_ZONE_DEG, LE_RADIUS_SIGMAS, corner_edges,
-                    corner_warnings, edge_circle, edge_point, leading_end)
+                    corner_warnings, edge_circle, edge_point, leading_end,
+                    withhold_sparse_edges)
 from .geometry import angle_deg, norms, unit
 from .medial import refine_centres, side_range
 from .nose import edge_split
@@ -226,9 +227,10 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
     le_thk, te_thk = thk[n_st:n_st + n_off], thk[n_st + n_off:]
 
     area, centroid = area_centroid(profile)
-    warnings = corner_warnings(profile, le, te, nose_tail) + notes
+    circles = (le_circle, te_circle)
+    warnings = corner_warnings(profile, le, te, nose_tail, circles) + notes
     le_radius, te_radius = le_circle.radius, te_circle.radius
-    for name in corner_edges(profile, le, te, nose_tail):
+    for name in corner_edges(profile, le, te, nose_tail, circles):
         # A corner's radius is zero: the circle fitted about the camber line's end (kept, for
         # a scan plan's edge spacing) is the window's, not the part's.
         warnings.append("%s is a corner, not a rounded edge: its radius is not reported (the "
@@ -238,7 +240,8 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
             le_radius = None
         else:
             te_radius = None
-    return Characteristics(
+    # an edge whose zone holds too few measured points: its values withheld (edges.py)
+    return withhold_sparse_edges(Characteristics(
         chord_mm=float(chord), chord_method=chord_method, nose_tail_chord_mm=nose_tail,
         caliper_chord_mm=caliper, tangent_chord_mm=tangent_chord,
         axial_chord_mm=extent(profile, axis), stagger_deg=angle_deg(stagger_dir, axis),
@@ -251,7 +254,7 @@ def characteristics(profile, engine_axis=(1.0, 0.0), chord_method="nose-tail",
         centroid_mm=centroid, le_point=le, te_point=te, chord_dir=chord_dir, engine_axis=axis,
         le_rule=le_rule, mcl=mcl, inscribed_centres=centres, inscribed_radii=radii,
         profile=profile, suction_range=(suction.lo, suction.hi),
-        pressure_range=(pressure.lo, pressure.hi), warnings=warnings)
+        pressure_range=(pressure.lo, pressure.hi), warnings=warnings), noise_mm)
 
 
 def _check_no_parameter_beside(chord_method, stations_pct, edge_offsets_mm, edge_zone_deg,

@@ -27,7 +27,17 @@ _ZONE_WINDOW = 512            # dense samples either side of the edge point scan
 # A resampled zone (too few input points) moves with its fitted centre and converges linearly:
 # it is settled when its bounds move by less than this (a nanometre; the radius moves far less).
 _ZONE_SETTLED_MM = 1e-6
+# The edge-zone rule (docs/user-guide.md, "Edges measured or not"): an edge zone holding fewer
+# measured points than this is fitted to the smoothing spline, whose shape error at a sharp
+# turn the circle fit amplifies beyond any U the points' noise gives; on a measured (smoothed)
+# profile the edge's radius and the values read from its edge point are then withheld.
 ZONE_MIN_POINTS = 12
+
+
+def zone_points_enough(n_points):
+    """The one rule for an edge zone: whether ``n_points`` measured points in it are enough
+    for its edge circle to be fitted to the points themselves (ZONE_MIN_POINTS)."""
+    return n_points is not None and int(n_points) >= ZONE_MIN_POINTS
 
 
 @dataclass
@@ -37,6 +47,9 @@ class CircleFit2D:
     rms: float
     n_points: int
     zone_deg: float
+    # the input points in the final zone (n_points counts the resampled curve's samples when
+    # these are too few, zone_points_enough); None for a record written before it was kept
+    zone_points: int = None
 
 
 def _solve_spd3(a, b):
@@ -122,31 +135,32 @@ def edge_circle(profile, end_centre, outward, edge_u, zone_deg):
         settled = 1e-9 if not seen or seen[-1][0] is not None else _ZONE_SETTLED_MM
         if zone is not None and abs(lo - zone[0]) < settled and abs(hi - zone[1]) < settled:
             break
-        xy, key = _zone_points(profile, lo, hi)
+        xy, key, n_in = _zone_points(profile, lo, hi)
         zone = (lo, hi)
         earlier = [k for k, (kk, _) in enumerate(seen) if key is not None and kk == key]
         if earlier:
             if earlier[-1] == len(seen) - 1:      # the same points: the same fit, converged
                 break
             cycle = [fit for _, fit in seen[earlier[-1]:]]
-            centre, radius, rms, n = max(cycle, key=lambda f: f[3])
-            return CircleFit2D(centre, radius, rms, n, zone_deg)
+            centre, radius, rms, n, n_in = max(cycle, key=lambda f: f[3])
+            return CircleFit2D(centre, radius, rms, n, zone_deg, n_in)
         centre, radius, rms = fit_circle_2d(xy)
-        seen.append((key, (centre, radius, rms, len(xy))))
-    centre, radius, rms, n = seen[-1][1]
-    return CircleFit2D(centre, radius, rms, n, zone_deg)
+        seen.append((key, (centre, radius, rms, len(xy), n_in)))
+    centre, radius, rms, n, n_in = seen[-1][1]
+    return CircleFit2D(centre, radius, rms, n, zone_deg, n_in)
 
 
 def _zone_points(profile, lo, hi):
-    """The input points in the parameter range [lo, hi] (unwrapped) when there are at least
-    ZONE_MIN_POINTS of them -- measured points fit without any smoothing's bias -- else the
-    profile curve resampled finely over it. Returns the points and a key of the input points
-    taken (None for a resampled curve, which moves with the range)."""
+    """The input points in the parameter range [lo, hi] (unwrapped) when they are enough
+    (zone_points_enough) -- measured points fit without any smoothing's bias -- else the
+    profile curve resampled finely over it. Returns the points, a key of the input points
+    taken (None for a resampled curve, which moves with the range) and their count."""
     u = np.mod(profile.point_params - lo, profile.length)
     inside = u <= hi - lo
-    if inside.sum() >= ZONE_MIN_POINTS:
-        return profile.points[inside], np.flatnonzero(inside).tobytes()
-    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES)), None
+    n_in = int(inside.sum())
+    if zone_points_enough(n_in):
+        return profile.points[inside], np.flatnonzero(inside).tobytes(), n_in
+    return profile.eval(np.linspace(lo, hi, _ZONE_SAMPLES)), None, n_in
 
 
 def _zone_range(profile, centre, outward, edge_u, zone_deg):
@@ -278,30 +292,153 @@ def edge_spacing_mm(radius_mm, noise_mm, radius_sigma_mm, zone_deg=DEFAULT_EDGE_
     return arc / edge_points_needed(noise_mm, radius_sigma_mm, zone_deg)
 
 
-def corner_edges(profile, le, te, chord):
-    """{"LE" and/or "TE": the corner}: the edges that are a corner of the input points (one
-    within 2 % of the chord of the edge point, corner_warnings's rule)."""
-    pts = profile.points[profile.corners]
-    out = {}
-    for name, p in (("LE", le), ("TE", te)):
-        near = np.linalg.norm(pts - p, axis=1) < 0.02 * chord
-        if near.any():
-            out[name] = pts[near][0]
-    return out
+# A turn of the input polyline flagged as a corner (profile._corners) is a round edge's when
+# the edge circle fitted there is a circle (rms within _ROUND_RMS of its radius), the vertex
+# and its two neighbours lie on it (within _ROUND_ON of its radius), no input point near it
+# lies inside it (an edge's circle is inscribed: its flanks leave it outwards, where a spline
+# rounding off a point overshoots the points round it), and the vertex turns by no more than
+# _ROUND_TURN times the turn of a polyline inscribed in that circle with the same segments: a
+# small-radius edge cut at a spacing of a fair part of its radius turns by tens of degrees
+# per vertex and is still round.
+_ROUND_RMS, _ROUND_ON, _ROUND_TURN = 0.02, 0.02, 1.25
+_ROUND_REACH = 3.0            # radii from the centre within which no point may lie inside
 
 
-def corner_warnings(profile, le, te, chord):
-    """One line per corner of the input points: the spline rounds a corner off over a point
-    spacing, so an edge radius, edge point and chord read there are not the part's."""
+def round_vertex(points, i, circle):
+    """Whether vertex i of the closed polyline ``points`` is a vertex of a round edge cut
+    coarsely: of a polyline inscribed in ``circle`` (a CircleFit2D) and turning as such a
+    polyline does, the points round it outside the circle (above)."""
+    if circle is None or not circle.radius > 0 or circle.rms > _ROUND_RMS * circle.radius:
+        return False
+    n = len(points)
+    prev, p, nxt = points[(i - 1) % n], points[i], points[(i + 1) % n]
+    c, r = np.asarray(circle.center, dtype=float), float(circle.radius)
+    if np.max(np.abs(norms(np.array([prev, p, nxt]) - c) - r)) > _ROUND_ON * r:
+        return False
+    dist = norms(points - c)
+    if np.any(dist[dist <= _ROUND_REACH * r] < (1.0 - _ROUND_ON) * r):
+        return False
+    d1, d2 = p - prev, nxt - p
+    turn = abs(np.arctan2(cross2(d1, d2), d1 @ d2))
+    inscribed = sum(np.arcsin(min(1.0, np.linalg.norm(d) / (2.0 * r))) for d in (d1, d2))
+    return bool(turn <= _ROUND_TURN * inscribed)
+
+
+def _edge_corners(profile, le, te, chord, circles):
+    """[(index, "LE"/"TE"/None)] of the input points' corners that are not round edges
+    (round_vertex against the edge circle of the edge they lie at; ``circles``: (LE circle,
+    TE circle) or None), each with the edge it lies at (within 2 % of the chord of its edge
+    point) or None on a side."""
     out = []
     for i in profile.corners:
         p = profile.points[i]
-        where = ("at the LE" if np.linalg.norm(p - le) < 0.02 * chord else
-                 "at the TE" if np.linalg.norm(p - te) < 0.02 * chord else "on a side")
+        where = ("LE" if np.linalg.norm(p - le) < 0.02 * chord else
+                 "TE" if np.linalg.norm(p - te) < 0.02 * chord else None)
+        if where is not None and circles is not None and \
+                round_vertex(profile.points, i, circles[0 if where == "LE" else 1]):
+            continue
+        out.append((int(i), where))
+    return out
+
+
+def corner_edges(profile, le, te, chord, circles=None):
+    """{"LE" and/or "TE": the corner}: the edges that are a corner of the input points (one
+    within 2 % of the chord of the edge point, corner_warnings's rule; with ``circles``, (LE
+    circle, TE circle), a vertex of a round edge cut coarsely is not one: round_vertex)."""
+    out = {}
+    for i, where in _edge_corners(profile, le, te, chord, circles):
+        if where is not None and where not in out:
+            out[where] = profile.points[i]
+    return out
+
+
+def corner_warnings(profile, le, te, chord, circles=None):
+    """One line per corner of the input points (corner_edges's rule): the spline rounds a
+    corner off over a point spacing, so an edge radius, edge point and chord read there are
+    not the part's."""
+    out = []
+    for i, where in _edge_corners(profile, le, te, chord, circles):
+        p = profile.points[i]
         out.append("corner %s at (%.4f, %.4f) mm: the profile is not smooth there; "
                    "characteristics near it (edge radius, edge point, chords, metal angle) "
-                   "are not trustworthy" % (where, p[0], p[1]))
+                   "are not trustworthy" % ("at the " + where if where else "on a side",
+                                            p[0], p[1]))
     return out
+
+
+# What rests on each edge's fit (docs/user-guide.md, "Edges measured or not"): its circle, its
+# camber-line end (the metal angle) and its edge point (the edge thicknesses, measured along the
+# camber line from it), and, through the edge point, every chord and the stagger (the chord's
+# angle). The axial chord rests on an edge when its extreme along the engine axis lies on that
+# edge's round (_axial_extreme_at_edge). The thickness stations and the largest thickness's
+# position move with an edge point only by its bias times the thickness's slope there, far
+# below their U: they are kept.
+EDGE_FIELDS = {"LE": ("le_radius_mm", "inlet_angle_deg", "le_thickness_mm"),
+               "TE": ("te_radius_mm", "outlet_angle_deg", "te_thickness_mm")}
+CHORD_FIELDS = ("chord_mm", "nose_tail_chord_mm", "caliper_chord_mm", "tangent_chord_mm",
+                "stagger_deg")
+
+
+def sparse_edges(ch, noise_mm):
+    """{"LE"/"TE": measured points in its zone} of the edges of a measured (smoothed,
+    ``noise_mm`` > 0) profile whose zone fails zone_points_enough; {} for exact points (the
+    nominal's cut), whose interpolating curve is the profile."""
+    if not noise_mm > 0:
+        return {}
+    return {name: int(circle.zone_points) for name, circle in
+            (("LE", ch.le_circle), ("TE", ch.te_circle))
+            if circle.zone_points is not None and not zone_points_enough(circle.zone_points)}
+
+
+def edge_zone_withheld(ch, noise_mm):
+    """{Characteristics field: the reason (one line)} of every value withheld because an
+    edge's zone holds too few measured points (sparse_edges, EDGE_FIELDS, CHORD_FIELDS)."""
+    out = {}
+    for name, n in sparse_edges(ch, noise_mm).items():
+        circle = ch.le_circle if name == "LE" else ch.te_circle
+        reason = ("%d measured point%s in the %s zone (+-%g deg), %d needed"
+                  % (n, "" if n == 1 else "s", name, circle.zone_deg, ZONE_MIN_POINTS))
+        fields = EDGE_FIELDS[name] + CHORD_FIELDS
+        if _axial_extreme_at_edge(ch, circle, ch.le_point if name == "LE" else ch.te_point):
+            fields += ("axial_chord_mm",)
+        for f in fields:
+            out.setdefault(f, reason)
+    return out
+
+
+# The axial chord's end rests on an edge when it lies on the edge's round: seen from the edge
+# circle's centre on the outward half (within 90 deg of the camber line's end direction, wider
+# than the zone: on a staggered blade the extreme along the axis lies on the round outside
+# the zone) and within _AXIAL_REACH radii of it.
+_AXIAL_REACH = 3.0
+
+
+def _axial_extreme_at_edge(ch, circle, edge_pt):
+    """Whether one of the profile's two extremes along the engine axis (the axial chord's
+    ends) lies on the round of the edge of ``circle`` (above)."""
+    outward = unit(np.asarray(edge_pt, dtype=float) - circle.center)
+    along = ch.profile.dense @ ch.engine_axis
+    for p in ch.profile.dense[[int(np.argmin(along)), int(np.argmax(along))]]:
+        v = p - circle.center
+        if np.linalg.norm(v) <= _AXIAL_REACH * circle.radius and v @ outward >= 0.0:
+            return True
+    return False
+
+
+def withhold_sparse_edges(ch, noise_mm):
+    """``ch`` with the values edge_zone_withheld names set to None (a list to Nones) and one
+    warning per sparse edge, first, saying what is not measured and why."""
+    withheld = edge_zone_withheld(ch, noise_mm)
+    for name in sorted(sparse_edges(ch, noise_mm), reverse=True):
+        names = [f for f in EDGE_FIELDS[name] + CHORD_FIELDS + ("axial_chord_mm",)
+                 if f in withheld and getattr(ch, f) is not None]
+        ch.warnings.insert(0, "%s: %s: not measured (null): %s; a circle there would be "
+                              "fitted to the smooth fit's edge, whose shape is not the part's"
+                           % (name, withheld[EDGE_FIELDS[name][0]], ", ".join(names)))
+    for f in withheld:
+        value = getattr(ch, f)
+        setattr(ch, f, [None] * len(value) if isinstance(value, list) else None)
+    return ch
 
 
 def withhold_corner_edges(measured, nominal):
@@ -313,7 +450,7 @@ def withhold_corner_edges(measured, nominal):
     fit rounds the corner off over the points' spacing and noise, and the same rule then
     reads the rounding, degrees off on a perfect part. docs/user-guide.md, "Sharp edges"."""
     corners = corner_edges(nominal.profile, nominal.le_point, nominal.te_point,
-                            nominal.nose_tail_chord_mm)
+                           nominal.nose_tail_chord_mm, (nominal.le_circle, nominal.te_circle))
     for name, angle, radius in (("LE", "inlet_angle_deg", "le_radius_mm"),
                                 ("TE", "outlet_angle_deg", "te_radius_mm")):
         if name not in corners:
