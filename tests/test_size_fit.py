@@ -319,7 +319,12 @@ class AirfoilCommand(unittest.TestCase):
             # an offset profile: both sides and both ends move out by delta
             self.assertAlmostEqual(deviation["max_thickness_mm"], 2 * self.DELTA,
                                    delta=3 * UM)
-            self.assertAlmostEqual(deviation["chord_mm"], 2 * self.DELTA, delta=3 * UM)
+            # the chord rests on the edge points: withheld (with its reason) where an edge
+            # zone holds too few of the 20k points, else right
+            if deviation["chord_mm"] is None:
+                self.assertIn("chord_mm", block["withheld"])
+            else:
+                self.assertAlmostEqual(deviation["chord_mm"], 2 * self.DELTA, delta=3 * UM)
 
     def test_plain_fit_states_its_take_up(self):
         doc = self.docs["least-squares"]
