@@ -32,7 +32,7 @@ sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 
 from corpus import all_cases, truth  # noqa: E402
-from corpus.profiles import DenseLoop  # noqa: E402
+from corpus.profiles import ArcProfile, DenseLoop  # noqa: E402
 
 HEIGHTS = (25.0, 50.0, 75.0)
 DENSITIES = (20000, 50000, 200000, 800000)
@@ -49,16 +49,18 @@ ANGLES = ("stagger_deg", "inlet_angle_deg", "outlet_angle_deg")
 # deviation is 0 exactly (the part is the CAD).
 JUDGED = ("chord_mm", "axial_chord_mm", "stagger_deg", "max_thickness_mm", "le_radius_mm",
           "te_radius_mm", "inlet_angle_deg", "outlet_angle_deg", "area_mm2", "twist_deg")
-# Words by which a note names a characteristic (a note that names it flags it).
+# What a note must say to flag a characteristic: its field name, or one of its words; an
+# edge's characteristic (LE/TE radius, inlet/outlet angle) by a generic word ("radius",
+# "metal angle") only when the note also names that edge.
 NOTE_WORDS = {
-    "chord_mm": ("chord",), "axial_chord_mm": ("axial chord", "axial_chord"),
-    "stagger_deg": ("stagger",), "max_thickness_mm": ("max thickness", "max_thickness",
-                                                      "maximum thickness", "thickness"),
-    "le_radius_mm": ("le radius", "le_radius", "edge radius", "radius"),
-    "te_radius_mm": ("te radius", "te_radius", "edge radius", "radius"),
-    "inlet_angle_deg": ("inlet", "metal angle"), "outlet_angle_deg": ("outlet", "metal angle"),
-    "area_mm2": ("area",), "twist_deg": ("twist",),
+    "chord_mm": ("chord",), "axial_chord_mm": ("axial chord",), "stagger_deg": ("stagger",),
+    "max_thickness_mm": ("thickness",), "area_mm2": ("area",), "twist_deg": ("twist",),
+    "le_radius_mm": ("le radius", "leading-edge radius"),
+    "te_radius_mm": ("te radius", "trailing-edge radius"),
+    "inlet_angle_deg": ("inlet",), "outlet_angle_deg": ("outlet",),
 }
+EDGE_WORDS = {"le_radius_mm": ("LE", "radius"), "te_radius_mm": ("TE", "radius"),
+              "inlet_angle_deg": ("LE", "metal angle"), "outlet_angle_deg": ("TE", "metal angle")}
 
 
 # ------------------------------------------------------------------ building a case's parts
@@ -77,7 +79,7 @@ def error_profile(profile, error):
     if error == "thickness" and hasattr(profile, "thickened"):
         return profile.thickened(THICKNESS_FACTOR)
     if error == "le_reshape" and hasattr(profile, "le_reshaped"):
-        arc = type(profile).__name__ == "ArcProfile"
+        arc = isinstance(profile, ArcProfile)
         return profile.le_reshaped(LE_SHIFT_ARC_MM if arc else LE_RESHAPE)
     return None
 
@@ -164,13 +166,18 @@ def true_deviations(nom_doc, made_doc, error, z, q):
 # ------------------------------------------------------------------ judging one report
 
 def flagged(notes, key):
-    """A note flags a characteristic when it names it (NOTE_WORDS, case-insensitive) and is
-    not the nominal's own remark: "a note" is any entry of the section's notes list."""
-    words = NOTE_WORDS.get(key, (key,))
+    """Whether a note of the section flags the characteristic ``key`` (NOTE_WORDS,
+    EDGE_WORDS). "A note" is any entry of the section block's ``notes`` list."""
+    import re
     for n in notes or ():
-        low = str(n).lower()
-        if any(w in low for w in words):
+        text = str(n)
+        low = text.lower()
+        if key in low or any(w in low for w in NOTE_WORDS.get(key, ())):
             return True
+        if key in EDGE_WORDS:
+            edge, word = EDGE_WORDS[key]
+            if word in low and re.search(r"\b%s\b" % edge, text):
+                return True
     return False
 
 
@@ -312,8 +319,8 @@ def summarise(rows):
     return out
 
 
-def print_table(rows, stream=sys.stdout):
-    w = stream.write
+def print_table(rows, stream=None):
+    w = (stream or sys.stdout).write
     bad = [r for r in rows if r["status"] == "CONFIDENT WRONG"]
     failed = [r for r in rows if r["status"] == "FAILED"]
     if bad:
@@ -369,6 +376,8 @@ def main(argv=None):
         "delete a case's results (out_*) to re-measure with new code")
     ap.add_argument("--fresh", action="store_true",
                     help="re-run the airfoil command (keep CAD, truths and scans)")
+    ap.add_argument("--cached-only", action="store_true",
+                    help="judge only the runs whose results are in the cache (no new runs)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--json", default=None, help="write every row to FILE")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
@@ -388,8 +397,13 @@ def main(argv=None):
         ap.error("unknown case(s): %s" % ", ".join(sorted(unknown)))
     errors = ("none", "oversize") if (a.quick and not a.errors) else \
         (tuple(a.errors.split(",")) if a.errors else None)
-    jobs = [(c, e, n) for c in cases if c.name in names
-            for e in c.errors if errors is None or e in errors for n in densities]
+    # errors outermost: an interrupted run has judged every case as made first
+    order = ("none", "oversize", "twist", "thickness", "le_reshape")
+    jobs = [(c, e, n) for n in densities for e in order for c in cases
+            if c.name in names and e in c.errors and (errors is None or e in errors)]
+    if a.cached_only:
+        jobs = [(c, e, n) for c, e, n in jobs if os.path.exists(os.path.join(
+            a.cache, c.name, "out_%s_%d_s%d" % (e, n, a.seed), "airfoil.json"))]
     if a.fresh:
         import shutil
         for c, e, n in jobs:
