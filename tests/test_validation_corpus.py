@@ -56,7 +56,8 @@ class TestCorpusCAD(unittest.TestCase):
         pts = self.case.profile.s.points(spacing=0.05)[::7]
         d = [self.nominal.distToShape(v)[0] for v in _vertices(pts, self.z)]
         # the interpolating B-spline's own error, largest where the edge circle meets an arc
-        self.assertLess(max(d), 1.5e-3)
+        self.assertLess(np.median(d), 2e-4)
+        self.assertLess(max(d), 3e-3)
 
     def test_edge_radii_are_the_curvature_of_the_cad(self):
         """OCC's curvature of the section's B-spline at the closed-form LE and TE points is
@@ -76,7 +77,10 @@ class TestCorpusCAD(unittest.TestCase):
         import Part
         skin = Part.Compound(self.oversize.Faces)   # a solid's distance is 0 inside it
         d = np.array([skin.distToShape(v)[0] for v in _vertices(pts, self.z)])
-        np.testing.assert_allclose(d, vm.OVERSIZE_MM, atol=1.5e-3)
+        # the interpolating B-splines follow the arcs within 0.2 um and overshoot by up to
+        # about 2 um only where an edge circle meets an arc (the curvature jumps 50-fold)
+        self.assertLess(np.median(np.abs(d - vm.OVERSIZE_MM)), 2e-4)
+        np.testing.assert_allclose(d, vm.OVERSIZE_MM, atol=3e-3)
         dev = vm.true_deviations(self.nom_doc, self.big_doc, "oversize", self.z, 0.5)
         self.assertAlmostEqual(dev["le_radius_mm"], vm.OVERSIZE_MM, places=9)
         self.assertAlmostEqual(dev["max_thickness_mm"], 2 * vm.OVERSIZE_MM, places=9)
