@@ -254,6 +254,7 @@ def run_one(case, error, density, cache, seed, nominal_cache):
     os.makedirs(d, exist_ok=True)
     base = dict(case=case.name, family=case.family, error=error, density=density, key=None)
     t0 = time.perf_counter()
+    out = None
     try:
         if case.cad_path:
             nom_path = made_path = case.cad_path
@@ -279,6 +280,9 @@ def run_one(case, error, density, cache, seed, nominal_cache):
             os.replace(scan + ".tmp.csv", scan)
         out = os.path.join(d, "out_%s_%d_s%d" % (error, density, seed))
         res = os.path.join(out, "airfoil.json")
+        if os.path.exists(out + ".failed.json"):
+            with open(out + ".failed.json") as fh:
+                return [dict(base, **json.load(fh))]
         if not os.path.exists(res):
             if nom_path not in nominal_cache:
                 nominal_cache.clear()
@@ -289,8 +293,15 @@ def run_one(case, error, density, cache, seed, nominal_cache):
             doc = json.load(fh)
     except Exception as exc:   # a crash is a finding: one line, the matrix goes on
         line = ("%s: %s" % (type(exc).__name__, exc)).splitlines()[0][:200]
-        return [dict(base, status="FAILED", message=line,
-                     where=traceback.format_exc().strip().splitlines()[-3].strip()[:160])]
+        frames = [ln.strip() for ln in traceback.format_exc().splitlines()
+                  if ln.strip().startswith("File ")]
+        # the deepest frame of the project's code, where the finding is
+        where = ([f for f in frames if "BladeInspect" in f] or frames or [""])[-1][:200]
+        failure = dict(status="FAILED", message=line, where=where)
+        if out is not None:       # the command itself failed: remembered with its results
+            with open(out + ".failed.json", "w") as fh:
+                json.dump(failure, fh)
+        return [dict(base, **failure)]
     rows = judge(case, error, density, doc, nom_doc, made_doc)
     for r in rows:
         r["seconds"] = round(time.perf_counter() - t0, 1)
@@ -408,13 +419,17 @@ def main(argv=None):
     jobs = [(c, e, n) for n in densities for e in order for c in cases
             if c.name in names and e in c.errors and (errors is None or e in errors)]
     if a.cached_only:
-        jobs = [(c, e, n) for c, e, n in jobs if os.path.exists(os.path.join(
-            a.cache, c.name, "out_%s_%d_s%d" % (e, n, a.seed), "airfoil.json"))]
+        done = lambda c, e, n: os.path.join(a.cache, c.name, "out_%s_%d_s%d" % (e, n, a.seed))
+        jobs = [(c, e, n) for c, e, n in jobs
+                if os.path.exists(os.path.join(done(c, e, n), "airfoil.json"))
+                or os.path.exists(done(c, e, n) + ".failed.json")]
     if a.fresh:
         import shutil
         for c, e, n in jobs:
-            shutil.rmtree(os.path.join(a.cache, c.name, "out_%s_%d_s%d" % (e, n, a.seed)),
-                          ignore_errors=True)
+            out = os.path.join(a.cache, c.name, "out_%s_%d_s%d" % (e, n, a.seed))
+            shutil.rmtree(out, ignore_errors=True)
+            if os.path.exists(out + ".failed.json"):
+                os.remove(out + ".failed.json")
     t0 = time.perf_counter()
     rows = []
     if a.jobs > 1:

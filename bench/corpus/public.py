@@ -1,5 +1,5 @@
 """Real public geometries, read from ../shared/data/blades/ (never copied into the
-repository): the ParaBlade impulse cascade profile and STD10 compressor section (2D, extruded)
+repository): the ParaBlade STD10 compressor section (2D, extruded)
 and NASA Rotor 67 (its section table, which the project lofts itself). Their truths are brute
 force on the exact CAD profile (truth.py); Rotor 67 is scanned as made (every true deviation
 zero)."""
@@ -34,9 +34,6 @@ def cases():
     pb = os.path.join(BLADES, "parablade")
     out = []
     if os.path.isdir(pb):
-        out.append(Case("parablade_impulse", "public",
-                        DenseLoop(read_move_surface(os.path.join(pb, "Impulse_2D_MoveSurface.txt"))),
-                        span=250.0, source="ParaBlade Impulse_2D (../shared/data/blades)"))
         out.append(Case("parablade_std10", "public",
                         DenseLoop(read_move_surface(os.path.join(pb, "STD10_2D_MoveSurface.txt"))),
                         span=100.0, source="ParaBlade STD10_2D (../shared/data/blades)"))

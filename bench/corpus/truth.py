@@ -32,6 +32,7 @@ class Distance:
     def __call__(self, p):
         p = np.atleast_2d(p)
         _, idx = self.tree.query(p, k=6)
+        idx = np.minimum(idx, len(self.a) - 1)    # a non-finite point gets "no neighbour"
         best = np.full(len(p), np.inf)
         for j in range(idx.shape[1]):
             for seg in (idx[:, j], (idx[:, j] - 1) % len(self.a)):
@@ -60,8 +61,11 @@ def largest_inscribed_circle(loop):
     v, d = v[inside], d[inside]
     best = None
     for k in np.argsort(d)[-5:]:
-        res = minimize(lambda c: -dist(c)[0], v[k], method="Nelder-Mead",
-                       options=dict(xatol=1e-9, fatol=1e-12, maxiter=2000))
+        res = minimize(lambda c: -dist(c)[0] if np.all(np.isfinite(c)) else np.inf, v[k],
+                       method="Nelder-Mead", options=dict(xatol=1e-9, fatol=1e-12,
+                                                          maxiter=2000))
+        if not np.isfinite(res.fun):
+            continue
         if best is None or -res.fun > best[0]:
             best = (-res.fun, res.x)
     return 2.0 * float(best[0]), best[1]
