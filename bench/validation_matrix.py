@@ -351,23 +351,28 @@ def print_table(rows, stream=None):
             w("  %s %s %d: %s\n" % (r["case"], r["error"], r["density"], r["message"]))
     w("\nValidation matrix (U k=2; covered |error|<=U; CW = confident wrong, |error|>2U with "
       "no note)\n")
-    w("%-17s %7s %6s %8s %8s %4s %6s %8s %5s %6s\n" % (
-        "family", "points", "judged", "<=U", "<=2U", "CW", "noted", "withheld", "noU", "failed"))
+    w("%-17s %7s %6s %8s %8s %4s %6s %8s %5s %6s %7s\n" % (
+        "family", "points", "judged", "<=U", "<=2U", "CW", "noted", "withheld", "noU", "failed",
+        "notruth"))
     summ = summarise(rows)
     tot = dict(judged=0, covered=0, within2U=0, confident_wrong=0, wrong_noted=0, withheld=0,
-               no_U=0, failed=0)
+               no_U=0, failed=0, no_truth=0)
     for (fam, dens), s in sorted(summ.items()):
         for k in tot:
             tot[k] += s[k]
         pct = lambda a: ("%5.1f%%" % (100.0 * a / s["judged"])) if s["judged"] else "   -  "
-        w("%-17s %7d %6d %8s %8s %4d %6d %8d %5d %6d\n" % (
+        w("%-17s %7d %6d %8s %8s %4d %6d %8d %5d %6d %7d\n" % (
             fam, dens, s["judged"], pct(s["covered"]), pct(s["within2U"]),
-            s["confident_wrong"], s["wrong_noted"], s["withheld"], s["no_U"], s["failed"]))
+            s["confident_wrong"], s["wrong_noted"], s["withheld"], s["no_U"], s["failed"],
+            s["no_truth"]))
     j = tot["judged"] or 1
-    w("%-17s %7s %6d %7.1f%% %7.1f%% %4d %6d %8d %5d %6d\n" % (
+    w("%-17s %7s %6d %7.1f%% %7.1f%% %4d %6d %8d %5d %6d %7d\n" % (
         "ALL", "", tot["judged"], 100.0 * tot["covered"] / j, 100.0 * tot["within2U"] / j,
         tot["confident_wrong"], tot["wrong_noted"], tot["withheld"], tot["no_U"],
-        tot["failed"]))
+        tot["failed"], tot["no_truth"]))
+    if tot["no_truth"]:
+        w("notruth: sections cut off the part's stations (the plane is not the one the corpus "
+          "knows the truth of: the span axis is not the stacking axis)\n")
     return tot
 
 
