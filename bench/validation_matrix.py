@@ -162,7 +162,13 @@ def true_deviations(nom_doc, made_doc, error, z, q):
         return None
     out = {k: tm[k] - tn[k] for k in tm if k in tn and k in JUDGED}
     if error == "twist":
-        out["twist_deg"] = TWIST_TIP_DEG * q
+        # The best fit turns the part by the twist's mean (a linear twist sampled evenly about
+        # mid-span: its value there), so every angle's true deviation after the fit is the
+        # twist relative to mid-span; the lengths are unchanged by either.
+        for k in ANGLES:
+            if k in out:
+                out[k] -= TWIST_TIP_DEG * 0.5
+        out["twist_deg"] = TWIST_TIP_DEG * (q - 0.5)
     return out
 
 
