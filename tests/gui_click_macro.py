@@ -14,7 +14,8 @@ from PySide import QtGui
 sys.path.insert(0, os.environ["BI_REPO"])
 from tests.gui_harness import (OUT, ReportWatch, active_panel, check,  # noqa: E402
                                click_ok_and_wait, click_task_button, run_scenario, settle,
-                               start_workbench, step, wait_until, window_shot)
+                               start_workbench, step, task_button, wait_until,
+                               window_shot)
 
 RESULT_WAIT_S = 5
 
@@ -42,11 +43,25 @@ def click_ok_expecting(name, kind, shot):
           not watch.problems(), watch.problems())
     if panel is not None:
         window_shot(shot)
+        task_view_shot(shot + "_panel")
     return panel
 
 
+def task_view_shot(name):
+    """The dock that holds the task view, alone: the result panel as the user guide shows it."""
+    window = Gui.getMainWindow()
+    for dock in window.findChildren(QtGui.QDockWidget):
+        if dock.isVisible() and dock.findChild(QtGui.QDialogButtonBox) is not None:
+            dock.grab().save(os.path.join(OUT, name + ".png"))
+            return
+
+
 def close_result():
-    click_task_button(QtGui.QDialogButtonBox.Close)
+    """Close the result panel with its Close button; any other dialog as the macro can."""
+    if task_button(QtGui.QDialogButtonBox.Close) is not None:
+        click_task_button(QtGui.QDialogButtonBox.Close)
+    else:
+        Gui.Control.closeDialog()
     settle(0.3)
 
 
@@ -65,6 +80,7 @@ def run():
         ps, _, _, _ = simulate_measurement(objects.nominal_of(blade), n_points=20000, seed=5)
         objects.make_measurement(doc, ps)
         doc.recompute()
+        state["blade"] = blade
         check("register: input panel open",
               open_input_panel("BladeInspect_Register", taskpanels.RegisterPanel) is not None)
         panel = click_ok_expecting("register", taskpanels.RegistrationPanel,
@@ -75,7 +91,6 @@ def run():
               panel.text.toPlainText()[:400] if panel is not None else None)
         close_result()
         check("register: Close closes the result panel", not Gui.Control.activeDialog())
-        state["blade"] = blade
 
     @step("airfoil analysis: OK shows the characteristics panel")
     def _():

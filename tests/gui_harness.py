@@ -106,16 +106,18 @@ def task_button(which=QtGui.QDialogButtonBox.Ok):
 
 
 def click_task_button(which=QtGui.QDialogButtonBox.Ok):
-    """Click the task panel's button as a user does: a mouse click through Qt, so FreeCAD's
-    task view calls the panel's accept() or reject() the way it does for a user."""
-    try:
-        from PySide2.QtTest import QTest
-    except ImportError:
-        from PySide6.QtTest import QTest
+    """Click the task panel's button as a user does: a left mouse press and release at its
+    centre (QTest.mouseClick's events; FreeCAD's PySide has no QtTest), so FreeCAD's task view
+    calls the panel's accept() or reject() the way it does for a user."""
     button = task_button(which)
     if button is None:
         raise AssertionError("the task view shows no %r button" % which)
-    QTest.mouseClick(button, QtCore.Qt.LeftButton)
+    centre = QtCore.QPointF(button.rect().center())
+    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
+                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
+        event = QtGui.QMouseEvent(kind, centre, QtCore.Qt.LeftButton, buttons,
+                                  QtCore.Qt.NoModifier)
+        QtGui.QApplication.sendEvent(button, event)
 
 
 def wait_until(condition, timeout_s):
