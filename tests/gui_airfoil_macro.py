@@ -10,9 +10,9 @@ import FreeCADGui as Gui
 from PySide import QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
-from tests.gui_harness import (OUT, active_panel, check, clipped_headers,  # noqa: E402
-                               run_scenario, settle, start_workbench, step, view_shot,
-                               window_shot)
+from tests.gui_harness import (OUT, active_panel, check, click_ok_and_wait,  # noqa: E402
+                               clipped_headers, run_scenario, settle, start_workbench,
+                               step, view_shot, window_shot)
 
 
 class ConsoleLines:
@@ -52,7 +52,7 @@ def run():
         panel.fit.objective.setCurrentIndex(panel.fit.objective.findText("minimax"))
         window_shot("airfoil_task_panel_register_fit")
         with ConsoleLines() as lines:
-            panel.accept()
+            click_ok_and_wait()
             settle()
         calls = [line for line in lines if "BladeInspect.app.actions.register(" in line]
         check("register runs as one console line with the fit", len(calls) == 1
@@ -113,7 +113,7 @@ def run():
                      "max_thickness_mm,all,-0.05,0.05\narea_mm2,all,0.5,1.0\n")
         options.characteristics.setText(limits)
         with ConsoleLines() as lines:
-            options.accept()
+            click_ok_and_wait()
             settle()
         check("airfoil runs as a console line",
               any("BladeInspect.app.actions.airfoil(" in line for line in lines), lines)

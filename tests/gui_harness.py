@@ -95,6 +95,86 @@ def clipped_headers(table):
     return clipped
 
 
+def task_button(which=QtGui.QDialogButtonBox.Ok):
+    """The visible button ``which`` of the task view's button box (FreeCAD 0.20's Combo View,
+    1.0's Tasks), or None."""
+    for box in Gui.getMainWindow().findChildren(QtGui.QDialogButtonBox):
+        button = box.button(which)
+        if button is not None and button.isVisible():
+            return button
+    return None
+
+
+def click_task_button(which=QtGui.QDialogButtonBox.Ok):
+    """Click the task panel's button as a user does: a left mouse press and release at its
+    centre (QTest.mouseClick's events; FreeCAD's PySide has no QtTest), so FreeCAD's task view
+    calls the panel's accept() or reject() the way it does for a user."""
+    button = task_button(which)
+    if button is None:
+        raise AssertionError("the task view shows no %r button" % which)
+    centre = QtCore.QPointF(button.rect().center())
+    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
+                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
+        event = QtGui.QMouseEvent(kind, centre, QtCore.Qt.LeftButton, buttons,
+                                  QtCore.Qt.NoModifier)
+        QtGui.QApplication.sendEvent(button, event)
+
+
+def wait_until(condition, timeout_s):
+    """Run the event loop until condition() holds or timeout_s passed; condition()'s value."""
+    end = time.time() + timeout_s
+    while not condition() and time.time() < end:
+        QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+        time.sleep(0.02)
+    return condition()
+
+
+def click_ok_and_wait(timeout_s=600):
+    """Click the task panel's OK, then run the event loop until the command's work is done
+    (no job running, no event left to start one)."""
+    from BladeInspect.gui import progress
+    click_task_button(QtGui.QDialogButtonBox.Ok)
+    settle(0.3)
+    wait_until(lambda: not progress.busy(), timeout_s)
+    settle(0.3)
+
+
+def report_view_text():
+    """The text of the Report view (FreeCAD's console messages, errors and tracebacks)."""
+    texts = [w.toPlainText() for w in Gui.getMainWindow().findChildren(QtGui.QTextEdit)
+             if "report" in w.objectName().lower()]
+    return "\n".join(texts)
+
+
+class ReportWatch:
+    """What the Report view gained, and the Python exceptions nobody caught (a Qt slot's go to
+    sys.excepthook), while the block ran: ``new_text``, ``exceptions``."""
+
+    def __enter__(self):
+        self.before = report_view_text()
+        self.exceptions = []
+        self.hook = sys.excepthook
+
+        def hook(kind, value, tb):
+            self.exceptions.append("".join(traceback.format_exception(kind, value, tb)))
+            self.hook(kind, value, tb)
+        sys.excepthook = hook
+        return self
+
+    def __exit__(self, *exc):
+        sys.excepthook = self.hook
+        after = report_view_text()
+        self.new_text = after[len(self.before):] if after.startswith(self.before) else after
+
+    def problems(self):
+        """The lines a user must not see after a working command: a traceback or the task
+        view's refusal, with every uncaught exception."""
+        bad = [line for line in self.new_text.splitlines()
+               if "Traceback" in line or "Active task dialog found" in line
+               or "Error" in line.split(":")[0]]
+        return bad + self.exceptions
+
+
 def active_panel(kinds):
     """The visible task panel of one of these classes, or None."""
     for obj in gc.get_objects():

@@ -15,8 +15,8 @@ import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
-from tests.gui_harness import (OUT, active_panel, check, run_scenario, settle,  # noqa: E402
-                               start_workbench, step, view_shot, window_shot)
+from tests.gui_harness import (OUT, active_panel, check, click_ok_and_wait,  # noqa: E402
+                               run_scenario, settle, start_workbench, step, view_shot, window_shot)
 
 HEIGHTS = (20.0, 50.0, 80.0)
 
@@ -69,7 +69,7 @@ def run():
         window_shot("loop_task_panel_simulate")
         panel.points.setValue(3000)
         panel.seed.setValue(5)
-        panel.accept()
+        click_ok_and_wait()
         settle()
         blade = objects.find_objects(doc, objects.DemoBlade.Type)
         check("simulate built the demo blade (none in the document)", len(blade) == 1)
@@ -170,7 +170,7 @@ def run():
         # with another once made an unchanged 70 s run take 119 s of wall time.
         t0, cpu0 = time.time(), time.process_time()
         try:
-            panel.accept()
+            click_ok_and_wait()
         finally:
             loop_commands.PLAN_LISTENERS.remove(on_plan)
         state["inspect_cpu_s"] = time.process_time() - cpu0
@@ -392,7 +392,7 @@ def run():
         panel.tilt.setValue(0.1)
         panel_seed, panel_diameter = panel.seed.value(), panel.diameter.value()
         window_shot("loop_task_panel_calibrate")
-        panel.accept()
+        click_ok_and_wait()
         settle()
         check("RIG.json written", os.path.isfile(rig_json))
         check("calibration result shown", loop_commands.RESULTS and

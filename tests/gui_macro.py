@@ -13,7 +13,7 @@ import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
-from tests.gui_harness import (OUT, active_panel, check,  # noqa: E402
+from tests.gui_harness import (OUT, active_panel, check, click_ok_and_wait,  # noqa: E402
                                run_scenario, settle, start_workbench, step, view_shot,
                                window_shot)
 
@@ -53,7 +53,7 @@ def run():
             return do_command(line)
         Gui.doCommand = recorded
         try:
-            panel.accept()
+            click_ok_and_wait()
             settle()
         finally:
             Gui.doCommand = do_command
@@ -141,7 +141,7 @@ def run():
                range(register_panel.fit.icp_weights.count())] == ["default", "snr", "sensor"]
               and register_panel.fit.values()["weights"] is None)
         window_shot("task_panel_register")
-        register_panel.accept()
+        click_ok_and_wait()
         regs = objects.find_objects(doc, "BladeInspect::Registration")
         check("registration made", len(regs) == 1, progress.MESSAGES[-1:])
         reg = regs[0]
@@ -251,7 +251,7 @@ def run():
         panel.sections.setValue(2)
         panel.point_spacing.setValue(0.5)
         window_shot("task_panel_scan")
-        panel.accept()
+        click_ok_and_wait()
         scans = objects.find_objects(doc, "BladeInspect::Measurement")
         check("scan made a measurement", len(scans) == 1, progress.MESSAGES[-1:])
         meas = scans[0]

@@ -145,9 +145,7 @@ class InspectPanel(taskpanels.FormPanel):
 
     def accept(self):
         options = self.options()   # read before closing: closing deletes the widgets
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(**options)
-        return True
+        return taskpanels.close_then(self.on_accept, **options)
 
 
 class CalibratePanel(taskpanels.ConnectRigPanel):
@@ -176,9 +174,7 @@ class CalibratePanel(taskpanels.ConnectRigPanel):
                    "sphere_diameter": self.diameter.value()}
         if options["rig_spec"] == "sim":
             options.update(axis_offset_mm=self.offset.value(), axis_tilt_deg=self.tilt.value())
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(**options)
-        return True
+        return taskpanels.close_then(self.on_accept, **options)
 
 
 class SimulatePanel(taskpanels.FormPanel):
@@ -205,9 +201,7 @@ class SimulatePanel(taskpanels.FormPanel):
 
     def accept(self):
         options = self.options()
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(**options)
-        return True
+        return taskpanels.close_then(self.on_accept, **options)
 
 
 # ---------------------------------------------------------------- commands

@@ -1,11 +1,12 @@
 """Task panels: the parameters of a command before it runs, and what a result says after.
 Panels collect input and show output; the work is done by the commands' pipeline calls."""
 import dataclasses
+import functools
 import json
 import math
 
 import FreeCADGui
-from PySide import QtGui
+from PySide import QtCore, QtGui
 
 from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
@@ -16,6 +17,16 @@ from ..inspection import fitting
 from ..inspection.result import rival_lines
 from . import tables
 from .i18n import QT_TRANSLATE_NOOP, translate
+
+
+def close_then(action, *args, **kwargs):
+    """What a parameter panel's accept() returns: the panel closes, and ``action(*args,
+    **kwargs)`` (the work, then its result panel) runs from the event loop once FreeCAD has let
+    go of the panel. FreeCAD keeps the panel as the active dialog until its accept() returns,
+    so a result panel shown from inside it fails with "Active task dialog found"."""
+    FreeCADGui.Control.closeDialog()
+    QtCore.QTimer.singleShot(0, functools.partial(action, *args, **kwargs))
+    return True
 
 
 def show_panel(panel):
@@ -113,9 +124,7 @@ class DemoBladePanel(FormPanel):
 
     def accept(self):
         params = self.params()   # read before closing: closing deletes the widgets
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(params)
-        return True
+        return close_then(self.on_accept, params)
 
 
 class ConnectRigPanel(FormPanel):
@@ -159,9 +168,7 @@ class ConnectRigPanel(FormPanel):
 
     def accept(self):
         spec, seed = self.spec(), self.seed.value()
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(spec, seed)
-        return True
+        return close_then(self.on_accept, spec, seed)
 
 
 class ScanPanel(FormPanel):
@@ -201,9 +208,7 @@ class ScanPanel(FormPanel):
 
     def accept(self):
         options = self.options()
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(options)
-        return True
+        return close_then(self.on_accept, options)
 
 
 class FitSelector(QtGui.QGroupBox):
@@ -273,9 +278,7 @@ class RegisterPanel(FormPanel):
 
     def accept(self):
         seed, fit = self.seed.value(), self.fit.values()
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(seed, **fit)
-        return True
+        return close_then(self.on_accept, seed, **fit)
 
 
 def _escape(text):
@@ -448,9 +451,7 @@ class AirfoilOptionsPanel(FormPanel):
 
     def accept(self):
         options = self.options()
-        FreeCADGui.Control.closeDialog()
-        self.on_accept(**options)
-        return True
+        return close_then(self.on_accept, **options)
 
 
 class AirfoilPanel(_ResultPanel):
