@@ -167,10 +167,11 @@ class ReportWatch:
         self.new_text = after[len(self.before):] if after.startswith(self.before) else after
 
     def problems(self):
-        """The lines a user must not see after a working command: a traceback or the task
-        view's refusal, with every uncaught exception."""
+        """The lines a user must not see after a working command: a traceback, the task
+        view's refusal or a shape the 3D view cannot draw, with every uncaught exception."""
         bad = [line for line in self.new_text.splitlines()
                if "Traceback" in line or "Active task dialog found" in line
+               or "Cannot compute Inventor representation" in line
                or "Error" in line.split(":")[0]]
         return bad + self.exceptions
 

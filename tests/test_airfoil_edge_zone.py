@@ -234,10 +234,6 @@ class CoarseRoundEdgeIsNotACorner(unittest.TestCase):
                         ch.warnings)
 
 
-if __name__ == "__main__":
-    unittest.main()
-
-
 class StageOnASparseSection(unittest.TestCase):
     """The stage on the demo blade's 50 % section sampled every 0.1 mm (its edge zones hold a
     handful of points): the block names what it withholds and why, its first notes say so,
@@ -290,3 +286,7 @@ class StageOnASparseSection(unittest.TestCase):
         self.assertEqual(v["failed"], [])
         self.assertEqual(v["not_proven"], ["section %s: te_radius_mm (not measured)"
                                            % b["label"]])
+
+
+if __name__ == "__main__":
+    unittest.main()

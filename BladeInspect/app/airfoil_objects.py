@@ -233,6 +233,10 @@ def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
                 if ch is None:
                     continue
                 for kind, cls in KINDS.items():
+                    if cls is EdgeCircles and not ch.edge_circles():
+                        # both edges withheld: nothing to draw (an empty compound's void
+                        # bounding box is an error line in the Report view)
+                        continue
                     name = "%s_%s_%s" % (kind, section.plane.label, profile)
                     made.append(_make(doc, cls, name, section, profile, ch, registration,
                                       registration.Nominal, opts))

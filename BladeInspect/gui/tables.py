@@ -126,6 +126,7 @@ class NamedRowsTable(QtGui.QTableWidget):
     def __init__(self, *args):
         super().__init__(*args)
         self._sharing = False
+        self._name_label = None    # the names' header as set, before any break
 
     def resizeEvent(self, event):   # noqa: N802 (Qt's name)
         super().resizeEvent(event)
@@ -135,14 +136,35 @@ class NamedRowsTable(QtGui.QTableWidget):
         # what ResizeToContents gives the column
         return max(self.sizeHintForColumn(c), self.horizontalHeader().sectionSizeHint(c))
 
-    def _header_need(self, c):
+    def _header_need(self, c, text=None):
         """The header's longest line with the style's header margin on both sides, as the
         header draws its label (its size hint adds more: a sort indicator's room)."""
         header = self.horizontalHeader()
-        item = self.horizontalHeaderItem(c)
-        lines = (item.text() if item is not None else "").split("\n")
+        if text is None:
+            item = self.horizontalHeaderItem(c)
+            text = item.text() if item is not None else ""
         margin = header.style().pixelMetric(QtGui.QStyle.PM_HeaderMargin, None, header)
-        return max(header.fontMetrics().horizontalAdvance(x) for x in lines) + 2 * margin + 2
+        return max(header.fontMetrics().horizontalAdvance(x) for x in text.split("\n")) \
+            + 2 * margin + 2
+
+    def _break_name_header(self, room):
+        """The names' header whole on one line when ``room`` px hold it, else broken over two
+        lines with a hyphen where the first line fills the room: on a panel too narrow for
+        it (every other column already at its narrowest) a header cut to "Characteris" reads
+        as another word."""
+        item = self.horizontalHeaderItem(self.name_column)
+        if item is None:
+            return
+        if self._name_label is None:
+            self._name_label = item.text()
+        label = text = self._name_label
+        if "\n" not in label and self._header_need(self.name_column, label) > room:
+            fits = [i for i in range(2, len(label) - 1)
+                    if self._header_need(self.name_column, label[:i] + "-") <= room]
+            cut = fits[-1] if fits else 2
+            text = label[:cut] + "-\n" + label[cut:]
+        if item.text() != text:
+            item.setText(text)
 
     def _texts(self, c):
         items = (self.item(r, c) for r in range(self.rowCount()) if self.columnSpan(r, c) == 1)
@@ -166,7 +188,10 @@ class NamedRowsTable(QtGui.QTableWidget):
             return
         self._sharing = True
         try:
-            need = self._header_need(self.name_column)
+            item = self.horizontalHeaderItem(self.name_column)
+            if self._name_label is None and item is not None:
+                self._name_label = item.text()
+            need = self._header_need(self.name_column, self._name_label)
             spare = self.viewport().width() - sum(self._full_width(c)
                                                   for c in range(self.columnCount())
                                                   if c != self.name_column)
@@ -178,6 +203,7 @@ class NamedRowsTable(QtGui.QTableWidget):
                 header.setSectionResizeMode(c, QtGui.QHeaderView.Fixed)
                 header.resizeSection(c, narrow)
                 spare += self._full_width(c) - narrow
+            self._break_name_header(spare)
             # the wrapped cells' rows as tall as their lines
             for r in range(self.rowCount()):
                 if self.columnSpan(r, 0) == 1:
