@@ -167,11 +167,12 @@ class SizeTakeUp:
 
     def scale(self):
         """The factor from the take-up's effect at the estimated size to the systematic term:
-        1 + U/|s| (the size's own U through the same sensitivity); 2 when the size is not
-        resolved (|s| <= U), where the effect itself is of the order of the noise; None when
-        the size fit did not determine the size."""
+        1 + U/|s| (the size's own U through the same sensitivity), at most 2: where the size
+        is not resolved (|s| <= U) the effect itself is of the order of the noise; 2 when the
+        points leave the size's variance undetermined (a pose direction they do not measure,
+        e.g. along the span of a blade without ends), U then taken as |s|."""
         if self.U_mm is None:
-            return None
+            return 2.0
         return 1.0 + min(self.U_mm / max(abs(self.size_mm), 1e-12), 1.0)
 
 
@@ -203,8 +204,6 @@ def size_take_up_term(m, take_up, opts):
     the size ``take_up.size_mm``), times take_up.scale(). None when they cannot be measured
     there."""
     factor = take_up.scale()
-    if factor is None:
-        return None
     R = take_up.transform[:3, :3]
     moved = tf.apply_transform(take_up.transform, m.result.points_cad[m.idx])
     normals = np.asarray(m.result.normal[m.idx], dtype=float) @ R.T
