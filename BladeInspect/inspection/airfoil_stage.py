@@ -26,6 +26,7 @@ from ..measurement.planning import blade_faces
 from . import airfoil_task
 from . import uncertainty as uncertainty_mod
 from .airfoil_measure import SectionMeasurement, measure_at, section_points
+from . import airfoil_uncertainty
 from .airfoil_uncertainty import refit_uncertainty
 from .airfoil_values import (CHARACTERISTICS, LISTS, base_name, char_values, flat,
                              ordered_notes, section_summary, withheld_values)
@@ -373,7 +374,7 @@ def _refused(plane, reason, nominal_values=None, le_rule=None):
     return sr
 
 
-def _section(nominal, plane, opts, result, rng, counted=None, task=None):
+def _section(nominal, plane, opts, result, rng, counted=None, task=None, take_up=None):
     from ..cad.airfoil_sections import NotAirfoilSection, airfoil_section
     blade, roles = _blade_faces(nominal)
     try:
@@ -436,7 +437,31 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None):
         sr.task_u = airfoil_task.section_uncertainty(task, sr, measurement, opts, rng)
     elif opts.draws:
         block["uncertainty"] = refit_uncertainty(measurement, opts, rng)
+        if take_up is not None and block["uncertainty"] is not None:
+            _add_size_take_up(sr, measurement, take_up, opts)
     return sr
+
+
+def _add_size_take_up(sr, measurement, take_up, opts):
+    """The plain rigid pose's take-up of the part's size as a systematic term of the section's
+    U (airfoil_uncertainty.size_take_up_term), stated in ``uncertainty_size_take_up`` and a
+    note."""
+    term = airfoil_uncertainty.size_take_up_term(measurement, take_up, opts)
+    if term is None:
+        sr.notes.append("measured: the pose's take-up of the part's size could not be "
+                        "measured at the size fit's pose; U does not include it")
+        return
+    block = sr.block
+    block["uncertainty"], block["uncertainty_size_take_up"], grown = \
+        airfoil_uncertainty.add_take_up(block["uncertainty"], term, COVERAGE_FACTOR)
+    if grown:   # a part made to size takes nothing up: no note
+        sr.notes.append(
+            "measured: the least-squares pose takes up the part's size (estimated %+.4f mm, "
+            "U %s) by moving the points up to %.4f mm; U holds that take-up as a systematic "
+            "term (uncertainty_size_take_up), which widens it by more than half for %s "
+            "(--fit least-squares-size keeps size out of the pose)"
+            % (take_up.size_mm, "n/a" if take_up.U_mm is None else "%.5f mm" % take_up.U_mm,
+               take_up.pose_motion_mm, ", ".join(grown)))
 
 
 def measured_surface(result):
@@ -501,7 +526,9 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
         task = airfoil_task.open_task(
             opts.task_uncertainty, airfoil_task.task_key(nominal, opts, result),
             opts, result)
-    results = [_section(nominal, p, opts, result, rng, counted, task) for p in planes]
+    take_up = None if opts.draws == 0 or task is not None else \
+        airfoil_uncertainty.size_take_up_model(result, nominal)
+    results = [_section(nominal, p, opts, result, rng, counted, task, take_up) for p in planes]
     if task is not None and not task.made:
         task.finish()    # written (atomically) to its file, or kept in memory
     if opts.decision_rule not in decision_mod.RULES:
@@ -552,6 +579,13 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
                 "decision_without_u": "a characteristic with no stated u (draws 0) is "
                                       "decided by %s: %s" % (NO_U_RULE,
                                                              decision_mod.RULE_TEXT[NO_U_RULE])}
+    if take_up is not None:
+        settings["size_take_up"] = {
+            "size_mm": take_up.size_mm, "U_mm": take_up.U_mm,
+            "pose_motion_mm": take_up.pose_motion_mm, "fit_seconds": take_up.seconds,
+            "rule": "plain least-squares pose: each characteristic measured again at the "
+                    "least-squares-size fit's pose; |difference| x (1 + U/|size|, at most 2) "
+                    "added to its expanded U (uncertainty_size_take_up)"}
     if task is not None:
         settings.update(airfoil_task.settings_of(
             task, {r.plane.label: r.task_u for r in results if r.task_u is not None},

@@ -26,6 +26,7 @@ from ..core import uncertainty_model
 from ..core.errors import InputError
 from ..rig.sensor import SensorModel
 from . import airfoil_measure
+from . import fitting
 from . import uncertainty as uncertainty_mod
 from .airfoil_measure import into_plane, on_smooth_fit, slide
 from .airfoil_values import char_values, flat, unflat
@@ -143,6 +144,91 @@ def refit_uncertainty(m, opts, rng, draws_sd=None):
         if key in sd:
             sd[key] = float(np.hypot(sd[key], bias))
     return unflat(sd, measured_values)
+
+
+class SizeTakeUp:
+    """The size fit beside a plain rigid least-squares pose (``uncertainty_size_take_up``):
+    the estimated uniform size ``size_mm`` (+ oversize), its statistical U (k = 2; the
+    sensor's accuracy, which also reads as size, is in the draws' bias already), the size
+    fit's motion of the points (``transform``, CAD frame), the largest distance it moves an
+    inlier and the seconds the fit took."""
+
+    def __init__(self, run, seconds, result):
+        self.size_mm = float(run.size)
+        variance = run.size_variance
+        self.U_mm = (float(fitting.K * np.sqrt(variance))
+                     if variance is not None and np.isfinite(variance) else None)
+        self.transform = np.asarray(run.transform, dtype=float)
+        inlier = np.asarray(run.inlier, dtype=bool)
+        p = np.asarray(result.points_cad, dtype=float)[inlier]
+        moved = tf.apply_transform(self.transform, p)
+        self.pose_motion_mm = float(np.max(np.linalg.norm(moved - p, axis=1))) if len(p) else 0.0
+        self.seconds = float(seconds)
+
+    def scale(self):
+        """The factor from the take-up's effect at the estimated size to the systematic term:
+        1 + U/|s| (the size's own U through the same sensitivity), at most 2: where the size
+        is not resolved (|s| <= U) the effect itself is of the order of the noise; 2 when the
+        points leave the size's variance undetermined (a pose direction they do not measure,
+        e.g. along the span of a blade without ends), U then taken as |s|."""
+        if self.U_mm is None:
+            return 2.0
+        return 1.0 + min(self.U_mm / max(abs(self.size_mm), 1e-12), 1.0)
+
+
+def size_take_up_model(result, nominal):
+    """SizeTakeUp of a registration whose pose is the plain rigid least-squares one (None for
+    any other fit, or when the size fit cannot be made)."""
+    import time
+    if result is None or not fitting.is_plain_rigid(result):
+        return None
+    t0 = time.perf_counter()
+    try:
+        run = fitting.size_fit_from_pose(result, nominal)
+    except InputError:
+        return None
+    if run is None or run.size is None:
+        return None
+    return SizeTakeUp(run, time.perf_counter() - t0, result)
+
+
+# A characteristic whose U the take-up term widens by more than this fraction is named in
+# the section's note.
+TAKE_UP_NOTE_FRACTION = 0.5
+
+
+def size_take_up_term(m, take_up, opts):
+    """{flat key: systematic term, mm or deg, added to the expanded U} of the section ``m``
+    (an airfoil_measure.SectionMeasurement) under the plain rigid pose: its characteristics
+    measured again at the size fit's pose, |plain - at size fit| (what the pose took up of
+    the size ``take_up.size_mm``), times take_up.scale(). None when they cannot be measured
+    there."""
+    factor = take_up.scale()
+    R = take_up.transform[:3, :3]
+    moved = tf.apply_transform(take_up.transform, m.result.points_cad[m.idx])
+    normals = np.asarray(m.result.normal[m.idx], dtype=float) @ R.T
+    try:
+        ch, fit, cont, _, _ = airfoil_measure.measure_at(moved, normals, m.frame, m.nominal,
+                                                          opts)
+    except InputError:
+        return None
+    at_size = flat(char_values(ch, m.frame, fit, cont))
+    plain = flat(m.values)
+    return {key: float(abs(plain[key] - at_size[key]) * factor)
+            for key in plain if key in at_size
+            and np.isfinite(plain[key]) and np.isfinite(at_size[key])}
+
+
+def add_take_up(uncertainty, term, k):
+    """(u with the term folded in, the term as a block like ``uncertainty``, the keys whose
+    expanded U grew by more than TAKE_UP_NOTE_FRACTION): the systematic term is added to the
+    expanded U linearly (it is a bias), U = k u + term, so u becomes u + term / k."""
+    u = flat(uncertainty)
+    grown = [key for key in u if key in term and np.isfinite(u[key])
+             and term[key] > TAKE_UP_NOTE_FRACTION * k * u[key]]
+    widened = {key: (u[key] + term[key] / k if key in term else u[key]) for key in u}
+    kept = {key: term[key] for key in u if key in term}
+    return unflat(widened, uncertainty), unflat(kept, uncertainty), grown
 
 
 def _calibration_model(result, idx, opts, sensor):

@@ -334,6 +334,9 @@ def apply(result, nominal, choice, tolerance, all_objectives=False, progress=Non
         seconds["deviations"] = time.perf_counter() - t0
     if choice.objective == "least-squares":
         record["size_take_up"] = size_take_up(result, free)
+        if chosen is None and runs.get(SIZE) is not None:
+            # the size fit from this very pose: the airfoil stage's take-up term reuses it
+            result.size_fit_run = runs[SIZE]
     record["timing_s"] = seconds
     result.fit = record
     return out
@@ -396,6 +399,32 @@ def size_take_up(result, free=None):
             "center_mm": center.tolist(), "pose_motion_mm_per_mm": motion,
             "deviation_mm_per_mm": deviation, "deviation_median_mm_per_mm": median,
             "note": note}
+
+
+def is_plain_rigid(result):
+    """Whether ``result``'s pose is the plain rigid least-squares one (no size parameter, no
+    datum, no minimax): the pose that takes up a uniform size error."""
+    fit = getattr(result, "fit", None) or {}
+    return fit.get("objective", DEFAULT_OBJECTIVE) == "least-squares"
+
+
+def size_fit_from_pose(result, nominal):
+    """core.fits' least-squares-size fit (its transform the motion in the CAD frame) from the
+    result's present pose, inliers, weights and free degrees of freedom; None with too few
+    inliers. The run apply() made from this pose is reused when there is one."""
+    run = getattr(result, "size_fit_run", None)
+    if run is not None:
+        return run
+    record = getattr(result, "fit", None) or {}
+    text = record.get("free")
+    choice = FitChoice(free=None if text in (None, "all") else text,
+                       engine_axis=tuple(record.get("engine_axis") or ENGINE_AXIS))
+    weights = fit_weights(result)
+    if np.count_nonzero(weights > 0) <= 7:
+        return None
+    return fits.fit(SIZE, result.points_cad, exact_closest_fn(nominal), np.eye(4), weights,
+                    free=free_of(choice, nominal),
+                    at_init=(np.asarray(result.deviation), np.asarray(result.normal)))
 
 
 def _take_size_fit_covariance(result, nominal, run):
