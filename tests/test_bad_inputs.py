@@ -322,9 +322,10 @@ class TestUnmeasuredDirections(unittest.TestCase):
         points, normals = self.cylinder(20.0, 9.0)
         H, icp = self.information(points, normals, points.mean(axis=0))
         split = icp.split_information(H, 1e-5, 80.0, len(points))
-        # A stand-in nominal: samples of the prism's side, span along Z.
+        # A stand-in nominal: samples of the prism's side (with their normals, as a
+        # nominal's), span along Z.
         samples = SimpleNamespace(xyz=points, weight=np.ones(len(points)),
-                                  face=np.zeros(len(points), int))
+                                  face=np.zeros(len(points), int), normal=normals)
         words = describe_unmeasured(split, SimpleNamespace(samples=samples, roles={}))
         self.assertEqual([w["motion"] for w in words],
                          ["position along the span is not measured"])
@@ -333,7 +334,7 @@ class TestUnmeasuredDirections(unittest.TestCase):
         H, icp = self.information(points, normals, points[:200].mean(axis=0))
         split = icp.split_information(H, 1e-5, 80.0, len(points))
         samples = SimpleNamespace(xyz=points, weight=np.ones(len(points)),
-                                  face=np.zeros(len(points), int))
+                                  face=np.zeros(len(points), int), normal=normals)
         words = describe_unmeasured(split, SimpleNamespace(samples=samples, roles={}))
         self.assertEqual([w["motion"] for w in words],
                          ["position along the span is not measured",
