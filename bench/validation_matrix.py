@@ -153,22 +153,57 @@ def station_truth(doc, z):
     return t
 
 
-def true_deviations(nom_doc, made_doc, error, z, q):
-    """{characteristic: true deviation} for the section at height z (span fraction q)."""
+def true_deviations(nom_doc, made_doc, error, z, q, fit=None):
+    """{characteristic: true deviation} for the section at height z (span fraction q).
+    ``fit``: for a twist, the fitted part's rotation relative to the nominal at each judged
+    height and the axial chord's change under it (``twist_fit``)."""
     if error == "none":
         return {k: 0.0 for k in JUDGED}
+    if error == "twist":
+        # Read in the fitted frame: each section is the nominal turned by the twist there
+        # less the fit's own turn; lengths keep, the axial chord turns with the profile.
+        key = "%.4f" % q
+        if fit is None or key not in fit["rel_deg"]:
+            return None
+        out = {k: 0.0 for k in JUDGED}
+        for k in ANGLES + ("twist_deg",):
+            out[k] = fit["rel_deg"][key]
+        out["axial_chord_mm"] = fit["axial_chord_mm"][key]
+        return out
     tn, tm = station_truth(nom_doc, z), station_truth(made_doc, z)
     if tn is None or tm is None:
         return None
-    out = {k: tm[k] - tn[k] for k in tm if k in tn and k in JUDGED}
-    if error == "twist":
-        # The best fit turns the part by the twist's mean (a linear twist sampled evenly about
-        # mid-span: its value there), so every angle's true deviation after the fit is the
-        # twist relative to mid-span; the lengths are unchanged by either.
-        for k in ANGLES:
-            if k in out:
-                out[k] -= TWIST_TIP_DEG * 0.5
-        out["twist_deg"] = TWIST_TIP_DEG * (q - 0.5)
+    return {k: tm[k] - tn[k] for k in tm if k in tn and k in JUDGED}
+
+
+def twist_fit(case, profile, made_path, seed, cache_path, n_points=20000):
+    """The twist's truth in the fitted frame (corpus.fit_truth): the rigid least-squares
+    fit's motion from ``n_points`` of a scan of the made part simulated as the matrix's own
+    (same pattern, weights and seed), and at each judged height the section's rotation
+    relative to the nominal and the axial chord's change. Cached at ``cache_path``."""
+    if os.path.exists(cache_path):
+        with open(cache_path) as fh:
+            return json.load(fh)
+    from BladeInspect.core import transforms as tf
+    from BladeInspect.inspection import pipeline
+    from BladeInspect.inspection.simulate import simulate_measurement
+    from corpus.fit_truth import fitted_rotation
+    made = pipeline.load_nominal(made_path)
+    ps, to_cad, _, good = simulate_measurement(made, n_points=n_points, seed=seed)
+    points = tf.apply_transform(to_cad, ps.xyz)[good]
+    loop = profile.points()
+    rel, info = fitted_rotation(case, loop, TWIST_TIP_DEG, points, ps.snr[good])
+    out = dict(info, rel_deg={}, axial_chord_mm={})
+    for h in HEIGHTS:
+        q = h / 100.0
+        station = truth.rotate(loop, case.twist_deg(q) if case.twist_deg else 0.0)
+        r = rel(q)
+        out["rel_deg"]["%.4f" % q] = r
+        out["axial_chord_mm"]["%.4f" % q] = \
+            truth.extent(truth.rotate(station, r)) - truth.extent(station)
+    with open(cache_path + ".tmp", "w") as fh:
+        json.dump(out, fh, indent=1)
+    os.replace(cache_path + ".tmp", cache_path)
     return out
 
 
@@ -201,7 +236,7 @@ def angle_sign(nominal_block, nom_doc, z):
     return -1.0 if abs(rep + t["stagger_deg"]) < abs(rep - t["stagger_deg"]) else 1.0
 
 
-def judge(case, error, density, doc, nom_doc, made_doc, span_lo_hi=None):
+def judge(case, error, density, doc, nom_doc, made_doc, fit=None):
     rows = []
     for block in doc.get("airfoil") or []:
         label = block.get("label")
@@ -209,7 +244,7 @@ def judge(case, error, density, doc, nom_doc, made_doc, span_lo_hi=None):
         z = (nominal.get("centroid_mm") or [None, None, None])[2]
         h = block.get("height_pct")
         q = h / 100.0 if h is not None else None
-        td = true_deviations(nom_doc, made_doc, error, z, q) if z is not None else None
+        td = true_deviations(nom_doc, made_doc, error, z, q, fit) if z is not None else None
         if td is None:
             rows.append(dict(case=case.name, family=case.family, error=error, density=density,
                              section=label, key=None, status="no truth at this plane"))
@@ -297,6 +332,10 @@ def run_one(case, error, density, cache, seed, nominal_cache):
                         seed=seed, nominal=nominal_cache[nom_path])
         with open(res) as fh:
             doc = json.load(fh)
+        fit = None
+        if error == "twist" and not case.cad_path:
+            fit = twist_fit(case, profile, made_path, seed,
+                            os.path.join(d, "twist_fit_s%d.json" % seed))
     except Exception as exc:   # a crash is a finding: one line, the matrix goes on
         line = ("%s: %s" % (type(exc).__name__, exc)).splitlines()[0][:200]
         frames = [ln.strip() for ln in traceback.format_exc().splitlines()
@@ -308,7 +347,7 @@ def run_one(case, error, density, cache, seed, nominal_cache):
             with open(out + ".failed.json", "w") as fh:
                 json.dump(failure, fh)
         return [dict(base, **failure)]
-    rows = judge(case, error, density, doc, nom_doc, made_doc)
+    rows = judge(case, error, density, doc, nom_doc, made_doc, fit)
     for r in rows:
         r["seconds"] = round(time.perf_counter() - t0, 1)
     return rows

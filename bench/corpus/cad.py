@@ -12,6 +12,12 @@ def select_points(loop, max_step=0.5, max_turn_deg=3.0):
     """Points of a dense closed loop for interpolation: at most ``max_step`` mm apart and at
     most ``max_turn_deg`` of turning between neighbours (dense round the edges)."""
     loop = np.asarray(loop, float)
+    return loop[select_indices(loop, max_step, max_turn_deg)]
+
+
+def select_indices(loop, max_step=0.5, max_turn_deg=3.0):
+    """The indices ``select_points`` keeps."""
+    loop = np.asarray(loop, float)
     d = np.roll(loop, -1, axis=0) - loop
     seg = np.linalg.norm(d, axis=1)
     ang = np.arctan2(d[:, 1], d[:, 0])
@@ -23,7 +29,7 @@ def select_points(loop, max_step=0.5, max_turn_deg=3.0):
         if acc_l >= max_step or acc_t >= max_turn_deg:
             keep.append(i)
             acc_l = acc_t = 0.0
-    return loop[keep]
+    return np.asarray(keep)
 
 
 def _curve(points2d, z):
@@ -50,15 +56,21 @@ def build(stations, mode="solid", hub=None):
     import FreeCAD
     import Part
     V = FreeCAD.Vector
-    curves = [_curve(select_points(loop), z) for z, loop in stations]
+    # Every station interpolates the same points of its loop (the stations are one profile
+    # turned and shifted): a loft through curves of different point counts twists its surface
+    # between the stations by millimetres.
+    sizes = {len(loop) for _, loop in stations}
+    if len(sizes) != 1:
+        raise ValueError("the stations' loops differ in length: %s" % sorted(sizes))
+    keep = select_indices(stations[0][1])
+    curves = [_curve(np.asarray(loop, float)[keep], z) for z, loop in stations]
     if len(stations) == 1:
         z, _ = stations[0]
         z0 = -1.0 if hub else 0.0
-        c0 = _curve(select_points(stations[0][1]), z0)
+        c0 = _curve(np.asarray(stations[0][1], float)[keep], z0)
         solid = Part.Face(Part.Wire(c0.toShape())).extrude(V(0, 0, 2 * z - z0))
     else:
-        wires = [Part.Wire(c.toShape()) for c in curves]
-        solid = Part.makeLoft(wires, True, False)
+        solid = _skinned(curves, [z for z, _ in stations])
     if hub:
         bb = solid.BoundBox
         m = 8.0
@@ -74,6 +86,42 @@ def build(stations, mode="solid", hub=None):
         faces = [f for f in solid.Faces if f.Surface.__class__.__name__ != "Plane"]
         return Part.Shell(faces), curves
     return solid, curves
+
+
+def _skinned(curves, zs):
+    """The solid through station curves that share their knots (one profile turned and
+    shifted): each pole's path across the stations is a cubic interpolation of that pole's
+    positions, so the surface passes through every station curve exactly and turns smoothly
+    between them. (Part.makeLoft's approximation of the same curves strays by millimetres
+    between the stations.)"""
+    import Part
+    first = curves[0]
+    knots, mults = first.getKnots(), first.getMultiplicities()
+    for c in curves[1:]:
+        if c.getMultiplicities() != mults or \
+                np.max(np.abs(np.subtract(c.getKnots(), knots))) > 1e-9 * knots[-1]:
+            raise ValueError("the station curves differ in their knots")
+    q = [(z - zs[0]) / (zs[-1] - zs[0]) for z in zs]
+    columns = []
+    for j in range(first.NbPoles):
+        path = Part.BSplineCurve()
+        path.interpolate(Points=[c.getPole(j + 1) for c in curves], Parameters=q)
+        columns.append(path)
+    surface = Part.BSplineSurface()
+    surface.buildFromPolesMultsKnots(
+        [c.getPoles() for c in columns], mults, columns[0].getMultiplicities(), knots,
+        columns[0].getKnots(), True, False, first.Degree, columns[0].Degree)
+    side = surface.toShape()
+    ends = [e for e in side.Edges if abs(e.BoundBox.ZMax - e.BoundBox.ZMin) < 1e-9]
+    caps = [Part.Face(Part.Wire([e])) for e in ends]
+    shell = Part.Shell([side] + caps)
+    shell.sewShape()        # orients the faces consistently (else the solid is invalid)
+    solid = Part.Solid(shell)
+    if solid.Volume < 0:
+        solid.reverse()
+    if not solid.isValid():
+        raise ValueError("the skinned blade is not a valid solid")
+    return solid
 
 
 def write_step(shape, path):
