@@ -4,6 +4,7 @@ import dataclasses
 import functools
 import json
 import math
+import re
 
 import FreeCADGui
 from PySide import QtCore, QtGui
@@ -12,8 +13,10 @@ from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
 from ..core import decision
 from ..core.airfoil import CHORD_METHODS
+from ..core.errors import InputError
 from ..inspection import characteristic_names as names
 from ..inspection import fitting
+from ..inspection.airfoil_stage import parse_engine_axis, read_characteristics
 from ..inspection.result import rival_lines
 from . import tables
 from .i18n import QT_TRANSLATE_NOOP, translate
@@ -51,20 +54,141 @@ def spin_box(value, minimum, maximum, decimals=3, suffix=""):
     return box
 
 
+# The Browse buttons' file dialog, ask(title, filters) -> path or None: gui.commands sets it to
+# its ask_open_file (which tests answer in its place), since this module cannot import it.
+FILE_DIALOG = {"open": None}
+# The command line's options as the panels name them: an error the GUI shows names the control
+# the user can change, not a flag they cannot type (gui_text).
+CLI_CONTROLS = {
+    "--allow-mismatch": QT_TRANSLATE_NOOP("BladeInspect",
+                                          "the Register panel's 'Allow mismatch' box"),
+    "--section-heights": QT_TRANSLATE_NOOP("BladeInspect", "Section heights"),
+    "--characteristics": QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"),
+    "--engine-axis": QT_TRANSLATE_NOOP("BladeInspect", "Engine axis"),
+    "--chord-method": QT_TRANSLATE_NOOP("BladeInspect", "Chord"),
+    "--weights-by-zone": QT_TRANSLATE_NOOP("BladeInspect", "Zone weights"),
+    "--weights": QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
+    "--free": QT_TRANSLATE_NOOP("BladeInspect", "Free DOF"),
+    "--fit": QT_TRANSLATE_NOOP("BladeInspect", "Objective"),
+    "--decision-rule": QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"),
+    "--rig-file": QT_TRANSLATE_NOOP("BladeInspect", "Rig calibration"),
+}
+_FLAG = re.compile(r"--[a-z][a-z-]*[a-z]")
+
+
+def gui_text(message):
+    """An error message of the pipeline with the command line's options named as the GUI's
+    controls."""
+    return _FLAG.sub(lambda m: translate("BladeInspect", CLI_CONTROLS[m.group(0)])
+                     if m.group(0) in CLI_CONTROLS else m.group(0), message)
+
+
+# An input error's colour, as FreeCAD's own task panels show one.
+ERROR_STYLE = "color: #c00000;"
+
+
+def form_layout(parent):
+    """A form layout that stays readable in a narrow task view (the Combo View is about 230 px
+    wide by default): a row whose label and field do not fit side by side puts the field under
+    its label instead of clipping either."""
+    layout = QtGui.QFormLayout(parent)
+    layout.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
+    layout.setFieldGrowthPolicy(QtGui.QFormLayout.AllNonFixedFieldsGrow)
+    return layout
+
+
+def wrapped_label(text):
+    label = QtGui.QLabel(text)
+    label.setWordWrap(True)
+    return label
+
+
+def object_combo(candidates, chosen):
+    """A combo box of document objects shown by their labels (names in the tooltip), the
+    object ``chosen`` preselected; currentData() is the chosen object's Name."""
+    box = QtGui.QComboBox()
+    box.setSizeAdjustPolicy(QtGui.QComboBox.AdjustToMinimumContentsLengthWithIcon)
+    box.setMinimumContentsLength(8)
+    for obj in candidates:
+        box.addItem(obj.Label, obj.Name)
+        box.setItemData(box.count() - 1, obj.Name, QtCore.Qt.ToolTipRole)
+    if chosen is not None and chosen in candidates:
+        box.setCurrentIndex(list(candidates).index(chosen))
+    return box
+
+
 class FormPanel:
+    """An input panel: labelled rows, and accept() that checks them (validate) before the
+    panel closes; a bad input shows its one-line error in red under its field and keeps the
+    panel open with what the user typed."""
     title = ""    # marked with QT_TRANSLATE_NOOP("BladeInspect", ...), translated when shown
 
     def __init__(self):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("BladeInspect", self.title))
-        self.layout = QtGui.QFormLayout(self.form)
+        self.layout = form_layout(self.form)
+        self.errors = {}
 
     def add_row(self, label, widget, tip=None):
-        """A form row; ``label`` and ``tip`` are translated here."""
+        """A form row; ``label`` and ``tip`` are translated here. Its error line (hidden)
+        follows it."""
         if tip:
             widget.setToolTip(translate("BladeInspect", tip))
-        self.layout.addRow(translate("BladeInspect", label), widget)
+        self.layout.addRow(wrapped_label(translate("BladeInspect", label)), widget)
+        error = wrapped_label("")
+        error.setStyleSheet(ERROR_STYLE)
+        error.setObjectName("error")
+        error.hide()
+        self.layout.addRow(error)
+        self.errors[widget] = error
         return widget
+
+    def add_file_row(self, label, line_edit, tip, dialog_title, filters):
+        """A row of a file name with a Browse button that fills it (FILE_DIALOG)."""
+        row = QtGui.QWidget()
+        box = QtGui.QHBoxLayout(row)
+        box.setContentsMargins(0, 0, 0, 0)
+        box.addWidget(line_edit, 1)
+        button = QtGui.QPushButton(translate("BladeInspect", "Browse..."))
+        button.setToolTip(translate("BladeInspect", "Choose the file"))
+        box.addWidget(button)
+
+        def browse():
+            path = FILE_DIALOG["open"](translate("BladeInspect", dialog_title), filters)
+            if path:
+                line_edit.setText(path)
+                self.clear_error(line_edit)
+        button.clicked.connect(browse)
+        line_edit.setToolTip(translate("BladeInspect", tip))
+        self.add_row(label, row)
+        self.errors[line_edit] = self.errors.pop(row)
+        line_edit.browse_button = button
+        return line_edit
+
+    def show_error(self, widget, text):
+        label = self.errors[widget]
+        label.setText(text)
+        label.setToolTip(text)
+        label.show()
+        widget.setFocus()
+
+    def clear_error(self, widget):
+        self.errors[widget].hide()
+
+    def check(self, widget, parse):
+        """parse() with the field's error line cleared, or shown with its InputError; True
+        when it parsed."""
+        try:
+            parse()
+        except InputError as exc:
+            self.show_error(widget, gui_text(str(exc)))
+            return False
+        self.clear_error(widget)
+        return True
+
+    def validate(self):
+        """True when every input reads; else the errors shown (the panel stays open)."""
+        return True
 
     def reject(self):
         FreeCADGui.Control.closeDialog()
@@ -98,6 +222,10 @@ DEMO_BLADE_LABELS = {
 }
 
 
+DEMO_BLADE_TIP = QT_TRANSLATE_NOOP(
+    "BladeInspect", "A parameter of the parametric demo blade, interpolated from hub to tip")
+
+
 class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Demo blade")
@@ -116,13 +244,20 @@ class DemoBladePanel(FormPanel):
                                                 (field.name.replace("_", " "), ""))
             box = spin_box(value, -1e4, 1e4, suffix=unit)
             self.boxes[field.name] = box
-            self.add_row(label, box)
+            self.add_row(label, box, DEMO_BLADE_TIP)
+        # BladeParams.validate names the field it refuses; its error shows under the last row.
+        self.errors[self.form] = self.errors[box]
 
     def params(self):
         return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())
                                    for name, box in self.boxes.items()})
 
+    def validate(self):
+        return self.check(self.form, lambda: self.params().validate())
+
     def accept(self):
+        if not self.validate():
+            return False
         params = self.params()   # read before closing: closing deletes the widgets
         return close_then(self.on_accept, params)
 
@@ -142,9 +277,14 @@ class ConnectRigPanel(FormPanel):
         for port in self._ports():
             self.port.addItem(port)
         self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Rig"), self.kind)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Port"), self.port)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed (simulated)"), self.seed)
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Rig"), self.kind,
+                     QT_TRANSLATE_NOOP("BladeInspect", "The simulated rig measures the nominal "
+                                       "CAD; a serial port drives the real rig"))
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Port"), self.port,
+                     QT_TRANSLATE_NOOP("BladeInspect", "The rig's serial port"))
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed (simulated)"), self.seed,
+                     QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the simulated rig's "
+                                       "fixture pose and noise"))
         self.kind.currentIndexChanged.connect(self._update)
         self._update()
 
@@ -166,7 +306,15 @@ class ConnectRigPanel(FormPanel):
             return "sim"
         return "serial:" + self.port.currentText().strip()
 
+    def validate(self):
+        def port():
+            if self.spec() == "serial:":
+                raise InputError(translate("BladeInspect", "Name the serial port"))
+        return self.check(self.port, port)
+
     def accept(self):
+        if not self.validate():
+            return False
         spec, seed = self.spec(), self.seed.value()
         return close_then(self.on_accept, spec, seed)
 
@@ -178,8 +326,10 @@ class ScanPanel(FormPanel):
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.sections = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Sections"),
-                                     spin_box(settings.value("Sections"), 1, 200))
+        self.sections = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Sections"),
+            spin_box(settings.value("Sections"), 1, 200),
+            QT_TRANSLATE_NOOP("BladeInspect", "Sections scanned over the span"))
         self.spacing = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Section spacing"),
             spin_box(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm"),
@@ -187,7 +337,8 @@ class ScanPanel(FormPanel):
                               "Distance between sections; 0 spreads them over the span"))
         self.point_spacing = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Point spacing"),
-            spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm"))
+            spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Distance between points along a section"))
         self.sides = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Sides"), spin_box(settings.value("Sides"), 1, 2),
             QT_TRANSLATE_NOOP("BladeInspect", "2 turns the part over to scan the other side"))
@@ -196,8 +347,10 @@ class ScanPanel(FormPanel):
             spin_box(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm"),
             QT_TRANSLATE_NOOP("BladeInspect", "Rescan a section until every point is within "
                                               "this distance of the sensor's standoff"))
-        self.seed = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
-                                 spin_box(settings.value("Seed"), 0, 2 ** 31 - 1))
+        self.seed = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+            spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
+            QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the simulated rig's noise"))
 
     def options(self):
         spacing = self.spacing.value()
@@ -218,7 +371,7 @@ class FitSelector(QtGui.QGroupBox):
 
     def __init__(self):
         super().__init__(translate("BladeInspect", "Fit"))
-        layout = QtGui.QFormLayout(self)
+        layout = form_layout(self)
         self.objective = QtGui.QComboBox()
         self.objective.addItems(list(fitting.OBJECTIVE_NAMES))
         self.objective.setToolTip(translate(
@@ -250,7 +403,7 @@ class FitSelector(QtGui.QGroupBox):
                               (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule),
                               (QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
                                self.icp_weights)):
-            layout.addRow(translate("BladeInspect", label), widget)
+            layout.addRow(wrapped_label(translate("BladeInspect", label)), widget)
 
     def values(self):
         """Keywords of app.actions.fit_choice (literals, for the console line)."""
@@ -263,22 +416,56 @@ class FitSelector(QtGui.QGroupBox):
 
 
 class RegisterPanel(FormPanel):
-    """The registration's seed and the fit to move it to."""
+    """Which CAD (nominal) and which measured points the registration uses, preselected from
+    the selection, its seed, whether a scan that does not fit the CAD is kept, and the fit to
+    move it to. on_accept(nominal name, measurement name, seed, allow_mismatch, **fit)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Register")
 
-    def __init__(self, on_accept):
+    def __init__(self, on_accept, nominals=(), measurements=(), nominal=None,
+                 measurement=None):
         super().__init__()
         self.on_accept = on_accept
+        self.nominal = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Nominal CAD"), object_combo(nominals, nominal),
+            QT_TRANSLATE_NOOP("BladeInspect", "The CAD the points are registered to (the "
+                              "selected one when a CAD is selected)"))
+        self.measurement = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Measured points"),
+            object_combo(measurements, measurement),
+            QT_TRANSLATE_NOOP("BladeInspect", "The point set to register (the selected one "
+                              "when a point set is selected)"))
         self.seed = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
             spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
             QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the coarse stage"))
+        self.allow_mismatch = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Allow mismatch"),
+            QtGui.QCheckBox(translate("BladeInspect", "Keep a result that does not fit")),
+            QT_TRANSLATE_NOOP("BladeInspect", "Keep the registration, with a warning, when "
+                              "too few points lie near the CAD's surface (another part's "
+                              "scan, or a part far out of tolerance); off: refuse it"))
         self.fit = FitSelector()
         self.layout.addRow(self.fit)
 
+    def validate(self):
+        ok = self.check(self.nominal, lambda: self._chosen(
+            self.nominal, translate("BladeInspect", "No nominal CAD in the document")))
+        return self.check(self.measurement, lambda: self._chosen(
+            self.measurement, translate("BladeInspect", "No measured points in the "
+                                        "document"))) and ok
+
+    @staticmethod
+    def _chosen(combo, missing):
+        if combo.currentIndex() < 0:
+            raise InputError(missing)
+
     def accept(self):
+        if not self.validate():
+            return False
+        nominal, measurement = self.nominal.currentData(), self.measurement.currentData()
         seed, fit = self.seed.value(), self.fit.values()
-        return close_then(self.on_accept, seed, **fit)
+        return close_then(self.on_accept, nominal, measurement, seed,
+                          self.allow_mismatch.isChecked(), **fit)
 
 
 def _escape(text):
@@ -426,19 +613,31 @@ class TablePanel(_ResultPanel):
 
 # ---------------------------------------------------------------- airfoil
 
+CHARACTERISTICS_FILTER = QT_TRANSLATE_NOOP("BladeInspect",
+                                           "Characteristics (*.csv);;All files (*)")
+
+
 class AirfoilOptionsPanel(FormPanel):
-    """The `airfoil` command's options: the characteristics file, chord method, engine axis."""
+    """The `airfoil` command's options: the registration it analyses, the characteristics file,
+    chord method, engine axis. on_accept(registration name, **options)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Airfoil analysis")
 
-    def __init__(self, on_accept):
+    def __init__(self, on_accept, registrations=(), registration=None):
         super().__init__()
         self.on_accept = on_accept
-        self.characteristics = self.add_row(
+        self.registration = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Registration"),
+            object_combo(registrations, registration),
+            QT_TRANSLATE_NOOP("BladeInspect", "The registered measurement to analyse (the "
+                              "selected one when a registration is selected)"))
+        self.characteristics = self.add_file_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"), QtGui.QLineEdit(),
             QT_TRANSLATE_NOOP("BladeInspect", "CSV: characteristic,section,lower,upper"
-                              "[,nominal]; empty: every characteristic reported, none judged"))
-        self.chord = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Chord"),
-                                  QtGui.QComboBox())
+                              "[,nominal]; empty: every characteristic reported, none judged"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"), CHARACTERISTICS_FILTER)
+        self.chord = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Chord"), QtGui.QComboBox(),
+            QT_TRANSLATE_NOOP("BladeInspect", "How the chord line is drawn"))
         self.chord.addItems(list(CHORD_METHODS))
         self.axis = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Engine axis"), QtGui.QLineEdit("x"),
@@ -449,9 +648,29 @@ class AirfoilOptionsPanel(FormPanel):
                 "chord_method": self.chord.currentText(),
                 "engine_axis": self.axis.text().strip() or None}
 
+    def validate(self):
+        def registration():
+            if self.registration.currentIndex() < 0:
+                raise InputError(translate("BladeInspect", "No registration in the document"))
+
+        def characteristics():
+            path = self.characteristics.text().strip()
+            if path:
+                read_characteristics(path)
+        def axis():
+            text = self.axis.text().strip()
+            if text:
+                parse_engine_axis(text)
+        checks = [self.check(self.registration, registration),
+                  self.check(self.characteristics, characteristics),
+                  self.check(self.axis, axis)]
+        return all(checks)
+
     def accept(self):
-        options = self.options()
-        return close_then(self.on_accept, **options)
+        if not self.validate():
+            return False
+        registration, options = self.registration.currentData(), self.options()
+        return close_then(self.on_accept, registration, **options)
 
 
 class AirfoilPanel(_ResultPanel):
