@@ -33,6 +33,8 @@ def click(widget):
 
 
 def open_panel(command, kind):
+    Gui.Control.closeDialog()    # what an earlier step left open
+    settle(0.1)
     Gui.runCommand(command)
     settle(0.3)
     return active_panel(kind)
@@ -52,12 +54,16 @@ def dock_shot(name):
             return
 
 
-def scroll_viewport(widget):
-    """The viewport of the scroll area the widget sits in (the task view's), or None."""
+def visible_right_edge(widget):
+    """The screen x of the right edge of the task view's visible area (the viewport of the
+    scroll area the widget sits in), or None when it sits in none."""
     parent = widget.parentWidget()
     while parent is not None and not isinstance(parent, QtGui.QAbstractScrollArea):
         parent = parent.parentWidget()
-    return parent.viewport() if parent is not None else None
+    if parent is None:
+        return None
+    viewport = parent.viewport()
+    return viewport.mapToGlobal(QtCore.QPoint(viewport.width(), 0)).x()
 
 
 def clipped(form):
@@ -67,15 +73,17 @@ def clipped(form):
     edit's text, a check box's text, and any widget that runs past the right edge of the task
     view's visible area (a sideways scroll)."""
     found = []
-    viewport = scroll_viewport(form)
+    edge = visible_right_edge(form)
     for widget in form.findChildren(QtGui.QWidget):
-        if not widget.isVisible() or widget.width() <= 0:
+        try:
+            if not widget.isVisible() or widget.width() <= 0:
+                continue
+            right = widget.mapToGlobal(QtCore.QPoint(widget.width(), 0)).x()
+        except RuntimeError:    # a child Qt deleted meanwhile (a combo box's popup parts)
             continue
         metrics = widget.fontMetrics()
-        if viewport is not None:
-            right = widget.mapTo(viewport, QtCore.QPoint(widget.width(), 0)).x()
-            if right > viewport.width() + 1:
-                found.append(("past the edge", type(widget).__name__, right, viewport.width()))
+        if edge is not None and right > edge + 1:
+            found.append(("past the edge", type(widget).__name__, right, edge))
         if isinstance(widget, QtGui.QLabel) and widget.text():
             if widget.wordWrap():
                 need = widget.heightForWidth(widget.width())

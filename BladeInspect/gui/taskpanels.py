@@ -97,6 +97,22 @@ def form_layout(parent):
     return layout
 
 
+# The widest a line edit asks to be before its row wraps (px); a longer text scrolls in it.
+LINE_EDIT_MAX_MIN_WIDTH = 180
+
+
+def fit_field(widget):
+    """Ask for the width the field needs to show its value whole, so that a form row too narrow
+    for label and field side by side wraps (form_layout) rather than clipping the value."""
+    if isinstance(widget, (QtGui.QAbstractSpinBox, QtGui.QComboBox)):
+        widget.setMinimumWidth(widget.sizeHint().width())
+    elif isinstance(widget, QtGui.QLineEdit):
+        text = widget.text() or widget.placeholderText()
+        widget.setMinimumWidth(min(max(widget.fontMetrics().horizontalAdvance(text) + 16, 80),
+                                   LINE_EDIT_MAX_MIN_WIDTH))
+    return widget
+
+
 def wrapped_label(text):
     label = QtGui.QLabel(text)
     label.setWordWrap(True)
@@ -134,7 +150,16 @@ class FormPanel:
         follows it."""
         if tip:
             widget.setToolTip(translate("BladeInspect", tip))
-        self.layout.addRow(wrapped_label(translate("BladeInspect", label)), widget)
+        self.layout.addRow(wrapped_label(translate("BladeInspect", label)), fit_field(widget))
+        return self._add_error_line(widget)
+
+    def add_wide_row(self, widget, tip):
+        """A row of one widget that names itself (a check box), the panel's width."""
+        widget.setToolTip(translate("BladeInspect", tip))
+        self.layout.addRow(widget)
+        return self._add_error_line(widget)
+
+    def _add_error_line(self, widget):
         error = wrapped_label("")
         error.setStyleSheet(ERROR_STYLE)
         error.setObjectName("error")
@@ -403,7 +428,7 @@ class FitSelector(QtGui.QGroupBox):
                               (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule),
                               (QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
                                self.icp_weights)):
-            layout.addRow(wrapped_label(translate("BladeInspect", label)), widget)
+            layout.addRow(wrapped_label(translate("BladeInspect", label)), fit_field(widget))
 
     def values(self):
         """Keywords of app.actions.fit_choice (literals, for the console line)."""
@@ -438,9 +463,8 @@ class RegisterPanel(FormPanel):
             QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
             spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
             QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the coarse stage"))
-        self.allow_mismatch = self.add_row(
-            QT_TRANSLATE_NOOP("BladeInspect", "Allow mismatch"),
-            QtGui.QCheckBox(translate("BladeInspect", "Keep a result that does not fit")),
+        self.allow_mismatch = self.add_wide_row(
+            QtGui.QCheckBox(translate("BladeInspect", "Allow mismatch")),
             QT_TRANSLATE_NOOP("BladeInspect", "Keep the registration, with a warning, when "
                               "too few points lie near the CAD's surface (another part's "
                               "scan, or a part far out of tolerance); off: refuse it"))
