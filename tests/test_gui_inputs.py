@@ -35,6 +35,11 @@ class NoBeamReason(unittest.TestCase):
     def test_neither(self):
         self.assertIn("no snr and no angle_deg column", self.reason(None, {}))
 
+    def test_an_angle_missing_in_a_row(self):
+        why = self.reason(np.ones(4), {"angle_deg": np.array([0.0, np.nan, 0.0, 0.0])})
+        self.assertIn("not finite", why)
+        self.assertNotIn("no snr", why)
+
     def test_a_beam_known(self):
         self.assertIn("carry snr and angle_deg",
                       self.reason(np.ones(4), {"angle_deg": np.zeros(4)}))
