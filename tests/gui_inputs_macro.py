@@ -285,6 +285,19 @@ def run():
                 dock_shot("inputs_demo_blade_panel")
             cancel_panel()
 
+    @step("a command without a panel names what it uses")
+    def _():
+        Gui.Control.closeDialog()
+        Gui.Selection.clearSelection()
+        Gui.Selection.addSelection(state["reg"])
+        with ReportWatch() as watch:
+            Gui.runCommand("BladeInspect_DeviationMap")
+            wait_until(lambda: not progress.busy(), 60)
+            settle(0.3)
+        check("deviation map: the Report view names the registration it uses",
+              "Deviation map uses %s" % state["reg"].Label in watch.new_text
+              and not watch.problems(), (watch.new_text[-600:], watch.problems()))
+
     @step("preferences: grouped, symbols written, a tooltip on every field")
     def _():
         seen = {}

@@ -58,7 +58,7 @@ class TestInputPanels(GuiMacroChecks, unittest.TestCase):
         self.assertIsNotNone(self.report)
         for name, info in self.report["steps"].items():
             self.assertEqual(info["status"], "ran", (name, info))
-        self.assertEqual(len(self.report["steps"]), 7)
+        self.assertEqual(len(self.report["steps"]), 8)
 
 
 if __name__ == "__main__":

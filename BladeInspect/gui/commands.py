@@ -17,7 +17,7 @@ from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
 from ..inspection.run_options import ReportSources, RunOptions
 from ..measurement.scan import open_rig
-from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
+from . import forms, progress, resources, taskpanels, viewproviders  # noqa: F401 (VPs)
 from .command_base import (Command, find_measurement, find_nominal, find_registration,
                            inputs_of, nominals_of)
 from .i18n import QT_TRANSLATE_NOOP, translate
@@ -49,7 +49,7 @@ def open_in_browser(path):
 
 
 # The input panels' Browse buttons open this module's dialog, looked up when clicked.
-taskpanels.FILE_DIALOG["open"] = lambda title, filters: ask_open_file(title, filters)
+forms.FILE_DIALOG["open"] = lambda title, filters: ask_open_file(title, filters)
 
 
 # ---------------------------------------------------------------- document helpers
@@ -99,8 +99,16 @@ def run_action(title, function, *args, on_plan=None, rig=None, **kwargs):
                 return do_command(imports, call)
             except InputError as exc:
                 # The GUI's user changes a control, not a command-line option.
-                raise InputError(taskpanels.gui_text(str(exc))) from None
+                raise InputError(forms.gui_text(str(exc))) from None
     return progress.run(title, job)
+
+
+def announced(title, obj):
+    """``obj``, named in the Report view as what the command ``title`` works on (the selected
+    one, else the newest): a command without a panel still says what it uses."""
+    FreeCAD.Console.PrintMessage(translate("BladeInspect", "BladeInspect: %s uses %s (%s)")
+                                 % (title, obj.Label, obj.Name) + "\n")
+    return obj
 
 
 def fit_view():
@@ -272,7 +280,7 @@ class Reconstruct(Command):
     is_active = "with_measurement"
 
     def Activated(self):
-        self.reconstruct(find_measurement())
+        self.reconstruct(announced(translate("BladeInspect", "Reconstruct"), find_measurement()))
 
     def reconstruct(self, measurement):
         """app.actions.reconstruct of the measurement."""
@@ -342,7 +350,7 @@ class DeviationMap(Command):
     is_active = "with_registration"
 
     def Activated(self):
-        self.make(find_registration())
+        self.make(announced(translate("BladeInspect", "Deviation map"), find_registration()))
 
     def make(self, registration, limit=None):
         doc = registration.Document
@@ -374,7 +382,8 @@ class SectionAnalysis(Command):
     is_active = "with_registered_nominal"
 
     def Activated(self):
-        table = self.analyse(find_registration())
+        table = self.analyse(announced(translate("BladeInspect", "Section analysis"),
+                                       find_registration()))
         if table is not None:
             self.show(table)
 
@@ -410,7 +419,7 @@ class Report(Command):
     def Activated(self):
         out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
-            registration = find_registration()
+            registration = announced(translate("BladeInspect", "Report"), find_registration())
             summary = self.report(registration, out_dir)
             html = os.path.join(out_dir, "report.html")
             if summary is not None:

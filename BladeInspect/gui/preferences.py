@@ -5,7 +5,7 @@ from PySide import QtGui
 
 from ..app import settings
 from .i18n import QT_TRANSLATE_NOOP, translate
-from .taskpanels import form_layout, wrapped_label
+from .forms import form_layout, wrapped_label
 
 # (group title, [(setting, label, tooltip)]), in the page's order; every setting of
 # app.settings.SETTINGS once.

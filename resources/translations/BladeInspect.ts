@@ -163,6 +163,11 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect: %s uses %s (%s)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
         <source>BladeInspect: report in %s; ICP weights: %s</source>
         <translation type="unfinished"></translation>
     </message>
@@ -177,7 +182,7 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <source>Browse...</source>
         <translation type="unfinished"></translation>
     </message>
@@ -305,16 +310,18 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Characteristics file</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <source>Choose the file</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord</source>
         <translation type="unfinished"></translation>
@@ -361,6 +368,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Decision rule</source>
         <translation type="unfinished"></translation>
@@ -424,6 +432,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Engine axis</source>
         <translation type="unfinished"></translation>
@@ -464,6 +473,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Free DOF</source>
         <translation type="unfinished"></translation>
@@ -484,6 +494,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>ICP weights</source>
         <translation type="unfinished"></translation>
@@ -663,6 +674,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Objective</source>
         <translation type="unfinished"></translation>
@@ -836,8 +848,8 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Rig calibration</source>
         <translation type="unfinished"></translation>
     </message>
@@ -899,8 +911,8 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Section heights</source>
         <translation type="unfinished"></translation>
     </message>
@@ -1291,6 +1303,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Zone weights</source>
         <translation type="unfinished"></translation>
@@ -1396,7 +1409,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
-        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <source>the Register panel's 'Allow mismatch' box</source>
         <translation type="unfinished"></translation>
     </message>
