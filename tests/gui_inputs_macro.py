@@ -170,17 +170,24 @@ def run():
 
     @step("register: a mismatch error names the GUI's box, not a command-line option")
     def _():
+        # a small scan of the other blade, registered to the first: it does not fit
+        ps, _, _, _ = simulate_measurement(objects.nominal_of(state["other"]), n_points=1500,
+                                           seed=6)
+        small = objects.make_measurement(doc, ps, name="OtherScan")
+        small.ViewObject.Visibility = False
         Gui.Selection.clearSelection()
-        Gui.Selection.addSelection(state["other"])
-        Gui.Selection.addSelection(state["meas"])
+        Gui.Selection.addSelection(small)
         panel = open_panel("BladeInspect_Register", taskpanels.RegisterPanel)
-        check("register: the newly selected CAD is preselected",
-              panel.nominal.currentText() == "Other blade", panel.nominal.currentText())
+        check("register: the newly selected points are preselected",
+              panel.measurement.currentText() == small.Label, panel.measurement.currentText())
+        panel.nominal.setCurrentIndex(panel.nominal.findText(state["blade"].Label))
         before = len(progress.MESSAGES)
         click_ok_and_wait()
         text = " ".join(m[1] for m in progress.MESSAGES[before:])
         check("register: the mismatch error names 'Allow mismatch', not --allow-mismatch",
               "Allow mismatch" in text and "--allow-mismatch" not in text, text)
+        check("register: the error names the CAD it was registered to",
+              "does not fit %s" % state["blade"].Label in text, text)
         Gui.Control.closeDialog()
         settle(0.3)
 

@@ -113,7 +113,8 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, allow_misma
     model = objects.nominal_of(nominal_obj)
     result = pipeline.register(model, objects.pointset_of(measurement_obj), seed=seed,
                                progress=lambda f, m: p(0.85 * f, m), weights=choice.weights,
-                               allow_mismatch=bool(allow_mismatch))
+                               allow_mismatch=bool(allow_mismatch),
+                               cad_source=nominal_obj.Label)
     result.cad_source = nominal_obj.Label
     p(0.9, "fit: %s, and its sensitivity" % choice.objective)
     judge_fits(result, model, choice, tolerance)
