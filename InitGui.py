@@ -25,6 +25,7 @@ class BladeInspectWorkbench(FreeCADGui.Workbench):
         self.appendToolbar("BladeInspect", commands.TOOLBAR)
         self.appendToolbar("BladeInspect loop", loop_commands.NAMES)
         self.appendMenu("BladeInspect", commands.MENU + ["Separator"] + loop_commands.NAMES)
+        self.appendMenu("&Help", commands.HELP_MENU)
         commands.register_preferences()
 
     def Activated(self):

@@ -58,5 +58,32 @@ class TablePages(unittest.TestCase):
         self.assertGreater(self.check(130, [0.06, 0.05, 0.88, 0.4]), 1)
 
 
+
+class CellsHoldTheirText(unittest.TestCase):
+    """A row label longer than its column is set smaller until it lies inside its cell (the
+    rendered extents of text and cell, the independent truth); short cells keep the size."""
+
+    def test_a_long_label_fits_its_cell(self):
+        fig = plt.figure(figsize=report_table.PORTRAIT)
+        try:
+            rows = [["Pose uncertainty (1 sigma, worst corner, after the planned scan)", "1.2"],
+                    ["Translation 1 sigma (x, y, z) after the blind scan", "0.5"],
+                    ["RMS", "0.002"]]
+            report_table.pdf_table(fig, [0.06, 0.5, 0.5, 0.2], ["Quantity", "Value"], rows,
+                                   report_table.TableStyle(7.5, cell_loc="left",
+                                                           col_widths=[0.45, 0.55]))
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            table = fig.axes[0].tables[0]
+            for (row, col), cell in table.get_celld().items():
+                text = cell.get_text()
+                inside, box = text.get_window_extent(renderer), cell.get_window_extent(renderer)
+                self.assertLessEqual(inside.width, box.width, text.get_text())
+                self.assertLessEqual(inside.height, box.height, text.get_text())
+                if text.get_text() in ("RMS", "0.002", "1.2", "Quantity", "Value"):
+                    self.assertEqual(text.get_fontsize(), 7.5)
+        finally:
+            plt.close(fig)
+
 if __name__ == "__main__":
     unittest.main()

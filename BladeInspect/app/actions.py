@@ -97,10 +97,12 @@ def fit_choice(fit=fitting.DEFAULT_OBJECTIVE, free=None, weights_by_zone=None,
 
 # ---------------------------------------------------------------- actions
 
-def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
+def register(doc_name, measurement, nominal, seed=0, tolerance=None, allow_mismatch=False,
+             **fit):
     """Register the Measurement named ``measurement`` to the nominal named ``nominal``
-    (pipeline.register), move it to the fit ``fit`` chooses (keywords of fit_choice) and add
-    the Registration with its fit and fit-sensitivity table."""
+    (pipeline.register; ``allow_mismatch`` keeps a scan that does not fit the CAD, with a
+    warning), move it to the fit ``fit`` chooses (keywords of fit_choice) and add the
+    Registration with its fit and fit-sensitivity table."""
     doc = _document(doc_name)
     measurement_obj = _object(doc, measurement, "measurement")
     nominal_obj = _object(doc, nominal, "nominal")
@@ -110,7 +112,9 @@ def register(doc_name, measurement, nominal, seed=0, tolerance=None, **fit):
     p(0.0, "sampling the nominal")
     model = objects.nominal_of(nominal_obj)
     result = pipeline.register(model, objects.pointset_of(measurement_obj), seed=seed,
-                               progress=lambda f, m: p(0.85 * f, m), weights=choice.weights)
+                               progress=lambda f, m: p(0.85 * f, m), weights=choice.weights,
+                               allow_mismatch=bool(allow_mismatch),
+                               cad_source=nominal_obj.Label)
     result.cad_source = nominal_obj.Label
     p(0.9, "fit: %s, and its sensitivity" % choice.objective)
     judge_fits(result, model, choice, tolerance)

@@ -13,23 +13,21 @@ _SCAN = ScanOptions()
 
 PARAM_PATH = "User parameter:BaseApp/Preferences/Mod/BladeInspect"
 
-# name: (kind "float" or "int", default, label, unit, minimum, maximum)
+# name: (kind "float" or "int", default, unit, minimum, maximum, decimals shown). Their labels,
+# groups and tooltips are the preferences page's (gui.preferences).
 SETTINGS = {
-    "StandoffMm": ("float", _SENSOR.standoff, "Sensor standoff z_s", "mm", 1.0, 500.0),
-    "WorkingRangeMm": ("float", _SENSOR.half_range, "Sensor working range +-delta", "mm", 0.1,
-                       100.0),
-    "EpsilonMm": ("float", _SCAN.epsilon, "Rescan stop criterion epsilon", "mm", 0.01, 50.0),
-    "SensorAccuracyMm": ("float", _SENSOR.accuracy, "Sensor accuracy", "mm", 0.0, 1.0),
-    "PointsPerSecond": ("float", _SENSOR.rate_hz, "Sensor rate", "points/s", 1.0, 1e6),
-    "Sections": ("int", _SCAN.n_sections, "Sections per scan", "", 1, 200),
-    "SectionSpacingMm": ("float", 0.0, "Section spacing (0 = spread over the span)", "mm", 0.0,
-                         1000.0),
-    "PointSpacingMm": ("float", _SCAN.point_spacing, "Point spacing along a section", "mm",
-                       0.005, 10.0),
-    "Sides": ("int", _SCAN.sides, "Sides scanned (2 = the part turned over)", "", 1, 2),
-    "ToleranceMm": ("float", PROFILE_TOLERANCE_MM, "Profile tolerance", "mm", 0.0001, 10.0),
-    "ColourLimitMm": ("float", 0.0, "Colour map limit (0 = the tolerance)", "mm", 0.0, 10.0),
-    "Seed": ("int", 0, "Random seed (simulated rig, registration)", "", 0, 2 ** 31 - 1),
+    "StandoffMm": ("float", _SENSOR.standoff, "mm", 1.0, 500.0, 2),
+    "WorkingRangeMm": ("float", _SENSOR.half_range, "mm", 0.1, 100.0, 2),
+    "SensorAccuracyMm": ("float", _SENSOR.accuracy, "mm", 0.0, 1.0, 4),
+    "PointsPerSecond": ("float", _SENSOR.rate_hz, "points/s", 1.0, 1e6, 0),
+    "EpsilonMm": ("float", _SCAN.epsilon, "mm", 0.01, 50.0, 2),
+    "Sections": ("int", _SCAN.n_sections, "", 1, 200, 0),
+    "SectionSpacingMm": ("float", 0.0, "mm", 0.0, 1000.0, 2),
+    "PointSpacingMm": ("float", _SCAN.point_spacing, "mm", 0.005, 10.0, 3),
+    "Sides": ("int", _SCAN.sides, "", 1, 2, 0),
+    "ToleranceMm": ("float", PROFILE_TOLERANCE_MM, "mm", 0.0001, 10.0, 4),
+    "ColourLimitMm": ("float", 0.0, "mm", 0.0, 10.0, 4),
+    "Seed": ("int", 0, "", 0, 2 ** 31 - 1, 0),
 }
 
 

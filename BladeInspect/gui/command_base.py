@@ -43,6 +43,23 @@ def find_nominal():
     return None
 
 
+def inputs_of(doc, type_names):
+    """The document's BladeInspect objects of these types, oldest first."""
+    if doc is None:
+        return []
+    return [obj for obj in doc.Objects if objects.proxy_type(obj) in type_names]
+
+
+def nominals_of(doc):
+    """What can serve as the nominal: the DemoBlade and CadModel objects, and a selected Part
+    feature with faces (find_nominal's)."""
+    found = inputs_of(doc, (objects.DemoBlade.Type, objects.CadModel.Type))
+    chosen = find_nominal()
+    if chosen is not None and chosen not in found:
+        found.append(chosen)
+    return found
+
+
 def find_measurement():
     return find_input((objects.Measurement.Type,))
 

@@ -17,8 +17,9 @@ from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
 from ..inspection.run_options import ReportSources, RunOptions
 from ..measurement.scan import open_rig
-from . import progress, resources, taskpanels, viewproviders  # noqa: F401 (registers VPs)
-from .command_base import Command, find_measurement, find_nominal, find_registration
+from . import forms, progress, resources, taskpanels, viewproviders  # noqa: F401 (VPs)
+from .command_base import (Command, find_measurement, find_nominal, find_registration,
+                           inputs_of, nominals_of)
 from .i18n import QT_TRANSLATE_NOOP, translate
 from .preferences import PreferencesPage
 from .session import RIG
@@ -45,6 +46,10 @@ def ask_directory(title):
 
 def open_in_browser(path):
     QtGui.QDesktopServices.openUrl(QtCore.QUrl.fromLocalFile(path))
+
+
+# The input panels' Browse buttons open this module's dialog, looked up when clicked.
+forms.FILE_DIALOG["open"] = lambda title, filters: ask_open_file(title, filters)
 
 
 # ---------------------------------------------------------------- document helpers
@@ -90,8 +95,20 @@ def run_action(title, function, *args, on_plan=None, rig=None, **kwargs):
 
     def job(p):
         with actions.interactive(progress=p, on_plan=on_plan, rig=rig):
-            return do_command(imports, call)
+            try:
+                return do_command(imports, call)
+            except InputError as exc:
+                # The GUI's user changes a control, not a command-line option.
+                raise InputError(forms.gui_text(str(exc))) from None
     return progress.run(title, job)
+
+
+def announced(title, obj):
+    """``obj``, named in the Report view as what the command ``title`` works on (the selected
+    one, else the newest): a command without a panel still says what it uses."""
+    FreeCAD.Console.PrintMessage(translate("BladeInspect", "BladeInspect: %s uses %s (%s)")
+                                 % (title, obj.Label, obj.Name) + "\n")
+    return obj
 
 
 def fit_view():
@@ -263,7 +280,7 @@ class Reconstruct(Command):
     is_active = "with_measurement"
 
     def Activated(self):
-        self.reconstruct(find_measurement())
+        self.reconstruct(announced(translate("BladeInspect", "Reconstruct"), find_measurement()))
 
     def reconstruct(self, measurement):
         """app.actions.reconstruct of the measurement."""
@@ -287,17 +304,28 @@ class Register(Command):
 
     is_active = "with_measurement_and_nominal"
 
-    def start(self, seed, **fit):
-        obj = self.register(find_measurement(), find_nominal(), seed,
-                            **fit)
+    def Activated(self):
+        doc = FreeCAD.ActiveDocument
+        FreeCADGui.Control.showDialog(self.panel(
+            self.start, nominals=nominals_of(doc), measurements=inputs_of(
+                doc, (objects.Measurement.Type,)),
+            nominal=find_nominal(), measurement=find_measurement()))
+
+    def start(self, nominal, measurement, seed, allow_mismatch=False, **fit):
+        doc = FreeCAD.ActiveDocument
+        obj = self.register(doc.getObject(measurement), doc.getObject(nominal), seed,
+                            allow_mismatch, **fit)
         if obj is not None:
             self.show(obj)
         return obj
 
-    def register(self, measurement, nominal_obj, seed=None, **fit):
-        """app.actions.register; ``fit``: the fit selector's choice (app.actions.fit_choice)."""
+    def register(self, measurement, nominal_obj, seed=None, allow_mismatch=False, **fit):
+        """app.actions.register; ``allow_mismatch`` keeps a scan that does not fit the CAD;
+        ``fit``: the fit selector's choice (app.actions.fit_choice)."""
         doc = measurement.Document
         seed = settings.value("Seed") if seed is None else seed
+        if allow_mismatch:
+            fit["allow_mismatch"] = True
         obj = run_action(translate("BladeInspect", "Register"), "register", doc.Name,
                          measurement.Name, nominal_obj.Name, int(seed),
                          tolerance=float(settings.value("ToleranceMm")), **fit)
@@ -322,7 +350,7 @@ class DeviationMap(Command):
     is_active = "with_registration"
 
     def Activated(self):
-        self.make(find_registration())
+        self.make(announced(translate("BladeInspect", "Deviation map"), find_registration()))
 
     def make(self, registration, limit=None):
         doc = registration.Document
@@ -354,7 +382,8 @@ class SectionAnalysis(Command):
     is_active = "with_registered_nominal"
 
     def Activated(self):
-        table = self.analyse(find_registration())
+        table = self.analyse(announced(translate("BladeInspect", "Section analysis"),
+                                       find_registration()))
         if table is not None:
             self.show(table)
 
@@ -390,7 +419,7 @@ class Report(Command):
     def Activated(self):
         out_dir = ask_directory(translate("BladeInspect", "Report folder"))
         if out_dir:
-            registration = find_registration()
+            registration = announced(translate("BladeInspect", "Report"), find_registration())
             summary = self.report(registration, out_dir)
             html = os.path.join(out_dir, "report.html")
             if summary is not None:
@@ -441,8 +470,15 @@ class Airfoil(Command):
 
     is_active = "with_registered_nominal"
 
-    def start(self, **options):
-        stage = self.analyse(find_registration(), **options)
+    def Activated(self):
+        doc = FreeCAD.ActiveDocument
+        FreeCADGui.Control.showDialog(self.panel(
+            self.start, registrations=[r for r in inputs_of(doc, (objects.Registration.Type,))
+                                       if r.Nominal is not None],
+            registration=find_registration()))
+
+    def start(self, registration, **options):
+        stage = self.analyse(FreeCAD.ActiveDocument.getObject(registration), **options)
         if stage is not None:
             self.show(stage.extras())
         return stage
@@ -462,6 +498,25 @@ class Airfoil(Command):
         taskpanels.show_panel(taskpanels.AirfoilPanel(analysis))
 
 
+class Help(Command):
+    name = "BladeInspect_Help"
+    menu = QT_TRANSLATE_NOOP("BladeInspect_Help", "BladeInspect user guide")
+    tip = QT_TRANSLATE_NOOP(
+        "BladeInspect_Help",
+        "Open the user guide: the workflows, their panels and what the results mean")
+    pixmap = "BladeInspect"
+
+    def Activated(self):
+        open_in_browser(user_guide_path())
+
+
+def user_guide_path():
+    """docs/user-guide.md of the installed workbench, else its README."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    guide = os.path.join(root, "docs", "user-guide.md")
+    return guide if os.path.exists(guide) else os.path.join(root, "README.md")
+
+
 class Preferences(Command):
     name = "BladeInspect_Preferences"
     menu = QT_TRANSLATE_NOOP("BladeInspect_Preferences", "Preferences...")
@@ -474,9 +529,12 @@ class Preferences(Command):
 
 
 COMMANDS = [DemoBlade(), LoadCad(), ConnectRig(), Scan(), ImportPoints(), Reconstruct(),
-            Register(), DeviationMap(), SectionAnalysis(), Airfoil(), Report(), Preferences()]
-TOOLBAR = [c.name for c in COMMANDS if c.name != Preferences.name]
-MENU = [c.name for c in COMMANDS]
+            Register(), DeviationMap(), SectionAnalysis(), Airfoil(), Report(), Preferences(),
+            Help()]
+TOOLBAR = [c.name for c in COMMANDS if c.name not in (Preferences.name, Help.name)]
+MENU = [c.name for c in COMMANDS if c.name != Help.name]
+# FreeCAD's Help menu gains the workbench's user guide while the workbench is active.
+HELP_MENU = [Help.name]
 BY_NAME = {c.name: c for c in COMMANDS}
 
 for _command in COMMANDS:

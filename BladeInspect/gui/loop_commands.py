@@ -21,6 +21,7 @@ from ..core.errors import InputError
 from ..inspection import characteristic_names as names
 from ..inspection.report import section_rows
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
+from ..rig.kinematics import read_rig_file
 from . import commands, progress, tables, taskpanels
 from .command_base import Command, find_nominal, find_registration
 from .i18n import QT_TRANSLATE_NOOP, translate
@@ -115,17 +116,20 @@ class InspectPanel(taskpanels.FormPanel):
                               "Nominal sections to measure, % of the span from hub to tip"))
         self.tolerance = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Tolerance"),
-            taskpanels.spin_box(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm"))
+            taskpanels.spin_box(settings.value("ToleranceMm"), 0.0001, 10.0, 4, "mm"),
+            QT_TRANSLATE_NOOP("BladeInspect", "The profile tolerance each section is judged "
+                              "against"))
         self.seed = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
             taskpanels.spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
             QT_TRANSLATE_NOOP("BladeInspect",
                               "Fixture pose of the simulated rig and the registration's sampling"))
-        self.rig_file = self.add_row(
+        self.rig_file = self.add_file_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Rig calibration"),
             QtGui.QLineEdit(LAST_RIG_FILE[0] or ""),
             QT_TRANSLATE_NOOP("BladeInspect",
-                              "RIG.json from Calibrate; empty: the nominal kinematics"))
+                              "RIG.json from Calibrate; empty: the nominal kinematics"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Rig calibration"), RIG_FILTER)
         self.airfoil = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Airfoil characteristics"), QtGui.QCheckBox(),
             QT_TRANSLATE_NOOP("BladeInspect", "Chord, stagger, thickness, edge radii, angles, "
@@ -134,8 +138,18 @@ class InspectPanel(taskpanels.FormPanel):
         self.airfoil.setChecked(True)
         self.fit = taskpanels.FitSelector()
         self.layout.addRow(self.fit)
-        self.layout.addRow(QtGui.QLabel(translate("BladeInspect", "Rig: %s") % (
+        self.layout.addRow(taskpanels.wrapped_label(translate("BladeInspect", "Rig: %s") % (
             RIG.spec if RIG.connected else translate("BladeInspect", "simulated (none connected)"))))
+
+    def validate(self):
+        def rig_file():
+            path = self.rig_file.text().strip()
+            if path:
+                read_rig_file(path)
+        checks = [self.check(self.heights, lambda: contracts.parse_section_heights(
+            self.heights.text(), translate("BladeInspect", "Section heights"))),
+            self.check(self.rig_file, rig_file)]
+        return all(checks)
 
     def options(self):
         return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
@@ -144,6 +158,8 @@ class InspectPanel(taskpanels.FormPanel):
                     **self.fit.values())
 
     def accept(self):
+        if not self.validate():
+            return False
         options = self.options()   # read before closing: closing deletes the widgets
         return taskpanels.close_then(self.on_accept, **options)
 

@@ -12,10 +12,13 @@ from ..app import registration_fit, settings
 from ..cad.demo_blade import BladeParams
 from ..core import decision
 from ..core.airfoil import CHORD_METHODS
+from ..core.errors import InputError
 from ..inspection import characteristic_names as names
 from ..inspection import fitting
+from ..inspection.airfoil_stage import parse_engine_axis, read_characteristics
 from ..inspection.result import rival_lines
 from . import tables
+from .forms import FormPanel, fit_field, form_layout, object_combo, wrapped_label
 from .i18n import QT_TRANSLATE_NOOP, translate
 
 
@@ -51,26 +54,6 @@ def spin_box(value, minimum, maximum, decimals=3, suffix=""):
     return box
 
 
-class FormPanel:
-    title = ""    # marked with QT_TRANSLATE_NOOP("BladeInspect", ...), translated when shown
-
-    def __init__(self):
-        self.form = QtGui.QWidget()
-        self.form.setWindowTitle(translate("BladeInspect", self.title))
-        self.layout = QtGui.QFormLayout(self.form)
-
-    def add_row(self, label, widget, tip=None):
-        """A form row; ``label`` and ``tip`` are translated here."""
-        if tip:
-            widget.setToolTip(translate("BladeInspect", tip))
-        self.layout.addRow(translate("BladeInspect", label), widget)
-        return widget
-
-    def reject(self):
-        FreeCADGui.Control.closeDialog()
-        return True
-
-
 # The demo blade's parameters (cad.demo_blade.BladeParams) as the panel names them, with
 # their units; a parameter not listed shows under its field name.
 DEMO_BLADE_LABELS = {
@@ -98,6 +81,10 @@ DEMO_BLADE_LABELS = {
 }
 
 
+DEMO_BLADE_TIP = QT_TRANSLATE_NOOP(
+    "BladeInspect", "A parameter of the parametric demo blade, interpolated from hub to tip")
+
+
 class DemoBladePanel(FormPanel):
     """BladeParams as spin boxes; OK builds the demo blade through on_accept(params)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Demo blade")
@@ -116,13 +103,20 @@ class DemoBladePanel(FormPanel):
                                                 (field.name.replace("_", " "), ""))
             box = spin_box(value, -1e4, 1e4, suffix=unit)
             self.boxes[field.name] = box
-            self.add_row(label, box)
+            self.add_row(label, box, DEMO_BLADE_TIP)
+        # BladeParams.validate names the field it refuses; its error shows under the last row.
+        self.errors[self.form] = self.errors[box]
 
     def params(self):
         return self.params_type(**{name: type(getattr(self.params_type(), name))(box.value())
                                    for name, box in self.boxes.items()})
 
+    def validate(self):
+        return self.check(self.form, lambda: self.params().validate())
+
     def accept(self):
+        if not self.validate():
+            return False
         params = self.params()   # read before closing: closing deletes the widgets
         return close_then(self.on_accept, params)
 
@@ -142,9 +136,14 @@ class ConnectRigPanel(FormPanel):
         for port in self._ports():
             self.port.addItem(port)
         self.seed = spin_box(settings.value("Seed"), 0, 2 ** 31 - 1)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Rig"), self.kind)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Port"), self.port)
-        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed (simulated)"), self.seed)
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Rig"), self.kind,
+                     QT_TRANSLATE_NOOP("BladeInspect", "The simulated rig measures the nominal "
+                                       "CAD; a serial port drives the real rig"))
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Port"), self.port,
+                     QT_TRANSLATE_NOOP("BladeInspect", "The rig's serial port"))
+        self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed (simulated)"), self.seed,
+                     QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the simulated rig's "
+                                       "fixture pose and noise"))
         self.kind.currentIndexChanged.connect(self._update)
         self._update()
 
@@ -166,7 +165,15 @@ class ConnectRigPanel(FormPanel):
             return "sim"
         return "serial:" + self.port.currentText().strip()
 
+    def validate(self):
+        def port():
+            if self.spec() == "serial:":
+                raise InputError(translate("BladeInspect", "Name the serial port"))
+        return self.check(self.port, port)
+
     def accept(self):
+        if not self.validate():
+            return False
         spec, seed = self.spec(), self.seed.value()
         return close_then(self.on_accept, spec, seed)
 
@@ -178,8 +185,10 @@ class ScanPanel(FormPanel):
     def __init__(self, on_accept):
         super().__init__()
         self.on_accept = on_accept
-        self.sections = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Sections"),
-                                     spin_box(settings.value("Sections"), 1, 200))
+        self.sections = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Sections"),
+            spin_box(settings.value("Sections"), 1, 200),
+            QT_TRANSLATE_NOOP("BladeInspect", "Sections scanned over the span"))
         self.spacing = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Section spacing"),
             spin_box(settings.value("SectionSpacingMm"), 0.0, 1000.0, 2, "mm"),
@@ -187,7 +196,8 @@ class ScanPanel(FormPanel):
                               "Distance between sections; 0 spreads them over the span"))
         self.point_spacing = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Point spacing"),
-            spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm"))
+            spin_box(settings.value("PointSpacingMm"), 0.005, 10.0, 3, "mm"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Distance between points along a section"))
         self.sides = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Sides"), spin_box(settings.value("Sides"), 1, 2),
             QT_TRANSLATE_NOOP("BladeInspect", "2 turns the part over to scan the other side"))
@@ -196,8 +206,10 @@ class ScanPanel(FormPanel):
             spin_box(settings.value("EpsilonMm"), 0.01, 50.0, 2, "mm"),
             QT_TRANSLATE_NOOP("BladeInspect", "Rescan a section until every point is within "
                                               "this distance of the sensor's standoff"))
-        self.seed = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
-                                 spin_box(settings.value("Seed"), 0, 2 ** 31 - 1))
+        self.seed = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
+            spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
+            QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the simulated rig's noise"))
 
     def options(self):
         spacing = self.spacing.value()
@@ -218,7 +230,7 @@ class FitSelector(QtGui.QGroupBox):
 
     def __init__(self):
         super().__init__(translate("BladeInspect", "Fit"))
-        layout = QtGui.QFormLayout(self)
+        layout = form_layout(self)
         self.objective = QtGui.QComboBox()
         self.objective.addItems(list(fitting.OBJECTIVE_NAMES))
         self.objective.setToolTip(translate(
@@ -250,7 +262,7 @@ class FitSelector(QtGui.QGroupBox):
                               (QT_TRANSLATE_NOOP("BladeInspect", "Decision rule"), self.rule),
                               (QT_TRANSLATE_NOOP("BladeInspect", "ICP weights"),
                                self.icp_weights)):
-            layout.addRow(translate("BladeInspect", label), widget)
+            layout.addRow(wrapped_label(translate("BladeInspect", label)), fit_field(widget))
 
     def values(self):
         """Keywords of app.actions.fit_choice (literals, for the console line)."""
@@ -263,22 +275,55 @@ class FitSelector(QtGui.QGroupBox):
 
 
 class RegisterPanel(FormPanel):
-    """The registration's seed and the fit to move it to."""
+    """Which CAD (nominal) and which measured points the registration uses, preselected from
+    the selection, its seed, whether a scan that does not fit the CAD is kept, and the fit to
+    move it to. on_accept(nominal name, measurement name, seed, allow_mismatch, **fit)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Register")
 
-    def __init__(self, on_accept):
+    def __init__(self, on_accept, nominals=(), measurements=(), nominal=None,
+                 measurement=None):
         super().__init__()
         self.on_accept = on_accept
+        self.nominal = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Nominal CAD"), object_combo(nominals, nominal),
+            QT_TRANSLATE_NOOP("BladeInspect", "The CAD the points are registered to (the "
+                              "selected one when a CAD is selected)"))
+        self.measurement = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Measured points"),
+            object_combo(measurements, measurement),
+            QT_TRANSLATE_NOOP("BladeInspect", "The point set to register (the selected one "
+                              "when a point set is selected)"))
         self.seed = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Seed"),
             spin_box(settings.value("Seed"), 0, 2 ** 31 - 1),
             QT_TRANSLATE_NOOP("BladeInspect", "Random seed of the coarse stage"))
+        self.allow_mismatch = self.add_wide_row(
+            QtGui.QCheckBox(translate("BladeInspect", "Allow mismatch")),
+            QT_TRANSLATE_NOOP("BladeInspect", "Keep the registration, with a warning, when "
+                              "too few points lie near the CAD's surface (another part's "
+                              "scan, or a part far out of tolerance); off: refuse it"))
         self.fit = FitSelector()
         self.layout.addRow(self.fit)
 
+    def validate(self):
+        ok = self.check(self.nominal, lambda: self._chosen(
+            self.nominal, translate("BladeInspect", "No nominal CAD in the document")))
+        return self.check(self.measurement, lambda: self._chosen(
+            self.measurement, translate("BladeInspect", "No measured points in the "
+                                        "document"))) and ok
+
+    @staticmethod
+    def _chosen(combo, missing):
+        if combo.currentIndex() < 0:
+            raise InputError(missing)
+
     def accept(self):
+        if not self.validate():
+            return False
+        nominal, measurement = self.nominal.currentData(), self.measurement.currentData()
         seed, fit = self.seed.value(), self.fit.values()
-        return close_then(self.on_accept, seed, **fit)
+        return close_then(self.on_accept, nominal, measurement, seed,
+                          self.allow_mismatch.isChecked(), **fit)
 
 
 def _escape(text):
@@ -426,19 +471,31 @@ class TablePanel(_ResultPanel):
 
 # ---------------------------------------------------------------- airfoil
 
+CHARACTERISTICS_FILTER = QT_TRANSLATE_NOOP("BladeInspect",
+                                           "Characteristics (*.csv);;All files (*)")
+
+
 class AirfoilOptionsPanel(FormPanel):
-    """The `airfoil` command's options: the characteristics file, chord method, engine axis."""
+    """The `airfoil` command's options: the registration it analyses, the characteristics file,
+    chord method, engine axis. on_accept(registration name, **options)."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Airfoil analysis")
 
-    def __init__(self, on_accept):
+    def __init__(self, on_accept, registrations=(), registration=None):
         super().__init__()
         self.on_accept = on_accept
-        self.characteristics = self.add_row(
+        self.registration = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Registration"),
+            object_combo(registrations, registration),
+            QT_TRANSLATE_NOOP("BladeInspect", "The registered measurement to analyse (the "
+                              "selected one when a registration is selected)"))
+        self.characteristics = self.add_file_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"), QtGui.QLineEdit(),
             QT_TRANSLATE_NOOP("BladeInspect", "CSV: characteristic,section,lower,upper"
-                              "[,nominal]; empty: every characteristic reported, none judged"))
-        self.chord = self.add_row(QT_TRANSLATE_NOOP("BladeInspect", "Chord"),
-                                  QtGui.QComboBox())
+                              "[,nominal]; empty: every characteristic reported, none judged"),
+            QT_TRANSLATE_NOOP("BladeInspect", "Characteristics file"), CHARACTERISTICS_FILTER)
+        self.chord = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Chord"), QtGui.QComboBox(),
+            QT_TRANSLATE_NOOP("BladeInspect", "How the chord line is drawn"))
         self.chord.addItems(list(CHORD_METHODS))
         self.axis = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Engine axis"), QtGui.QLineEdit("x"),
@@ -449,9 +506,29 @@ class AirfoilOptionsPanel(FormPanel):
                 "chord_method": self.chord.currentText(),
                 "engine_axis": self.axis.text().strip() or None}
 
+    def validate(self):
+        def registration():
+            if self.registration.currentIndex() < 0:
+                raise InputError(translate("BladeInspect", "No registration in the document"))
+
+        def characteristics():
+            path = self.characteristics.text().strip()
+            if path:
+                read_characteristics(path)
+        def axis():
+            text = self.axis.text().strip()
+            if text:
+                parse_engine_axis(text)
+        checks = [self.check(self.registration, registration),
+                  self.check(self.characteristics, characteristics),
+                  self.check(self.axis, axis)]
+        return all(checks)
+
     def accept(self):
-        options = self.options()
-        return close_then(self.on_accept, **options)
+        if not self.validate():
+            return False
+        registration, options = self.registration.currentData(), self.options()
+        return close_then(self.on_accept, registration, **options)
 
 
 class AirfoilPanel(_ResultPanel):

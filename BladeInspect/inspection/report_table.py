@@ -4,6 +4,7 @@ embedded PNG figures."""
 import base64
 import html
 import io
+import textwrap
 from dataclasses import dataclass
 
 # Resolution of the figures embedded in report.html.
@@ -64,7 +65,41 @@ def pdf_table(fig, rect, header, rows, style, title=None):
                      colWidths=style.col_widths)
     table.auto_set_font_size(False)
     table.set_fontsize(style.fontsize)
+    shrink_to_cells(fig, table)
     return ax
+
+
+# The smallest a cell's text is set on one line to fit its cell (pt); a text that needs less
+# is broken over lines that share the row's height (ROW_HEIGHT_PT).
+MIN_CELL_FONT_PT = 5.0
+
+
+def shrink_to_cells(fig, table):
+    """Fit the text of each cell that is wider than its cell (a long row label in a narrow
+    column): set smaller until it fits, down to MIN_CELL_FONT_PT, then broken over as many
+    lines as it needs in a font that puts them all in the row's height. Every other cell keeps
+    the table's size."""
+    renderer = fig.canvas.get_renderer()
+    for cell in table.get_celld().values():
+        text = cell.get_text()
+        if not text.get_text():
+            continue
+        room = cell.get_window_extent(renderer).width * (1.0 - 2.0 * cell.PAD)
+        need = text.get_window_extent(renderer).width
+        if need <= room or room <= 0:
+            continue
+        size = text.get_fontsize() * room / need * 0.97
+        if size >= MIN_CELL_FONT_PT:
+            text.set_fontsize(size)
+            continue
+        words = text.get_text()
+        for n_lines in range(2, 6):
+            size = min(MIN_CELL_FONT_PT, ROW_HEIGHT_PT / (1.25 * n_lines))
+            text.set_fontsize(size)
+            text.set_text("\n".join(textwrap.wrap(words, max(1, int(len(words) / n_lines) + 1),
+                                                   break_long_words=True)))
+            if text.get_window_extent(renderer).width <= room:
+                break
 
 
 # matplotlib sizes a table's rows for its default 10 pt text (1.2 x 10 pt) whatever font size is

@@ -62,7 +62,7 @@ def weight_model_for(pointset, choice=None, sensor=None, kinematics=None):
             np.asarray(pointset.columns["angle_deg"], dtype=float))))
         choice = "sensor" if has_beam else "snr"
         why = "default (%s): %s" % (DEFAULT_RULE, "the readings carry snr and angle_deg"
-                                    if has_beam else "no beam known (no snr or angle_deg)")
+                                    if has_beam else _no_beam_reason(pointset))
     else:
         why = "--weights %s" % choice
     if choice == "snr":
@@ -84,6 +84,16 @@ def weight_model_for(pointset, choice=None, sensor=None, kinematics=None):
                   % (np.asarray(BEAM_MACHINE).tolist(),
                      np.round(kinematics.axis_direction, 9).tolist()))
     return model, record
+
+
+def _no_beam_reason(pointset):
+    """Why the sensor weights are not the default for these readings: what they lack."""
+    missing = [name for name, absent in (("snr", pointset.snr is None),
+                                         ("angle_deg", "angle_deg" not in pointset.columns))
+               if absent]
+    if missing:
+        return "no beam known (no %s column)" % " and no ".join(missing)
+    return "no beam known (angle_deg is not finite in every row)"
 
 
 def weights_for_rows(xyz, snr, angle_deg, choice=None, kinematics=None, source="points"):

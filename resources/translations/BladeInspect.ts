@@ -34,6 +34,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>1: one side; 2: the part turned over to scan the other</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>2 turns the part over to scan the other side</source>
         <translation type="unfinished"></translation>
@@ -41,6 +46,21 @@
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>A letter (x, y, z, -x, ...) or a vector</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>A parameter of the parametric demo blade, interpolated from hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>A section is rescanned until every point lies within ε of the sensor's standoff</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Accuracy</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -96,6 +116,11 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Allow mismatch</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Angle of the chord named (its method) from the engine axis in the section plane, LE towards TE</source>
         <translation type="unfinished"></translation>
@@ -138,6 +163,11 @@
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect: %s uses %s (%s)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
         <source>BladeInspect: report in %s; ICP weights: %s</source>
         <translation type="unfinished"></translation>
     </message>
@@ -149,6 +179,11 @@
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>BladeInspect: the measured sections are kept in %s; './bladeinspect inspect --resume --out %s' with the same CAD, rig and options continues the inspection</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
+        <source>Browse...</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -271,10 +306,22 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Characteristics (*.csv);;All files (*)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Characteristics file</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
+        <source>Choose the file</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Chord</source>
         <translation type="unfinished"></translation>
@@ -310,12 +357,18 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Colour map limit</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Connect rig</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Decision rule</source>
         <translation type="unfinished"></translation>
@@ -362,11 +415,24 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Distance between points along a section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Distance between sections; 0 spreads them over the span</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Distance from the sensor to the middle of its working range</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Engine axis</source>
         <translation type="unfinished"></translation>
@@ -407,6 +473,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Free DOF</source>
         <translation type="unfinished"></translation>
@@ -417,6 +484,17 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Half the depth of the sensor's working range: it measures from zₛ − δ to zₛ + δ</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>How the chord line is drawn</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>ICP weights</source>
         <translation type="unfinished"></translation>
@@ -439,6 +517,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Inspection: Table 2 at the nominal sections</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Keep the registration, with a warning, when too few points lie near the CAD's surface (another part's scan, or a part far out of tolerance); off: refuse it</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -540,6 +623,7 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Measured points</source>
         <translation type="unfinished"></translation>
     </message>
@@ -554,12 +638,33 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Name the serial port</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>No measured points in the document</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>No nominal CAD in the document</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>No registration in the document</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>Nominal</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Nominal CAD</source>
         <translation type="unfinished"></translation>
     </message>
@@ -569,6 +674,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Objective</source>
         <translation type="unfinished"></translation>
@@ -599,6 +705,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Point spacing</source>
         <translation type="unfinished"></translation>
@@ -614,6 +721,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Points the sensor measures per second (the scan time estimate)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Port</source>
         <translation type="unfinished"></translation>
@@ -621,6 +733,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Pose error %.3f um = %.2f x its bound (%.3f um). Residual RMS %.4f mm (injected %.4f), min %.4f, max %.4f mm; paper: RMS 0.0019, min -0.0053, max 0.006.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Profile tolerance</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -655,8 +772,28 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Random seed</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Random seed of the coarse stage</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Random seed of the simulated rig's fixture pose and noise</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Random seed of the simulated rig's noise</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Rate</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -673,6 +810,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Registered points in the section's band</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Registration</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -696,11 +838,17 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Rescan criterion ε</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Rig</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Rig calibration</source>
         <translation type="unfinished"></translation>
@@ -732,6 +880,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Scan strategy</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Section</source>
@@ -758,6 +911,12 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Section heights</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Section heights (%)</source>
         <translation type="unfinished"></translation>
@@ -768,6 +927,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Section spacing</source>
         <translation type="unfinished"></translation>
@@ -783,6 +943,21 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Sections per scan</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Sections scanned over the span</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Sections the Scan command measures over the span</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Seed</source>
@@ -791,6 +966,16 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Seed (simulated)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Seed of the simulated rig and of the registration's sampling: the same seed repeats a run</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Sensor</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -819,8 +1004,18 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Sides scanned</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Simulated rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Simulation</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -857,6 +1052,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Standoff criterion ε</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Standoff zₛ</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -906,6 +1106,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The CAD the points are registered to (the selected one when a CAD is selected)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>The CAD's value (or the characteristics file's)</source>
         <translation type="unfinished"></translation>
@@ -931,6 +1136,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>The deviation at which the colour map saturates; 0: the profile tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>The fine ICP's weights: snr, the paper's SNR-linear weights; sensor, the sensor model's 1/(sigma_beam cos incidence)^2 (needs the readings' angle_deg); default: sensor when the points carry snr and angle_deg, else snr</source>
         <translation type="unfinished"></translation>
@@ -938,6 +1148,41 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>The measured value</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The point set to register (the selected one when a point set is selected)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>The profile tolerance each section is judged against</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>The profile tolerance each section is judged against (±, mm)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The registered measurement to analyse (the selected one when a registration is selected)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The rig's serial port</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>The sensor's stated accuracy, added to the tolerance when a scan is checked against the CAD</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The simulated rig measures the nominal CAD; a serial port drives the real rig</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -978,6 +1223,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Tolerance</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Tolerance and colour map</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1033,6 +1283,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>Working range ±δ</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Worst deviation</source>
         <translation type="unfinished"></translation>
@@ -1048,6 +1303,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Zone weights</source>
         <translation type="unfinished"></translation>
@@ -1123,6 +1379,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/preferences.py"/>
+        <source>points/s</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>reading %s</source>
         <translation type="unfinished"></translation>
@@ -1145,6 +1406,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/progress.py"/>
         <source>starting</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/forms.py"/>
+        <source>the Register panel's 'Allow mismatch' box</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1234,6 +1500,19 @@ k=2</source>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>Deviation map</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
+    <name>BladeInspect_Help</name>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>BladeInspect user guide</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/commands.py"/>
+        <source>Open the user guide: the workflows, their panels and what the results mean</source>
         <translation type="unfinished"></translation>
     </message>
 </context>
