@@ -400,28 +400,56 @@ class RegistrationPanel(_ResultPanel):
         layout.addWidget(self.text)
         sensitivity = registration_fit.sensitivity_of(obj)
         self.sensitivity = None
+        self.verdict_banner = None
         if sensitivity:
             self.sensitivity = sensitivity_widget(sensitivity)
             layout.addWidget(self.sensitivity)
+            # the verdict under the registration's own fit first: what the user came for
+            record = registration_fit.fit_record(obj) or {}
+            objective = record.get("objective")
+            verdict = (sensitivity.get("verdict_by_fit") or {}).get(objective)
+            if verdict is not None:
+                self.verdict_banner = tables.add_verdict(layout, verdict, translate(
+                    "BladeInspect", "The part's verdict under the %s fit (%s); the table below "
+                    "gives it under every fit.") % (objective, record.get("decision_rule")))
 
 
 class TablePanel(_ResultPanel):
     """A table of text cells with its header: the section analysis; ``sensitivity`` (a
     fit_sensitivity block) adds its table below."""
 
-    def __init__(self, title, header, rows, note="", sensitivity=None):
+    def __init__(self, title, header, rows, note="", sensitivity=None, verdict=None):
+        """``verdict``: inspection.verdict.judge's of the table: the part's verdict on top,
+        large, and each section's verdict, worst deviation, U and TUR first in the table."""
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(title)
         layout = QtGui.QVBoxLayout(self.form)
-        self.table = tables.section_table(header, rows)
+        self.verdict_banner = None
+        if verdict:
+            self.verdict_banner = tables.add_verdict(
+                layout, tables.part_verdict(verdict), verdict_details(verdict, len(rows)))
+            self.table = tables.section_verdict_table(header, rows, verdict)
+        else:
+            self.table = tables.section_table(header, rows)
         fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
         if note:
-            label = QtGui.QLabel(note)
+            label = QtGui.QLabel(tables.plus_minus(note))
             label.setWordWrap(True)
             layout.addWidget(label)
         if sensitivity:
             layout.addWidget(sensitivity_widget(sensitivity))
+
+
+def verdict_details(verdict, n_sections):
+    """The line under a part's verdict: what it judged, against what, by which rule."""
+    text = translate("BladeInspect", "%d sections and the out-of-tolerance spots judged "
+                     "against \u00b1%.3f mm (%s).") % (
+        n_sections, verdict["tolerance_mm"], verdict.get("decision_rule", ""))
+    if verdict.get("n_isolated_out"):
+        text += " " + translate("BladeInspect", "%d isolated points treated as sensor "
+                                "outliers.") % verdict["n_isolated_out"]
+    return text
 
 
 # ---------------------------------------------------------------- airfoil
@@ -462,11 +490,13 @@ class AirfoilPanel(_ResultPanel):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("BladeInspect", "Airfoil characteristics"))
         layout = QtGui.QVBoxLayout(self.form)
+        summary = (analysis.get("airfoil_verdict") or {}).get("summary", "")
+        # sections named by their nominal heights, as Table 2 names them
+        analysis = tables.named_by_height(analysis)
         # per section a line and its characteristics (gui.tables)
         self.rows = tables.airfoil_rows(analysis.get("airfoil", []))
         self.table = tables.airfoil_table(self.rows)
         self.table.setMinimumHeight(420)
-        layout.addWidget(self.table)
         # the failed characteristics by the names the table shows (result.json's summary,
         # with the field names, in the tooltip)
         verdict_ = analysis.get("airfoil_verdict") or {}
@@ -483,12 +513,20 @@ class AirfoilPanel(_ResultPanel):
                             settings_.get("uncertainty_method")))
         label = QtGui.QLabel("\n".join(line for line in lines if line))
         label.setWordWrap(True)
-        label.setToolTip(verdict_.get("summary", ""))
+        label.setToolTip(summary)
         layout.addWidget(label)
         self.verdict_label = label
+        layout.addWidget(self.table)
+        # the verdict first; a characteristic withheld as not measured is in no verdict
+        self.verdict_banner = tables.add_verdict(
+            layout, tables.part_verdict(verdict_), translate(
+                "BladeInspect", "Airfoil characteristics of %d sections; a value not "
+                "measured is shown without a verdict, with its reason.")
+            % len(analysis.get("airfoil", [])))
         # What the stage says it could not do well (sparse edges, non-circular ends): a
         # number shown without its caveat would be trusted where it should not be.
-        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"], note)
+        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"],
+                                tables.plus_minus(note))
                  for block in analysis.get("airfoil", []) for note in block.get("notes", [])]
         if notes:
             self.notes = QtGui.QTextBrowser()
