@@ -7,6 +7,8 @@ section, verdicts coloured. A characteristics table fits a 640 px panel without 
 sideways, its headers whole (tests/gui_loop_macro.py checks it; 560 px in
 tests/gui_airfoil_macro.py, where the unit and verdict columns wrap to leave the names'
 header its width: NamedRowsTable)."""
+import re
+
 from PySide import QtCore, QtGui
 
 from ..inspection import airfoil_stage as airfoil_mod
@@ -47,6 +49,9 @@ AIRFOIL_COLUMNS = (
 )
 # The column that takes the width left over (its names wrapped, whole in their tooltip).
 NAME_COLUMN = 0
+# The least share of the names' header a narrow panel may leave on its first line (broken
+# with a hyphen); narrower, the column keeps its header whole and the table scrolls sideways.
+NARROWEST_NAME_SHARE = 0.6
 VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
 # Sensitivity columns before and after the objectives'
 SENSITIVITY_LEADING = (AIRFOIL_COLUMNS[0], AIRFOIL_COLUMNS[1])
@@ -130,6 +135,7 @@ class NamedRowsTable(QtGui.QTableWidget):
         super().__init__(*args)
         self._sharing = False
         self._name_label = None    # the names' header as set, before any break
+        self._narrowed = False     # the names' column fixed at its header, the table scrolls
 
     def resizeEvent(self, event):   # noqa: N802 (Qt's name)
         super().resizeEvent(event)
@@ -186,8 +192,8 @@ class NamedRowsTable(QtGui.QTableWidget):
 
     def share_width(self):
         header = self.horizontalHeader()
-        if self._sharing or header.sectionResizeMode(self.name_column) != \
-                QtGui.QHeaderView.Stretch:
+        if self._sharing or (header.sectionResizeMode(self.name_column) !=
+                             QtGui.QHeaderView.Stretch and not self._narrowed):
             return
         self._sharing = True
         try:
@@ -206,7 +212,20 @@ class NamedRowsTable(QtGui.QTableWidget):
                 header.setSectionResizeMode(c, QtGui.QHeaderView.Fixed)
                 header.resizeSection(c, narrow)
                 spare += self._full_width(c) - narrow
-            self._break_name_header(spare)
+            if spare < NARROWEST_NAME_SHARE * need:
+                # a header broken that short no longer reads as its word (FreeCAD's default
+                # Combo View, about 300 px): the names' column keeps its header and longest
+                # word whole, the table scrolls sideways
+                header.setSectionResizeMode(self.name_column, QtGui.QHeaderView.Fixed)
+                header.resizeSection(self.name_column, max(need, self._word_width(
+                    self.name_column)))
+                self._narrowed = True
+                self._break_name_header(need)
+            else:
+                if self._narrowed:
+                    header.setSectionResizeMode(self.name_column, QtGui.QHeaderView.Stretch)
+                    self._narrowed = False
+                self._break_name_header(spare)
             # the wrapped cells' rows as tall as their lines
             for r in range(self.rowCount()):
                 if self.columnSpan(r, 0) == 1:
@@ -271,7 +290,7 @@ def airfoil_rows(blocks):
             shown = r["section"]
             line = tr("Section %s: %s") % (shown, tr(block.get("verdict") or ""))
             if block.get("summary"):    # what is not measured and why, in one line
-                line += " \u2014 " + block["summary"]
+                line += " \u2014 " + plus_minus(block["summary"])
             rows.append([line, block.get("verdict")])
         u = r["uncertainty"]
         expanded = r.get("U_k2") if r.get("U_k2") is not None else (
@@ -486,9 +505,6 @@ SECTION_VERDICT_COLUMNS = (
     (QT_TRANSLATE_NOOP("BladeInspect", "Verdict"),
      QT_TRANSLATE_NOOP("BladeInspect", "The section's worst deviation judged against the "
                                        "tolerance with its U: pass, not proven, fail")),
-    (QT_TRANSLATE_NOOP("BladeInspect", "Worst\nmm"),
-     QT_TRANSLATE_NOOP("BladeInspect", "The section's worst deviation from the CAD (signed; "
-                                       "isolated sensor outliers left out), mm")),
     (QT_TRANSLATE_NOOP("BladeInspect", "\u00b1U\nmm"),
      QT_TRANSLATE_NOOP("BladeInspect", "Expanded uncertainty U (k = 2) of the worst "
                                        "deviation, mm")),
@@ -499,7 +515,7 @@ SECTION_VERDICT_COLUMNS = (
 
 def section_verdict_rows(header, rows, verdict):
     """Table 2 (inspection.report.section_rows' header and rows) with each section's verdict
-    first: [(label, tip)] columns and rows of [name, verdict, worst, U, TUR, then the table's
+    first: [(label, tip)] columns and rows of [name, verdict, U, TUR, then the table's
     own columns after its label and height]; the verdict's sections matched by label."""
     by_label = {s["label"]: s for s in verdict.get("sections", [])}
     span = header.index("Span %")
@@ -511,17 +527,15 @@ def section_verdict_rows(header, rows, verdict):
         key = entry.get("verdict")
         if key is None and entry.get("pass") is not None:
             key = "pass" if entry["pass"] else "fail"
-        worst = entry.get("worst_deviation_mm")
         tur = entry.get("tur")
-        out.append([section_name(float(row[span])), key or "",
-                    _number(worst, True), _number(entry.get("U_mm")),
+        out.append([section_name(float(row[span])), key or "", _number(entry.get("U_mm")),
                     "" if tur is None else "%.1f" % tur]
                    + [cell for k, cell in enumerate(row) if k not in (0, span)])
     return columns, out
 
 
 def section_verdict_table(header, rows, verdict):
-    """Table 2 with the verdict, worst deviation, U and TUR of each section first (the
+    """Table 2 with the verdict, U and TUR of each section first (the
     section named by its height, its verdict coloured). Every column as wide as its header
     and cells (headers over two lines), the names' column too: a narrow panel (FreeCAD's
     default Combo View, about 300 px) scrolls sideways rather than cutting a number or a
@@ -569,3 +583,29 @@ def named_by_height(analysis):
         out["lean_bow"] = dict(lean_bow, largest_bow_section=rename.get(
             str(lean_bow["largest_bow_section"]), lean_bow["largest_bow_section"]))
     return out
+
+
+def _renamed_row(row, rename):
+    label, key = names.sensitivity_row_parts(row)
+    if label is None or label not in rename:
+        return row
+    what = key if key is not None else "worst deviation"
+    return dict(row, characteristic="section %s %s" % (rename[label], what))
+
+
+def sensitivity_named(sensitivity, rename):
+    """A copy of a fit_sensitivity block whose section rows name their sections by
+    ``rename`` ({label: section_name}), as Table 2 names them."""
+    if not rename:
+        return sensitivity
+    out = dict(sensitivity, rows=[_renamed_row(r, rename) for r in sensitivity["rows"]])
+    if sensitivity.get("largest_change"):
+        out["largest_change"] = _renamed_row(sensitivity["largest_change"], rename)
+    return out
+
+
+def breakable_paths(text):
+    """``text`` with a zero-width space after each "/" of an absolute path (a word that
+    starts with "/"), so that a wrapped label breaks a long folder's path at its separators
+    instead of widening the panel to hold it."""
+    return re.sub(r"(?<!\S)/\S+", lambda m: m.group(0).replace("/", "/\u200b"), text)

@@ -345,9 +345,11 @@ def fit_rows_height(table, max_rows):
                            + table.horizontalScrollBar().sizeHint().height())
 
 
-def sensitivity_widget(sensitivity):
+def sensitivity_widget(sensitivity, rename=None):
     """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change
-    (gui.tables: grouped by section, a value's cell coloured by its verdict)."""
+    (gui.tables: grouped by section, a value's cell coloured by its verdict); ``rename``:
+    {section label: name} (tables.section_name), the sections as Table 2 names them."""
+    sensitivity = tables.sensitivity_named(sensitivity, rename)
     box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
     layout = QtGui.QVBoxLayout(box)
     table = tables.sensitivity_table(sensitivity)
@@ -402,7 +404,10 @@ class RegistrationPanel(_ResultPanel):
         self.sensitivity = None
         self.verdict_banner = None
         if sensitivity:
-            self.sensitivity = sensitivity_widget(sensitivity)
+            # an inspection's sections by their planned heights, as Table 2 names them
+            heights = list(getattr(obj, "InspectionHeights", []) or [])
+            self.sensitivity = sensitivity_widget(sensitivity, {
+                str(k + 1): tables.section_name(h) for k, h in enumerate(heights)})
             layout.addWidget(self.sensitivity)
             # the verdict under the registration's own fit first: what the user came for
             record = registration_fit.fit_record(obj) or {}
@@ -422,8 +427,15 @@ class TablePanel(_ResultPanel):
         """``verdict``: inspection.verdict.judge's of the table: the part's verdict on top,
         large, and each section's verdict, worst deviation, U and TUR first in the table."""
         self.form = QtGui.QWidget()
-        self.form.setWindowTitle(title)
+        # The task box's title does not wrap: a long one ("Inspection: Table 2 at the nominal
+        # sections") would widen the panel past FreeCAD's default Combo View. Its first part
+        # is the title, the rest a wrapped line under the verdict.
+        head, _, rest = title.partition(": ")
+        self.form.setWindowTitle(head)
         layout = QtGui.QVBoxLayout(self.form)
+        # the details under the table (the weight model, the folder): the form's first label
+        self.note = QtGui.QLabel(tables.breakable_paths(tables.plus_minus(note)), self.form) \
+            if note else None
         self.verdict_banner = None
         if verdict:
             self.verdict_banner = tables.add_verdict(
@@ -431,14 +443,20 @@ class TablePanel(_ResultPanel):
             self.table = tables.section_verdict_table(header, rows, verdict)
         else:
             self.table = tables.section_table(header, rows)
+        if rest:
+            subtitle = QtGui.QLabel(rest)
+            subtitle.setWordWrap(True)
+            layout.insertWidget(0 if self.verdict_banner is None else 1, subtitle)
         fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
-        if note:
-            label = QtGui.QLabel(tables.plus_minus(note))
-            label.setWordWrap(True)
-            layout.addWidget(label)
+        if self.note is not None:
+            self.note.setWordWrap(True)
+            self.note.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+            layout.addWidget(self.note)
         if sensitivity:
-            layout.addWidget(sensitivity_widget(sensitivity))
+            span = header.index("Span %") if "Span %" in header else None
+            layout.addWidget(sensitivity_widget(sensitivity, None if span is None else {
+                row[0]: tables.section_name(float(row[span])) for row in rows}))
 
 
 def verdict_details(verdict, n_sections):
