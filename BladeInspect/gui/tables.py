@@ -190,6 +190,14 @@ class NamedRowsTable(QtGui.QTableWidget):
         word = max(metrics.horizontalAdvance(w) for x in lines for w in x.split())
         return max(word + pad, self._header_need(c))
 
+    def _longest_word(self, c):
+        """The column's longest word with a cell's margins (the size hint of a column with
+        group lines spanning it is theirs, not its cells')."""
+        metrics = self.fontMetrics()
+        words = [w for text in self._texts(c) for w in text.split()]
+        margin = 2 * self.style().pixelMetric(QtGui.QStyle.PM_FocusFrameHMargin, None, self) + 6
+        return max([metrics.horizontalAdvance(w) for w in words] + [0]) + margin
+
     def share_width(self):
         header = self.horizontalHeader()
         if self._sharing or (header.sectionResizeMode(self.name_column) !=
@@ -217,7 +225,7 @@ class NamedRowsTable(QtGui.QTableWidget):
                 # Combo View, about 300 px): the names' column keeps its header and longest
                 # word whole, the table scrolls sideways
                 header.setSectionResizeMode(self.name_column, QtGui.QHeaderView.Fixed)
-                header.resizeSection(self.name_column, max(need, self._word_width(
+                header.resizeSection(self.name_column, max(need, self._longest_word(
                     self.name_column)))
                 self._narrowed = True
                 self._break_name_header(need)

@@ -9,6 +9,16 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>%d isolated points treated as sensor outliers.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>%d sections and the out-of-tolerance spots judged against ±%.3f mm (%s).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>%s (not measured)</source>
         <translation type="unfinished"></translation>
@@ -68,6 +78,11 @@
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Airfoil characteristics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Airfoil characteristics of %d sections; a value not measured is shown without a verdict, with its reason.</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -373,12 +388,22 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Expanded uncertainty U (k = 2) of the worst deviation, mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
         <source>Expanded uncertainty U (k = 2): the decision's, else 2 u of the stated standard uncertainty</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Extent of the profile along the engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>FAIL</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -555,6 +580,16 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>NOT JUDGED</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>NOT PROVEN</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
         <source>Nominal</source>
         <translation type="unfinished"></translation>
     </message>
@@ -581,6 +616,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Outlier fraction</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>PASS</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -735,6 +775,12 @@ mm</source>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Section
+% span</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -901,8 +947,18 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>TUR</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Test uncertainty ratio: tolerance / U</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -938,6 +994,21 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>The measured value</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The part's verdict under the %s fit (%s); the table below gives it under every fit.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The section by its nominal height, % of the span from hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The section's worst deviation judged against the tolerance with its U: pass, not proven, fail</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1098,6 +1169,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>not measured</source>
         <translation type="unfinished"></translation>
@@ -1156,6 +1228,12 @@ mm</source>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>±U
 k=2</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>±U
+mm</source>
         <translation type="unfinished"></translation>
     </message>
 </context>
