@@ -523,18 +523,21 @@ class AirfoilPanel(_ResultPanel):
         if lean_bow:
             lines.append(translate("BladeInspect", "Lean and bow: largest bow at section %s.")
                          % lean_bow["largest_bow_section"])
-        settings_ = analysis.get("airfoil_settings", {})
-        if settings_:
-            lines.append(translate("BladeInspect", "Chord: %s; U = 2 x the %s (%s).")
-                         % (settings_.get("chord_method"),
-                            settings_.get("uncertainty_coverage"),
-                            settings_.get("uncertainty_method")))
         label = QtGui.QLabel("\n".join(line for line in lines if line))
         label.setWordWrap(True)
         label.setToolTip(summary)
         layout.addWidget(label)
         self.verdict_label = label
         layout.addWidget(self.table)
+        # how the values were measured and their U found: details, under the table
+        settings_ = analysis.get("airfoil_settings", {})
+        if settings_:
+            method = QtGui.QLabel(translate("BladeInspect", "Chord: %s; U = 2 x the %s (%s).")
+                                  % (settings_.get("chord_method"),
+                                     settings_.get("uncertainty_coverage"),
+                                     settings_.get("uncertainty_method")))
+            method.setWordWrap(True)
+            layout.addWidget(method)
         # the verdict first; a characteristic withheld as not measured is in no verdict
         self.verdict_banner = tables.add_verdict(
             layout, tables.part_verdict(verdict_), translate(
