@@ -197,7 +197,7 @@ def run():
         if panel is None:
             return
         check_banner("section analysis", panel, state["word"])
-        rows = check_section_table("section analysis", panel, state["verdict"])
+        rows = check_section_table("section analysis", panel, state["verdict"], exact=True)
         check("section analysis: each section's verdict as Inspect's",
               rows is not None and [r[0] for r in rows] == [r[0] for r in
                                                             state["inspect_rows"] or ()],
