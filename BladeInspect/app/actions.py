@@ -21,8 +21,7 @@ from ..core.errors import InputError
 from ..core.pointio import read_points
 from ..inspection import fitting
 from ..inspection import pipeline
-from ..inspection.sections import section_table
-from . import objects, settings
+from . import loop, objects, settings
 from .registration_fit import judge_fits
 
 MODULE = __name__          # "BladeInspect.app.actions": what a console line imports
@@ -173,19 +172,30 @@ def simulate(doc_name, seed=0, nominal=None, **options):
 
 
 def _registered_sections(reg, p):
-    """(Nominal, RegistrationResult, section table) of a Registration, as stored."""
+    """(Nominal, RegistrationResult, section table) of a Registration, as stored; an
+    inspection's table at its planned sections (app.loop.section_table_of)."""
     nominal = objects.nominal_of(reg.Nominal)
     p(0.2, "signed distances of the registered points")
     result = objects.registration_result(reg, nominal)
     p(0.5, "cutting sections")
-    return nominal, result, section_table(result, nominal)
+    return nominal, result, loop.section_table_of(reg, result, nominal)
 
 
-def section_analysis(doc_name, registration):
-    """The section table of the Registration named ``registration`` (inspection.sections),
-    its nominal profiles added to the document."""
+def section_analysis(doc_name, registration, tolerance=None):
+    """The section table of the Registration named ``registration`` (inspection.sections;
+    an inspection's at its planned sections), its nominal profiles added to the document.
+    The table's ``verdict`` is inspection.verdict.judge's against ``tolerance`` (None: the
+    preferences'; an inspection's own tolerance for an inspection), per section with U and
+    TUR."""
     doc, reg = _registration(doc_name, registration)
-    _, _, table = _registered_sections(reg, _progress())
+    tolerance = settings.value("ToleranceMm") if tolerance is None else float(tolerance)
+    p = _progress()
+    nominal = objects.nominal_of(reg.Nominal)
+    p(0.2, "signed distances of the registered points")
+    result = objects.registration_result(reg, nominal)
+    p(0.5, "cutting sections")
+    table, verdict = loop.judged_section_table(reg, result, nominal, tolerance)
+    table.verdict = verdict
     objects.make_section_profiles(doc, table, reg)
     return table
 
@@ -241,7 +251,7 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
     from ..inspection import airfoil_stage as airfoil_mod
     from ..inspection.closed_loop import run_inspect
     from ..inspection.run_options import RunOptions
-    from . import airfoil_objects, loop
+    from . import airfoil_objects
     airfoil_options = airfoil_mod.options_from_args() if airfoil else None
     doc = _document(doc_name)
     nominal_obj = _object(doc, nominal, "nominal")
@@ -269,7 +279,8 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
         registration = objects.make_registration(doc, result, measurement, nominal_obj,
                                                  seed, name="Inspection", fit_choice=choice)
         n_blind = int(np.count_nonzero(result.columns["phase"] == "blind"))
-        loop.mark_inspection(registration, heights, n_blind, out_dir)
+        loop.mark_inspection(registration, heights, n_blind, out_dir, tolerance=tolerance,
+                             airfoil=airfoil)
         deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
         profiles = objects.make_section_profiles(doc, summary["sections"], registration)
         stage = getattr(summary["sections"], "airfoil", None)

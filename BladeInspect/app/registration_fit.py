@@ -61,6 +61,10 @@ def add_properties(obj, add):
         hidden=True)
     add(obj, "App::PropertyString", "InlierCutJson", GROUP,
         "The fine ICP's per-point and neighbourhood cuts (core.icp.InlierCut)", hidden=True)
+    # The fine ICP's final weights: the worst deviations' U (inspection.uncertainty) of a
+    # reopened document, or of its section analysis, are then the run's own.
+    add(obj, "App::PropertyFloatList", "IcpWeights", GROUP,
+        "The fine ICP's final weight of each point", hidden=True)
 
 
 # InlierCut's per-point arrays as FloatList properties
@@ -134,6 +138,9 @@ def store(obj, result):
     for prop, field in CUT_ARRAYS.items():
         values = None if cut is None else getattr(cut, field)
         setattr(obj, prop, [] if values is None else np.asarray(values, dtype=float).tolist())
+    if "IcpWeights" in obj.PropertiesList:
+        weights = getattr(result, "icp_weights", None)
+        obj.IcpWeights = [] if weights is None else np.asarray(weights, dtype=float).tolist()
     hoods = None if cut is None else cut.neighbourhoods
     obj.InlierCutOrder = [] if hoods is None else np.asarray(hoods.order).tolist()
     obj.InlierCutJson = ("" if cut is None else json.dumps(
@@ -152,6 +159,8 @@ def restore(obj, result):
     the records it was stored with, so a report of it names the weights used."""
     result.weights = weights_record(obj)
     result.inlier_cut = inlier_cut_of(obj, len(result.deviation))
+    weights = np.asarray(getattr(obj, "IcpWeights", ()) or (), dtype=float)
+    result.icp_weights = weights if len(weights) == len(result.deviation) else None
 
 
 def inlier_cut_of(obj, n):

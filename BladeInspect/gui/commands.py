@@ -11,11 +11,11 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
-from ..app import actions, objects, registration_fit, settings
+from ..app import actions, loop, objects, settings
 from ..app.document import write_inspection_document
 from ..core.errors import InputError
 from ..inspection.report import section_rows, write_result_report
-from ..inspection.run_options import ReportSources, RunOptions
+from ..inspection.run_options import ReportSources
 from ..measurement.scan import open_rig
 from . import forms, progress, resources, taskpanels, viewproviders  # noqa: F401 (VPs)
 from .command_base import (Command, find_measurement, find_nominal, find_registration,
@@ -404,7 +404,7 @@ class SectionAnalysis(Command):
         header, rows = section_rows(table)
         taskpanels.show_panel(taskpanels.TablePanel(
             translate("BladeInspect", "Section analysis"), header, rows,
-            "; ".join(table.warnings)))
+            "; ".join(table.warnings), verdict=getattr(table, "verdict", None)))
 
 
 class Report(Command):
@@ -445,10 +445,11 @@ class Report(Command):
             nominal = objects.nominal_of(nominal_obj)
             result = objects.registration_result(registration, nominal)
             result.cad_source = cad_path or "built-in demo blade"
-            options = RunOptions(tolerance=settings.value("ToleranceMm"),
-                                 fit_choice=registration_fit.choice_of(registration))
+            # an inspection's report judges its sections, tolerance and airfoil as it did
+            options, planned = loop.report_options(registration, settings.value("ToleranceMm"))
             return write_result_report(result, nominal, out_dir, options, progress=p,
-                                       document=writer, sources=ReportSources(cad_path=cad_path))
+                                       document=writer,
+                                       sources=ReportSources(cad_path=cad_path, planned=planned))
         doc = registration.Document
         try:
             return progress.run(translate("BladeInspect", "Report"), job)

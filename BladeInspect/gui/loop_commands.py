@@ -81,14 +81,14 @@ def _hide_measured_frame(measurement):
         measurement.ViewObject.Visibility = False
 
 
-def _show_table(title, table, note, sensitivity=None, warnings=()):
+def _show_table(title, table, note, sensitivity=None, warnings=(), verdict=None):
     """Table 2 in a panel under ``note``, the result's ``warnings`` (result.json's, the
     planner's notes among them) and the table's; when the airfoil stage ran on the table, a
     button to its characteristics (the Airfoil command's panel)."""
     header, rows = section_rows(table)
     notes = list(dict.fromkeys([note] + list(warnings) + list(table.warnings)))
     panel = taskpanels.TablePanel(title, header, rows, "; ".join(n for n in notes if n),
-                                  sensitivity)
+                                  sensitivity, verdict=verdict)
     stage = getattr(table, "airfoil", None)
     if stage is not None:
         analysis = stage.extras()
@@ -306,7 +306,7 @@ class Inspect(Command):
         return _show_table(
             translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
             summary["sections"], note, summary["result"].fit_sensitivity,
-            summary["result"].warnings)
+            summary["result"].warnings, verdict=summary["verdict"])
 
 
 class Calibrate(Command):

@@ -7,6 +7,8 @@ section, verdicts coloured. A characteristics table fits a 640 px panel without 
 sideways, its headers whole (tests/gui_loop_macro.py checks it; 560 px in
 tests/gui_airfoil_macro.py, where the unit and verdict columns wrap to leave the names'
 header its width: NamedRowsTable)."""
+import re
+
 from PySide import QtCore, QtGui
 
 from ..inspection import airfoil_stage as airfoil_mod
@@ -16,8 +18,11 @@ from .i18n import QT_TRANSLATE_NOOP, translate
 # Cell colours of the verdicts (light, so that the text stays readable); a verdict not listed
 # (not judged) keeps the table's colour.
 VERDICT_COLOURS = {"pass": "#c8e6c9", "fail": "#ffcdd2", "not proven": "#ffe0b2",
-                   "not measured": "#ffcdd2"}
+                   # a toleranced value withheld is not proven, never a fail
+                   "not measured": "#ffe0b2"}
 GROUP_COLOUR = "#e0e0e0"
+# What a withheld value (null, with its reason) shows where its number would be
+NOT_MEASURED = QT_TRANSLATE_NOOP("BladeInspect", "not measured")
 
 AIRFOIL_COLUMNS = (
     (QT_TRANSLATE_NOOP("BladeInspect", "Characteristic"),
@@ -44,6 +49,9 @@ AIRFOIL_COLUMNS = (
 )
 # The column that takes the width left over (its names wrapped, whole in their tooltip).
 NAME_COLUMN = 0
+# The least share of the names' header a narrow panel may leave on its first line (broken
+# with a hyphen); narrower, the column keeps its header whole and the table scrolls sideways.
+NARROWEST_NAME_SHARE = 0.6
 VERDICT_COLUMN = len(AIRFOIL_COLUMNS) - 1
 # Sensitivity columns before and after the objectives'
 SENSITIVITY_LEADING = (AIRFOIL_COLUMNS[0], AIRFOIL_COLUMNS[1])
@@ -127,6 +135,7 @@ class NamedRowsTable(QtGui.QTableWidget):
         super().__init__(*args)
         self._sharing = False
         self._name_label = None    # the names' header as set, before any break
+        self._narrowed = False     # the names' column fixed at its header, the table scrolls
 
     def resizeEvent(self, event):   # noqa: N802 (Qt's name)
         super().resizeEvent(event)
@@ -181,10 +190,18 @@ class NamedRowsTable(QtGui.QTableWidget):
         word = max(metrics.horizontalAdvance(w) for x in lines for w in x.split())
         return max(word + pad, self._header_need(c))
 
+    def _longest_word(self, c):
+        """The column's longest word with a cell's margins (the size hint of a column with
+        group lines spanning it is theirs, not its cells')."""
+        metrics = self.fontMetrics()
+        words = [w for text in self._texts(c) for w in text.split()]
+        margin = 2 * self.style().pixelMetric(QtGui.QStyle.PM_FocusFrameHMargin, None, self) + 6
+        return max([metrics.horizontalAdvance(w) for w in words] + [0]) + margin
+
     def share_width(self):
         header = self.horizontalHeader()
-        if self._sharing or header.sectionResizeMode(self.name_column) != \
-                QtGui.QHeaderView.Stretch:
+        if self._sharing or (header.sectionResizeMode(self.name_column) !=
+                             QtGui.QHeaderView.Stretch and not self._narrowed):
             return
         self._sharing = True
         try:
@@ -203,7 +220,20 @@ class NamedRowsTable(QtGui.QTableWidget):
                 header.setSectionResizeMode(c, QtGui.QHeaderView.Fixed)
                 header.resizeSection(c, narrow)
                 spare += self._full_width(c) - narrow
-            self._break_name_header(spare)
+            if spare < NARROWEST_NAME_SHARE * need:
+                # a header broken that short no longer reads as its word (FreeCAD's default
+                # Combo View, about 300 px): the names' column keeps its header and longest
+                # word whole, the table scrolls sideways
+                header.setSectionResizeMode(self.name_column, QtGui.QHeaderView.Fixed)
+                header.resizeSection(self.name_column, max(need, self._longest_word(
+                    self.name_column)))
+                self._narrowed = True
+                self._break_name_header(need)
+            else:
+                if self._narrowed:
+                    header.setSectionResizeMode(self.name_column, QtGui.QHeaderView.Stretch)
+                    self._narrowed = False
+                self._break_name_header(spare)
             # the wrapped cells' rows as tall as their lines
             for r in range(self.rowCount()):
                 if self.columnSpan(r, 0) == 1:
@@ -253,9 +283,11 @@ def tolerance_text(lower, upper):
 # ---------------------------------------------------------------- airfoil characteristics
 
 def airfoil_rows(blocks):
-    """The characteristics table's rows: per section a group line ``[text, verdict]``, then
-    per characteristic [key, name, unit, nominal, actual, deviation, U (k = 2; the decision's,
-    else 2u of the block's standard uncertainty), tolerance, verdict] (from
+    """The characteristics table's rows (the blocks' sections named as named_by_height
+    names them): per section a group line ``[text, verdict]``, then
+    per characteristic [key, name, unit, nominal, actual ("not measured" when withheld),
+    deviation, U (k = 2; the decision's, else 2u of the block's standard uncertainty),
+    tolerance, verdict, the reason a value is withheld or None] (from
     inspection.airfoil_stage.csv_rows, by its column names)."""
     by_label = {b["label"]: b for b in blocks}
     rows, shown = [], None
@@ -264,19 +296,22 @@ def airfoil_rows(blocks):
         block = by_label[r["section"]]
         if r["section"] != shown:
             shown = r["section"]
-            line = tr("Section %s, %.1f %% span: %s") % (
-                shown, block["height_pct"], tr(block.get("verdict") or ""))
+            line = tr("Section %s: %s") % (shown, tr(block.get("verdict") or ""))
             if block.get("summary"):    # what is not measured and why, in one line
-                line += " \u2014 " + block["summary"]
+                line += " \u2014 " + plus_minus(block["summary"])
             rows.append([line, block.get("verdict")])
         u = r["uncertainty"]
         expanded = r.get("U_k2") if r.get("U_k2") is not None else (
             None if u is None else 2.0 * u)
         key = r["characteristic"]
+        # a value withheld (null) says so where the number would be, its reason in the tooltip
+        reason = (block.get("withheld") or {}).get(key.split("[")[0]) \
+            if r["measured"] is None else None
         rows.append([key, names.display_name(key, block["nominal"], tr),
-                     names.unit(key, tr), _number(r["nominal"]), _number(r["measured"]),
+                     names.unit(key, tr), _number(r["nominal"]),
+                     tr(NOT_MEASURED) if reason else _number(r["measured"]),
                      _number(r["deviation"], True), _number(expanded),
-                     tolerance_text(r["lower"], r["upper"]), r["verdict"]])
+                     tolerance_text(r["lower"], r["upper"]), r["verdict"], reason])
     return rows
 
 
@@ -290,11 +325,15 @@ def airfoil_table(rows):
             _group_row(table, r, *row)
             continue
         key, name, unit = row[:3]
+        reason = plus_minus(row[9]) if row[9] else None
         table.setItem(r, 0, _item(name, "%s\n%s" % (name, names.meaning(key, tr))))
         table.setItem(r, 1, _item(unit))
-        for c, text in enumerate(row[3:-1], 2):
-            table.setItem(r, c, _item(text, align=NUMBER))
-        table.setItem(r, VERDICT_COLUMN, verdict_item(row[-1]))
+        for c, text in enumerate(row[3:8], 2):
+            table.setItem(r, c, _item(text, tip=reason if c == 3 else None, align=NUMBER))
+        verdict = verdict_item(row[8])
+        if reason:
+            verdict.setToolTip(reason)
+        table.setItem(r, VERDICT_COLUMN, verdict)
     return fit_columns(table)
 
 
@@ -397,3 +436,184 @@ def section_table(header, rows):
                                            for c in range(table.columnCount())] + [1]))
     header_view.setSectionResizeMode(QtGui.QHeaderView.Stretch)
     return table
+
+
+# ---------------------------------------------------------------- the verdict first
+
+# The part's verdict as a user reads it first: the word, in strong colours (white text).
+VERDICT_WORDS = {"pass": QT_TRANSLATE_NOOP("BladeInspect", "PASS"),
+                 "not proven": QT_TRANSLATE_NOOP("BladeInspect", "NOT PROVEN"),
+                 "fail": QT_TRANSLATE_NOOP("BladeInspect", "FAIL"),
+                 None: QT_TRANSLATE_NOOP("BladeInspect", "NOT JUDGED")}
+BANNER_COLOURS = {"pass": "#2e7d32", "not proven": "#e65100", "fail": "#c62828",
+                  None: "#616161"}
+# The verdict's word this many times the body's font size
+BANNER_SCALE = 1.8
+
+
+def plus_minus(text):
+    """A text for the screen: ASCII "+-" (result.json's summaries) as "±"."""
+    return text.replace("+-", "\u00b1")
+
+
+def part_verdict(verdict):
+    """pass, not proven, fail (core.decision) of a verdict dict (inspection.verdict.judge's,
+    or a fit-sensitivity cell's), None when nothing was judged; "pass" only when the
+    verdict's own pass flag agrees (a not proven is never rounded to pass)."""
+    if not verdict:
+        return None
+    key = verdict.get("verdict")
+    if key is None and verdict.get("pass") is not None:
+        key = "pass" if verdict["pass"] else "fail"
+    if key == "pass" and verdict.get("pass") is False:
+        key = "fail"
+    return key
+
+
+def verdict_banner(key, details=""):
+    """The verdict first: a label with the word (PASS, NOT PROVEN, FAIL) large and white on
+    its colour, and under it ``details`` (what was judged against what; the tolerance, the
+    rule) in the body's size, wrapped. Returns (banner, details label or None)."""
+    banner = QtGui.QLabel(tr(VERDICT_WORDS.get(key, VERDICT_WORDS[None])))
+    font = banner.font()
+    font.setBold(True)
+    font.setPointSizeF(font.pointSizeF() * BANNER_SCALE)
+    banner.setFont(font)
+    banner.setAlignment(QtCore.Qt.AlignCenter)
+    banner.setStyleSheet("QLabel { color: white; background-color: %s; padding: 4px; }"
+                         % BANNER_COLOURS.get(key, BANNER_COLOURS[None]))
+    banner.setWordWrap(True)
+    banner.verdict = key
+    label = None
+    if details:
+        label = QtGui.QLabel(plus_minus(details))
+        label.setWordWrap(True)
+    return banner, label
+
+
+def add_verdict(layout, key, details=""):
+    """verdict_banner's labels on top of ``layout``; the banner (its details as .details)."""
+    banner, label = verdict_banner(key, details)
+    layout.insertWidget(0, banner)
+    if label is not None:
+        layout.insertWidget(1, label)
+    banner.details = label
+    return banner
+
+
+def section_name(height_pct):
+    """A section by its nominal height, as every panel names it: "50 %" (of the span)."""
+    return "%g %%" % round(float(height_pct), 1)
+
+
+SECTION_VERDICT_COLUMNS = (
+    (QT_TRANSLATE_NOOP("BladeInspect", "Section\n% span"),
+     QT_TRANSLATE_NOOP("BladeInspect", "The section by its nominal height, % of the span from "
+                                       "hub to tip")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "Verdict"),
+     QT_TRANSLATE_NOOP("BladeInspect", "The section's worst deviation judged against the "
+                                       "tolerance with its U: pass, not proven, fail")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "\u00b1U\nmm"),
+     QT_TRANSLATE_NOOP("BladeInspect", "Expanded uncertainty U (k = 2) of the worst "
+                                       "deviation, mm")),
+    (QT_TRANSLATE_NOOP("BladeInspect", "TUR"),
+     QT_TRANSLATE_NOOP("BladeInspect", "Test uncertainty ratio: tolerance / U")),
+)
+
+
+def section_verdict_rows(header, rows, verdict):
+    """Table 2 (inspection.report.section_rows' header and rows) with each section's verdict
+    first: [(label, tip)] columns and rows of [name, verdict, U, TUR, then the table's
+    own columns after its label and height]; the verdict's sections matched by label."""
+    by_label = {s["label"]: s for s in verdict.get("sections", [])}
+    span = header.index("Span %")
+    columns = [(tr(label), tr(tip)) for label, tip in SECTION_VERDICT_COLUMNS] + [
+        names.section_column(h, tr) for k, h in enumerate(header) if k not in (0, span)]
+    out = []
+    for row in rows:
+        entry = by_label.get(row[0], {})
+        key = entry.get("verdict")
+        if key is None and entry.get("pass") is not None:
+            key = "pass" if entry["pass"] else "fail"
+        tur = entry.get("tur")
+        out.append([section_name(float(row[span])), key or "", _number(entry.get("U_mm")),
+                    "" if tur is None else "%.1f" % tur]
+                   + [cell for k, cell in enumerate(row) if k not in (0, span)])
+    return columns, out
+
+
+def section_verdict_table(header, rows, verdict):
+    """Table 2 with the verdict, U and TUR of each section first (the
+    section named by its height, its verdict coloured). Every column as wide as its header
+    and cells (headers over two lines), the names' column too: a narrow panel (FreeCAD's
+    default Combo View, about 300 px) scrolls sideways rather than cutting a number or a
+    word."""
+    columns, out = section_verdict_rows(header, rows, verdict)
+    table = QtGui.QTableWidget(len(out), len(columns))
+    _header(table, columns, _same)
+    for r, row in enumerate(out):
+        table.setItem(r, 0, _item(row[0]))
+        table.setItem(r, 1, verdict_item(row[1]))
+        for c, cell in enumerate(row[2:], 2):
+            table.setItem(r, c, _item(str(cell), align=NUMBER))
+    table.verticalHeader().setVisible(False)
+    table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
+    table.setWordWrap(False)
+    table.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAsNeeded)
+    table.horizontalHeader().setSectionResizeMode(QtGui.QHeaderView.ResizeToContents)
+    return table
+
+
+def _renamed_entry(entry, rename):
+    # an airfoil_verdict entry "section 2: chord_mm" under its section's new name
+    if not entry.startswith("section ") or ": " not in entry:
+        return entry
+    label, _, key = entry[len("section "):].rpartition(": ")
+    return "section %s: %s" % (rename.get(label, label), key)
+
+
+def named_by_height(analysis):
+    """A copy of an airfoil analysis (result.json's airfoil fields) whose sections are named
+    by their nominal heights (section_name), in its blocks, its verdict's entries and its
+    lean and bow, as Table 2 names them."""
+    blocks = analysis.get("airfoil", [])
+    rename = {str(b["label"]): section_name(b["height_pct"]) for b in blocks
+              if b.get("height_pct") is not None}
+    out = dict(analysis, airfoil=[dict(b, label=rename.get(str(b["label"]), b["label"]))
+                                  for b in blocks])
+    verdict = analysis.get("airfoil_verdict")
+    if verdict:
+        out["airfoil_verdict"] = dict(verdict, **{
+            k: [_renamed_entry(e, rename) for e in verdict[k]]
+            for k in ("failed", "not_proven") if verdict.get(k)})
+    lean_bow = analysis.get("lean_bow")
+    if lean_bow and "largest_bow_section" in lean_bow:
+        out["lean_bow"] = dict(lean_bow, largest_bow_section=rename.get(
+            str(lean_bow["largest_bow_section"]), lean_bow["largest_bow_section"]))
+    return out
+
+
+def _renamed_row(row, rename):
+    label, key = names.sensitivity_row_parts(row)
+    if label is None or label not in rename:
+        return row
+    what = key if key is not None else "worst deviation"
+    return dict(row, characteristic="section %s %s" % (rename[label], what))
+
+
+def sensitivity_named(sensitivity, rename):
+    """A copy of a fit_sensitivity block whose section rows name their sections by
+    ``rename`` ({label: section_name}), as Table 2 names them."""
+    if not rename:
+        return sensitivity
+    out = dict(sensitivity, rows=[_renamed_row(r, rename) for r in sensitivity["rows"]])
+    if sensitivity.get("largest_change"):
+        out["largest_change"] = _renamed_row(sensitivity["largest_change"], rename)
+    return out
+
+
+def breakable_paths(text):
+    """``text`` with a zero-width space after each "/" of an absolute path (a word that
+    starts with "/"), so that a wrapped label breaks a long folder's path at its separators
+    instead of widening the panel to hold it."""
+    return re.sub(r"(?<!\S)/\S+", lambda m: m.group(0).replace("/", "/\u200b"), text)

@@ -390,9 +390,11 @@ def fit_rows_height(table, max_rows):
                            + table.horizontalScrollBar().sizeHint().height())
 
 
-def sensitivity_widget(sensitivity):
+def sensitivity_widget(sensitivity, rename=None):
     """The fit-sensitivity table (result.json's fit_sensitivity) with its largest change
-    (gui.tables: grouped by section, a value's cell coloured by its verdict)."""
+    (gui.tables: grouped by section, a value's cell coloured by its verdict); ``rename``:
+    {section label: name} (tables.section_name), the sections as Table 2 names them."""
+    sensitivity = tables.sensitivity_named(sensitivity, rename)
     box = QtGui.QGroupBox(translate("BladeInspect", "Fit sensitivity"))
     layout = QtGui.QVBoxLayout(box)
     table = tables.sensitivity_table(sensitivity)
@@ -445,28 +447,72 @@ class RegistrationPanel(_ResultPanel):
         layout.addWidget(self.text)
         sensitivity = registration_fit.sensitivity_of(obj)
         self.sensitivity = None
+        self.verdict_banner = None
         if sensitivity:
-            self.sensitivity = sensitivity_widget(sensitivity)
+            # an inspection's sections by their planned heights, as Table 2 names them
+            heights = list(getattr(obj, "InspectionHeights", []) or [])
+            self.sensitivity = sensitivity_widget(sensitivity, {
+                str(k + 1): tables.section_name(h) for k, h in enumerate(heights)})
             layout.addWidget(self.sensitivity)
+            # the verdict under the registration's own fit first: what the user came for
+            record = registration_fit.fit_record(obj) or {}
+            objective = record.get("objective")
+            verdict = (sensitivity.get("verdict_by_fit") or {}).get(objective)
+            if verdict is not None:
+                self.verdict_banner = tables.add_verdict(layout, verdict, translate(
+                    "BladeInspect", "The part's verdict under the %s fit (%s); the table below "
+                    "gives it under every fit.") % (objective, record.get("decision_rule")))
 
 
 class TablePanel(_ResultPanel):
     """A table of text cells with its header: the section analysis; ``sensitivity`` (a
     fit_sensitivity block) adds its table below."""
 
-    def __init__(self, title, header, rows, note="", sensitivity=None):
+    def __init__(self, title, header, rows, note="", sensitivity=None, verdict=None):
+        """``verdict``: inspection.verdict.judge's of the table: the part's verdict on top,
+        large, and each section's verdict, worst deviation, U and TUR first in the table."""
         self.form = QtGui.QWidget()
-        self.form.setWindowTitle(title)
+        # The task box's title does not wrap: a long one ("Inspection: Table 2 at the nominal
+        # sections") would widen the panel past FreeCAD's default Combo View. Its first part
+        # is the title, the rest a wrapped line under the verdict.
+        head, _, rest = title.partition(": ")
+        self.form.setWindowTitle(head)
         layout = QtGui.QVBoxLayout(self.form)
-        self.table = tables.section_table(header, rows)
+        # the details under the table (the weight model, the folder): the form's first label
+        self.note = QtGui.QLabel(tables.breakable_paths(tables.plus_minus(note)), self.form) \
+            if note else None
+        self.verdict_banner = None
+        if verdict:
+            self.verdict_banner = tables.add_verdict(
+                layout, tables.part_verdict(verdict), verdict_details(verdict, len(rows)))
+            self.table = tables.section_verdict_table(header, rows, verdict)
+        else:
+            self.table = tables.section_table(header, rows)
+        if rest:
+            subtitle = QtGui.QLabel(rest)
+            subtitle.setWordWrap(True)
+            layout.insertWidget(0 if self.verdict_banner is None else 1, subtitle)
         fit_rows_height(self.table, TABLE_ROWS_SHOWN)
         layout.addWidget(self.table)
-        if note:
-            label = QtGui.QLabel(note)
-            label.setWordWrap(True)
-            layout.addWidget(label)
+        if self.note is not None:
+            self.note.setWordWrap(True)
+            self.note.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+            layout.addWidget(self.note)
         if sensitivity:
-            layout.addWidget(sensitivity_widget(sensitivity))
+            span = header.index("Span %") if "Span %" in header else None
+            layout.addWidget(sensitivity_widget(sensitivity, None if span is None else {
+                row[0]: tables.section_name(float(row[span])) for row in rows}))
+
+
+def verdict_details(verdict, n_sections):
+    """The line under a part's verdict: what it judged, against what, by which rule."""
+    text = translate("BladeInspect", "%d sections and the out-of-tolerance spots judged "
+                     "against \u00b1%.3f mm (%s).") % (
+        n_sections, verdict["tolerance_mm"], verdict.get("decision_rule", ""))
+    if verdict.get("n_isolated_out"):
+        text += " " + translate("BladeInspect", "%d isolated points treated as sensor "
+                                "outliers.") % verdict["n_isolated_out"]
+    return text
 
 
 # ---------------------------------------------------------------- airfoil
@@ -539,11 +585,13 @@ class AirfoilPanel(_ResultPanel):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("BladeInspect", "Airfoil characteristics"))
         layout = QtGui.QVBoxLayout(self.form)
+        summary = (analysis.get("airfoil_verdict") or {}).get("summary", "")
+        # sections named by their nominal heights, as Table 2 names them
+        analysis = tables.named_by_height(analysis)
         # per section a line and its characteristics (gui.tables)
         self.rows = tables.airfoil_rows(analysis.get("airfoil", []))
         self.table = tables.airfoil_table(self.rows)
         self.table.setMinimumHeight(420)
-        layout.addWidget(self.table)
         # the failed characteristics by the names the table shows (result.json's summary,
         # with the field names, in the tooltip)
         verdict_ = analysis.get("airfoil_verdict") or {}
@@ -552,20 +600,31 @@ class AirfoilPanel(_ResultPanel):
         if lean_bow:
             lines.append(translate("BladeInspect", "Lean and bow: largest bow at section %s.")
                          % lean_bow["largest_bow_section"])
-        settings_ = analysis.get("airfoil_settings", {})
-        if settings_:
-            lines.append(translate("BladeInspect", "Chord: %s; U = 2 x the %s (%s).")
-                         % (settings_.get("chord_method"),
-                            settings_.get("uncertainty_coverage"),
-                            settings_.get("uncertainty_method")))
         label = QtGui.QLabel("\n".join(line for line in lines if line))
         label.setWordWrap(True)
-        label.setToolTip(verdict_.get("summary", ""))
+        label.setToolTip(summary)
         layout.addWidget(label)
         self.verdict_label = label
+        layout.addWidget(self.table)
+        # how the values were measured and their U found: details, under the table
+        settings_ = analysis.get("airfoil_settings", {})
+        if settings_:
+            method = QtGui.QLabel(translate("BladeInspect", "Chord: %s; U = 2 x the %s (%s).")
+                                  % (settings_.get("chord_method"),
+                                     settings_.get("uncertainty_coverage"),
+                                     settings_.get("uncertainty_method")))
+            method.setWordWrap(True)
+            layout.addWidget(method)
+        # the verdict first; a characteristic withheld as not measured is in no verdict
+        self.verdict_banner = tables.add_verdict(
+            layout, tables.part_verdict(verdict_), translate(
+                "BladeInspect", "Airfoil characteristics of %d sections; a value not "
+                "measured is shown without a verdict, with its reason.")
+            % len(analysis.get("airfoil", [])))
         # What the stage says it could not do well (sparse edges, non-circular ends): a
         # number shown without its caveat would be trusted where it should not be.
-        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"], note)
+        notes = ["%s %s: %s" % (translate("BladeInspect", "Section"), block["label"],
+                                tables.plus_minus(note))
                  for block in analysis.get("airfoil", []) for note in block.get("notes", [])]
         if notes:
             self.notes = QtGui.QTextBrowser()

@@ -49,6 +49,7 @@ from . import pipeline
 from . import sections as sections_mod
 from . import weighting
 from .judging import fit_and_judge
+from .planned_sections import PlannedSections
 from .checkpoint import LIVE_FOLDER, Checkpoint, inspection_identity, save_plan, start_or_resume
 from .checks import unmeasured_warning
 from .report import write_report
@@ -701,15 +702,10 @@ def _judge_after_blind(run, result, n_blind, n_rows, span_axis):
     indexed back into the whole result, and the verdict on every point; the result moved to
     the pose of the run's fit first (inspection.fitting), its fit sensitivity recorded."""
     nominal, options = run.nominal, run.options
+    planned = PlannedSections(tuple(options.section_heights), n_blind, n_rows)
 
     def planned_table(fitted):
-        rows = np.arange(n_blind, n_blind + n_rows)
-        table = sections_mod.section_table(fitted.planned_rows(rows), nominal,
-                                           heights_pct=options.section_heights,
-                                           span_axis=span_axis, cmm=run.cmm_data)
-        for sec in table.sections:
-            sec.point_index = sec.point_index + n_blind
-        return table
+        return planned.table(fitted, nominal, span_axis=span_axis, cmm=run.cmm_data)
     return fit_and_judge(result, nominal, options.fit_choice, options.tolerance, planned_table,
                          measurement_model=options.measurement_model)
 

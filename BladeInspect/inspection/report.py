@@ -604,7 +604,7 @@ def write_result_report(result, nominal, out_dir, options=None, progress=None, d
     t0 = time.perf_counter()
     progress(0.82, "section table")
     table, verdict = _fit_and_judge(result, nominal, options.replace(tolerance=tolerance),
-                                    sources.cmm_data)
+                                    sources.cmm_data, sources.planned)
     if options.airfoil is not None:   # the airfoil characteristics join the verdict
         airfoil_mod.attach(result, nominal, table, verdict, options.airfoil)
     result.timing_s["sections"] = time.perf_counter() - t0
@@ -631,12 +631,16 @@ def write_result_report(result, nominal, out_dir, options=None, progress=None, d
             "pdf_pages": files["pdf_pages"]}
 
 
-def _fit_and_judge(result, nominal, options, cmm_data):
+def _fit_and_judge(result, nominal, options, cmm_data, planned=None):
     """(section table, verdict) of ``result`` moved to the pose of the fit ``options`` choose
-    (inspection.judging), the table at their section heights with the CMM's columns."""
-    return judging.fit_and_judge(
-        result, nominal, options.fit_choice, options.tolerance,
-        lambda fitted: sections_mod.section_table(fitted, nominal,
-                                                  heights_pct=options.section_heights,
-                                                  cmm=cmm_data),
-        measurement_model=options.measurement_model)
+    (inspection.judging), the table at their section heights with the CMM's columns, or at an
+    inspection's ``planned`` sections (inspection.planned_sections) from its planned rows."""
+    if planned is not None:
+        def table_of(fitted):
+            return planned.table(fitted, nominal, cmm=cmm_data)
+    else:
+        def table_of(fitted):
+            return sections_mod.section_table(fitted, nominal,
+                                              heights_pct=options.section_heights, cmm=cmm_data)
+    return judging.fit_and_judge(result, nominal, options.fit_choice, options.tolerance,
+                                 table_of, measurement_model=options.measurement_model)

@@ -102,10 +102,13 @@ class ReportSources:
     """What a report is made from besides the registration (report.write_result_report):
     ``cad_path`` the nominal's CAD file (None: the demo blade), ``cmm_data`` the CMM's table
     (sections.read_cmm; None: none), ``batch_inputs`` what a batch made the file from
-    (inspection.batch.inputs_record; None: not a batch's)."""
+    (inspection.batch.inputs_record; None: not a batch's), ``planned`` an inspection's
+    sections (inspection.planned_sections.PlannedSections; None: the sections the points'
+    section column or the section heights give)."""
     cad_path: Optional[str] = None
     cmm_data: Any = None
     batch_inputs: Optional[dict] = None
+    planned: Any = None
 
 
 @dataclass(frozen=True)

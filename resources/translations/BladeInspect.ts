@@ -9,6 +9,16 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>%d isolated points treated as sensor outliers.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>%d sections and the out-of-tolerance spots judged against ±%.3f mm (%s).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>%s (not measured)</source>
         <translation type="unfinished"></translation>
@@ -88,6 +98,11 @@
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Airfoil characteristics</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>Airfoil characteristics of %d sections; a value not measured is shown without a verdict, with its reason.</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -439,12 +454,22 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Expanded uncertainty U (k = 2) of the worst deviation, mm</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
         <source>Expanded uncertainty U (k = 2): the decision's, else 2 u of the stated standard uncertainty</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Extent of the profile along the engine axis</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>FAIL</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -638,6 +663,16 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>NOT JUDGED</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>NOT PROVEN</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Name the serial port</source>
         <translation type="unfinished"></translation>
@@ -687,6 +722,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Outlier fraction</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>PASS</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -888,6 +928,12 @@ mm</source>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Section</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Section
+% span</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1101,8 +1147,18 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>TUR</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <source>Table 2: optical and CMM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>Test uncertainty ratio: tolerance / U</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1152,6 +1208,11 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
+        <source>The part's verdict under the %s fit (%s); the table below gives it under every fit.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>The point set to register (the selected one when a point set is selected)</source>
         <translation type="unfinished"></translation>
     </message>
@@ -1173,6 +1234,16 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>The rig's serial port</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The section by its nominal height, % of the span from hub to tip</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>The section's worst deviation judged against the tolerance with its U: pass, not proven, fail</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -1354,6 +1425,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>not measured</source>
         <translation type="unfinished"></translation>
@@ -1422,6 +1494,12 @@ mm</source>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>±U
 k=2</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/tables.py"/>
+        <source>±U
+mm</source>
         <translation type="unfinished"></translation>
     </message>
 </context>
