@@ -16,6 +16,7 @@ import numpy as np
 import FreeCAD
 
 from ..core import airfoil as kernel
+from ..core import background
 from ..core.contracts import json_default
 from ..core.errors import InputError
 from ..inspection import airfoil_stage as airfoil_mod
@@ -229,6 +230,7 @@ def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
         group.setEditorMode("Registration", ["ReadOnly"])
         group.setEditorMode("AirfoilJson", ["Hidden"])
         for section in stage.sections:
+            background.tick()    # a GUI's event loop turns between the sections
             for profile, ch in (("nominal", section.nominal), ("measured", section.measured)):
                 if ch is None:
                     continue

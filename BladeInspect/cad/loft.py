@@ -23,6 +23,7 @@ from scipy.spatial import cKDTree
 import FreeCAD
 import Part
 
+from ..core import background
 from ..core.errors import InputError
 
 DEGREE = 3
@@ -576,6 +577,7 @@ def reconstruct(pointset, n_poles=None):
                                              if g["n_points"] >= MIN_GROUP_POINTS])
     curves, fits, fit_errors, groups = [], [], [], []
     for g in raw_groups:
+        background.tick()    # a GUI's event loop turns between the section fits
         idx = g.pop("index")
         groups.append(g)
         if len(idx) < MIN_GROUP_POINTS:
