@@ -268,9 +268,12 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
                                                  seed, name="Inspection", fit_choice=choice)
         n_blind = int(np.count_nonzero(result.columns["phase"] == "blind"))
         loop.mark_inspection(registration, heights, n_blind, out_dir)
+        p(0.96, "adding the deviation map")
         deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit(),
                                                    tolerance=tolerance)
+        p(0.97, "adding the section profiles")
         profiles = objects.make_section_profiles(doc, summary["sections"], registration)
+        p(0.98, "adding the airfoil objects")
         stage = getattr(summary["sections"], "airfoil", None)
         analysis = None if stage is None else airfoil_objects.make_airfoil_objects(
             doc, stage, registration, airfoil_options)

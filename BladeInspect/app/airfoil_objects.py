@@ -230,11 +230,11 @@ def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
         group.setEditorMode("Registration", ["ReadOnly"])
         group.setEditorMode("AirfoilJson", ["Hidden"])
         for section in stage.sections:
-            background.tick()    # a GUI's event loop turns between the sections
             for profile, ch in (("nominal", section.nominal), ("measured", section.measured)):
                 if ch is None:
                     continue
                 for kind, cls in KINDS.items():
+                    background.tick()    # a GUI's event loop turns between the objects
                     if cls is EdgeCircles and not ch.edge_circles():
                         # both edges withheld: nothing to draw (an empty compound's void
                         # bounding box is an error line in the Report view)

@@ -361,6 +361,7 @@ def _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree):
     knots = uniform_knots(n_poles, degree)
     rejected = np.zeros(len(ordered), dtype=bool)
     for round_ in range(MAX_REFINE_ROUNDS):
+        background.tick()    # a GUI's event loop turns between the refinements
         spline, params, residuals = _fit_on_knots(params, ordered, weights * ~rejected, knots,
                                                   degree)
         if round_ == 0:

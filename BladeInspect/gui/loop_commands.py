@@ -182,7 +182,7 @@ class InspectPanel(taskpanels.FormPanel):
                 "replaces it") % self.interrupted["out_dir"])
             self.resume.setChecked(True)
         self.resume.toggled.connect(self._resume_toggled)
-        self.layout.addRow(self.resume)
+        self.layout.insertRow(0, self.resume)   # first: what OK will do
         self._resume_toggled(self.resume.isChecked())
 
     def _resume_toggled(self, checked):
@@ -341,6 +341,7 @@ class Inspect(Command):
             shutil.rmtree(os.path.dirname(out_dir), ignore_errors=True)
         else:
             INTERRUPTED[0] = None
+            summary["resumed"] = held is not None
             _hide_measured_frame(summary["objects"]["measurement"])
             if drawn["plan"].ViewObject is not None:
                 # The paths ran; drawn over the deviation map they would hide its colours.
@@ -382,6 +383,9 @@ class Inspect(Command):
                     tables.tr), 1e3 * summary["pose_uncertainty_mm"],
                    1e3 * summary["uncertainty_after_blind_mm"],
                    summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
+        if summary.get("resumed"):
+            note = translate("BladeInspect", "Resumed from the interrupted inspection's "
+                             "checkpoint.") + " " + note
         return _show_table(
             translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
             summary["sections"], note, summary["result"].fit_sensitivity,

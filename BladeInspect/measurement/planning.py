@@ -416,6 +416,7 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
     samples_m = {}
     for work in works:
         for row in work.chosen:
+            background.tick()    # a GUI's event loop turns between the views
             cand = np.flatnonzero(work.cosines[row] >= usable)
             if len(cand) == 0:
                 continue

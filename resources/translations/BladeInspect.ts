@@ -711,6 +711,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Resumed from the interrupted inspection's checkpoint.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Rig</source>
         <translation type="unfinished"></translation>
