@@ -30,7 +30,10 @@ CANCEL_WITHIN_S = 1.0
 
 class Lateness:
     """A QTimer every TICK_MS recording, per stage (the status bar's message while a job runs),
-    the worst lateness of its ticks: how long the event loop could not answer."""
+    the worst lateness of its ticks: how long the event loop could not answer. A wait that
+    spans the job's end counts up to that end; what follows it (the document's recompute, the
+    result panel) is kept apart under AFTER."""
+    AFTER = "after the job: recompute and result panel (not a stage)"
 
     def __init__(self):
         from BladeInspect.gui import progress
@@ -41,12 +44,26 @@ class Lateness:
         self.timer.timeout.connect(self.tick)
         self.last = None
         self.stage = None
+        self.ended = None
+        self.close = progress.StatusProgress.close
+
+        def close(bar):
+            self.ended = time.perf_counter()
+            return self.close(bar)
+        progress.StatusProgress.close = close
+
+    def note(self, stage, late):
+        self.worst[stage] = max(self.worst.get(stage, 0.0), late)
 
     def tick(self):
         now = time.perf_counter()
         if self.last is not None and self.stage is not None:
-            late = now - self.last - TICK_MS / 1000.0
-            self.worst[self.stage] = max(self.worst.get(self.stage, 0.0), late)
+            end = now
+            if self.ended is not None and self.last < self.ended < now:
+                end = self.ended
+                self.note(self.AFTER, now - self.ended)
+            self.note(self.stage, end - self.last - TICK_MS / 1000.0)
+        self.ended = None
         self.last = now
         busy = self.progress.busy()
         message = Gui.getMainWindow().statusBar().currentMessage()
@@ -58,9 +75,10 @@ class Lateness:
 
     def __exit__(self, *exc):
         self.timer.stop()
+        self.progress.StatusProgress.close = self.close
 
     def max(self):
-        return max(self.worst.values()) if self.worst else 0.0
+        return max([v for k, v in self.worst.items() if k != self.AFTER] or [0.0])
 
 
 def cancel_button():
