@@ -147,6 +147,12 @@ class ViewProviderDeviationMap(ViewProvider):
         style.style = coin.SoDrawStyle.POINTS
         style.pointSize = OUT_OF_TOLERANCE_SCALE * max(vobj.PointSize, 2.0)
         node.addChild(style)
+        if hasattr(coin, "SoDepthBuffer"):
+            # At the same depth as the map's own point, the larger one is drawn over it, not
+            # left with the map's colour in its middle.
+            depth = coin.SoDepthBuffer()
+            depth.function = coin.SoDepthBuffer.LEQUAL
+            node.addChild(depth)
         material = coin.SoMaterial()
         colours = [colourmap.ABOVE_COLOUR if classes[i] == colourmap.ABOVE
                    else colourmap.BELOW_COLOUR for i in index]
