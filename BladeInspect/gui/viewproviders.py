@@ -84,7 +84,8 @@ class ViewProviderRegistration(ViewProvider):
 
 class ViewProviderDeviationMap(ViewProvider):
     """The coloured points with the legend; the points beyond the tolerance drawn once more,
-    larger and in their class colours, so the worst points are seen among many."""
+    larger, in their class colours and in front of everything, so the worst points are seen
+    among many."""
     icon = "BladeInspect_DeviationMap"
 
     def attach(self, vobj):
@@ -148,10 +149,10 @@ class ViewProviderDeviationMap(ViewProvider):
         style.pointSize = OUT_OF_TOLERANCE_SCALE * max(vobj.PointSize, 2.0)
         node.addChild(style)
         if hasattr(coin, "SoDepthBuffer"):
-            # At the same depth as the map's own point, the larger one is drawn over it, not
-            # left with the map's colour in its middle.
+            # In front of everything, as inspection packages flag the worst points: the map's
+            # neighbouring points, nearer by a hair, would otherwise cover their middles.
             depth = coin.SoDepthBuffer()
-            depth.function = coin.SoDepthBuffer.LEQUAL
+            depth.test = False
             node.addChild(depth)
         material = coin.SoMaterial()
         colours = [colourmap.ABOVE_COLOUR if classes[i] == colourmap.ABOVE
