@@ -350,8 +350,8 @@ class Inspect(Command):
             analysis = summary["objects"].get("airfoil")
             for obj in analysis.Group if analysis is not None else ():
                 if obj.ViewObject is not None:
-                    # Red camber lines over the deviation map would read as deviations; the
-                    # Model tree shows them on demand.
+                    # The deviation map comes first; the camber lines and edge circles (thin,
+                    # grey) are shown on demand from the Model tree.
                     obj.ViewObject.Visibility = False
             doc.recompute()
             commands.fit_view()
