@@ -292,7 +292,7 @@ def run():
     @step("deviation map of a known result, legend, save and reopen")
     def _():
         blade = state["blade"]
-        from BladeInspect.core.colourmap import deviation_colours
+        from BladeInspect.core.colourmap import classed_colours
         result = _known_result(blade.Shape)
         reg = objects.make_registration(doc, result, name="KnownRegistration")
         Gui.Selection.clearSelection()
@@ -305,7 +305,7 @@ def run():
                 if o.Registration == reg][0]
         limit = dmap.Limit
         check("colours follow deviations", np.allclose(
-            colours_of(dmap), deviation_colours(result.deviation, limit), atol=1e-6))
+            colours_of(dmap), classed_colours(result.deviation, limit), atol=1e-6))
         vobj = dmap.ViewObject
         check("display mode Color", vobj.DisplayMode == "Color", vobj.DisplayMode)
         check("legend in the scene", vobj.Proxy.legend is not None)
@@ -325,7 +325,7 @@ def run():
         settle(0.5)
         dmap2 = doc2.getObject(name)
         check("reopened colours intact", np.allclose(
-            colours_of(dmap2), deviation_colours(result.deviation, limit), atol=0.5 / 255 + 1e-9))
+            colours_of(dmap2), classed_colours(result.deviation, limit), atol=0.5 / 255 + 1e-9))
         check("reopened display mode Color", dmap2.ViewObject.DisplayMode == "Color")
         check("reopened view provider and legend", isinstance(
             dmap2.ViewObject.Proxy, viewproviders.ViewProviderDeviationMap)

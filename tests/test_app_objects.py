@@ -314,25 +314,41 @@ class TestDeviationMap(DocumentCase):
         colours = np.array(obj.Color)[:, :3]
         self.assertEqual(len(colours), 400)
         self.assertEqual(obj.Points.CountPoints, 400)
-        # Colours are saved as 8 bits per channel.
-        np.testing.assert_allclose(colours, deviation_colours(dev, limit), atol=0.5 / 255 + 1e-9)
-        # The map's meaning, independent of its implementation: green at zero, red above,
-        # blue below, saturated beyond the limit.
+        # Colours are saved as 8 bits per channel. Within the limit (the tolerance here) the
+        # ramp's; beyond it the out-of-tolerance classes' own colours.
+        within = np.abs(dev) <= limit
+        np.testing.assert_allclose(colours[within], deviation_colours(dev[within], limit),
+                                   atol=0.5 / 255 + 1e-9)
+        # The map's meaning, independent of its implementation: green at zero; beyond the
+        # tolerance magenta above (red and blue, no green), near-black below, all alike.
         g0 = colours[0]
         self.assertGreater(g0[1], max(g0[0], g0[2]))
-        self.assertGreater(colours[1][0], max(colours[1][1], colours[1][2]))
-        self.assertGreater(colours[2][2], max(colours[2][0], colours[2][1]))
-        beyond = dev > limit
-        np.testing.assert_allclose(colours[beyond], np.tile(colours[1], (beyond.sum(), 1)))
+        self.assertGreater(min(colours[1][0], colours[1][2]), 0.9)
+        self.assertLess(colours[1][1], 0.1)
+        self.assertLess(max(colours[2]), 0.15)
+        above, below = dev > limit, dev < -limit
+        np.testing.assert_allclose(colours[above], np.tile(colours[1], (above.sum(), 1)))
+        np.testing.assert_allclose(colours[below], np.tile(colours[2], (below.sum(), 1)))
+        self.assertEqual(list(obj.OutOfTolerance), [int(below.sum()), int(above.sum())])
         shown = np.array([(v.x, v.y, v.z) for v in obj.Points.Points])
         np.testing.assert_allclose(shown, result.points_cad, atol=1e-4)
         self.assertAlmostEqual(obj.LegendValues[0], -limit)
         self.assertAlmostEqual(obj.LegendValues[-1], limit)
-        # A new limit recolours: points between the old and new limit stop saturating.
+        # A new limit recolours: points between the old and new limit are back on the ramp.
         obj.Limit = 0.1
         self.doc.recompute()
-        np.testing.assert_allclose(np.array(obj.Color)[:, :3], deviation_colours(dev, 0.1),
-                                   atol=0.5 / 255 + 1e-9)
+        within = np.abs(dev) <= 0.1
+        np.testing.assert_allclose(np.array(obj.Color)[within, :3],
+                                   deviation_colours(dev[within], 0.1), atol=0.5 / 255 + 1e-9)
+        self.assertEqual(list(obj.OutOfTolerance), [1, 1])
+        # A tolerance of its own inside a wider ramp: the classes follow the tolerance.
+        obj.Tolerance = 0.05
+        self.doc.recompute()
+        self.assertEqual(list(obj.OutOfTolerance),
+                         [int(np.sum(dev < -0.05)), int(np.sum(dev > 0.05))])
+        inside = np.abs(dev) <= 0.05
+        np.testing.assert_allclose(np.array(obj.Color)[inside, :3],
+                                   deviation_colours(dev[inside], 0.1), atol=0.5 / 255 + 1e-9)
 
     def test_an_error_leaves_no_half_built_objects(self):
         rng = np.random.default_rng(6)

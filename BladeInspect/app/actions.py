@@ -242,15 +242,16 @@ def inspection_rig(nominal_obj, seed, rig_file=None):
 
 
 def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None, airfoil=True,
-            **fit):
+            resume=False, **fit):
     """run_inspect on the nominal named ``nominal`` (the `inspect` command's pipeline), the
     fit ``fit`` chooses, with the airfoil characteristics unless ``airfoil`` is False (as the
     command's default and its --no-airfoil); the points, registration, deviation map, section
     profiles and airfoil objects added. Returns run_inspect's summary with the new objects
-    under "objects"."""
+    under "objects". ``resume``: continue the inspection interrupted in ``out_dir`` (as the
+    command's --resume), with the same options."""
     from ..inspection import airfoil_stage as airfoil_mod
     from ..inspection.closed_loop import run_inspect
-    from ..inspection.run_options import RunOptions
+    from ..inspection.run_options import LoopOptions, RunOptions
     from . import airfoil_objects
     airfoil_options = airfoil_mod.options_from_args() if airfoil else None
     doc = _document(doc_name)
@@ -263,7 +264,8 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
         summary = run_inspect(
             getattr(nominal_obj, "SourceFile", "") or None, out_dir,
             RunOptions(section_heights=heights, tolerance=tolerance, seed=seed,
-                       rig_file=rig_file, fit_choice=choice, airfoil=airfoil_options),
+                       rig_file=rig_file, fit_choice=choice, airfoil=airfoil_options,
+                       loop=LoopOptions(resume=bool(resume))),
             rig=rig, nominal=objects.nominal_of(nominal_obj), progress=p, document=False,
             on_plan=_INTERACTIVE["on_plan"])
         result = summary["result"]
@@ -281,8 +283,12 @@ def inspect(doc_name, nominal, out_dir, heights, tolerance, seed, rig_file=None,
         n_blind = int(np.count_nonzero(result.columns["phase"] == "blind"))
         loop.mark_inspection(registration, heights, n_blind, out_dir, tolerance=tolerance,
                              airfoil=airfoil)
-        deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit())
+        p(0.96, "adding the deviation map")
+        deviation_map = objects.make_deviation_map(doc, registration, settings.colour_limit(),
+                                                   tolerance=tolerance)
+        p(0.97, "adding the section profiles")
         profiles = objects.make_section_profiles(doc, summary["sections"], registration)
+        p(0.98, "adding the airfoil objects")
         stage = getattr(summary["sections"], "airfoil", None)
         analysis = None if stage is None else airfoil_objects.make_airfoil_objects(
             doc, stage, registration, airfoil_options)

@@ -16,6 +16,7 @@ import numpy as np
 import FreeCAD
 
 from ..core import airfoil as kernel
+from ..core import background
 from ..core.contracts import json_default
 from ..core.errors import InputError
 from ..inspection import airfoil_stage as airfoil_mod
@@ -233,6 +234,7 @@ def make_airfoil_objects(doc, stage, registration, opts, name=GROUP_NAME):
                 if ch is None:
                     continue
                 for kind, cls in KINDS.items():
+                    background.tick()    # a GUI's event loop turns between the objects
                     if cls is EdgeCircles and not ch.edge_circles():
                         # both edges withheld: nothing to draw (an empty compound's void
                         # bounding box is an error line in the Report view)

@@ -23,6 +23,7 @@ from scipy.spatial import cKDTree
 import FreeCAD
 import Part
 
+from ..core import background
 from ..core.errors import InputError
 
 DEGREE = 3
@@ -360,6 +361,7 @@ def _fit_walk(pts, scale, walk, along, sigma_ref, n_poles, degree):
     knots = uniform_knots(n_poles, degree)
     rejected = np.zeros(len(ordered), dtype=bool)
     for round_ in range(MAX_REFINE_ROUNDS):
+        background.tick()    # a GUI's event loop turns between the refinements
         spline, params, residuals = _fit_on_knots(params, ordered, weights * ~rejected, knots,
                                                   degree)
         if round_ == 0:
@@ -576,6 +578,7 @@ def reconstruct(pointset, n_poles=None):
                                              if g["n_points"] >= MIN_GROUP_POINTS])
     curves, fits, fit_errors, groups = [], [], [], []
     for g in raw_groups:
+        background.tick()    # a GUI's event loop turns between the section fits
         idx = g.pop("index")
         groups.append(g)
         if len(idx) < MIN_GROUP_POINTS:

@@ -5,6 +5,7 @@ import numpy as np
 import FreeCAD
 import Part
 
+from ..core import background
 from ..core.errors import InputError
 
 DEFAULT_SPACING = 0.02  # mm between polyline points: chord sag < 1 um at a 0.05 mm radius
@@ -82,6 +83,7 @@ def exact_cut(shape, point, normal, spacing=DEFAULT_SPACING):
     for pieces, closed in _wire_pieces(shape, point, normal, spacing):
         exact, which = [], []
         for pts in pieces:
+            background.tick()    # a GUI's event loop turns between the pieces
             k = _nearest_face(faces, pts[len(pts) // 2])
             exact.append(_onto_face(faces[k].Surface, pts, normal, d))
             which.append(np.full(len(pts), k, dtype=int))

@@ -32,7 +32,7 @@ from typing import Optional
 import numpy as np
 from scipy.spatial import cKDTree
 
-from . import bspline
+from . import background, bspline
 from .trim import TrimDomain
 
 # Number of nearest samples whose faces become Newton candidates for a point. SampleCover
@@ -401,8 +401,8 @@ class FaceSet:
         chunks = [rows[s:s + size] for s in range(0, n, size)]
         # numpy releases the GIL in its array loops: chunks on two threads use both cores.
         if len(chunks) > 1:
-            with ThreadPoolExecutor(max_workers=THREADS) as pool:
-                return list(pool.map(work, chunks))
+            # Waiting, this thread lets a GUI's event loop turn (core.background).
+            return background.pool_map(work, chunks, THREADS)
         return [work(c) for c in chunks]
 
     def warm_chunk(self, points, rows, out, start):

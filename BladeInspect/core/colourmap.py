@@ -8,6 +8,10 @@ The map is built in CIELAB rather than by mixing RGB primaries: its anchors have
 that falls symmetrically from the pale green at zero to equally dark ends, so equal |deviation|
 reads as equally strong on both sides and the eye sees no false bands (RGB 'jet' maps put
 bright yellow and cyan bands where nothing happens). Hue alone tells the sign.
+
+Points beyond the tolerance are a class of their own, as inspection packages draw them: above
++tolerance magenta, below -tolerance near-black, two colours the ramp never reaches, so the
+worst points stand out from the saturated ends of the bar (classed_colours, deviation_classes).
 """
 
 import numpy as np
@@ -26,6 +30,11 @@ _ANCHORS_LAB = np.array([
 
 LUT_SIZE = 511          # odd, so that one entry is exactly zero deviation
 NAN_COLOUR = (0.6, 0.6, 0.6)
+# Out of tolerance: far in hue or lightness from every colour of the ramp.
+ABOVE_COLOUR = (1.0, 0.0, 1.0)
+BELOW_COLOUR = (0.08, 0.08, 0.08)
+# deviation_classes' values
+BELOW, WITHIN, ABOVE = -1, 0, 1
 
 # D65 white point, the reference of sRGB.
 _WHITE = np.array([0.95047, 1.0, 1.08883])
@@ -98,3 +107,31 @@ def legend_ticks(limit, n_ticks=9):
         raise InputError("legend: at least 2 ticks needed, got %r" % (n_ticks,))
     values = np.linspace(-limit, limit, int(n_ticks))
     return values, deviation_colours(values, limit)
+
+
+def deviation_classes(deviation, tolerance):
+    """(N,) int8: ABOVE for deviations beyond +tolerance, BELOW beyond -tolerance, else WITHIN
+    (a deviation exactly at the tolerance is within it; NaN is WITHIN, drawn grey)."""
+    tolerance = _check_limit(tolerance)
+    dev = np.asarray(deviation, dtype=float).ravel()
+    classes = np.zeros(dev.shape, dtype=np.int8)
+    with np.errstate(invalid="ignore"):
+        classes[dev > tolerance] = ABOVE
+        classes[dev < -tolerance] = BELOW
+    return classes
+
+
+def classed_colours(deviation, tolerance, limit=None):
+    """deviation_colours on the ramp up to +-``limit`` (default the tolerance), with the points
+    beyond +-``tolerance`` in ABOVE_COLOUR and BELOW_COLOUR."""
+    colours = deviation_colours(deviation, tolerance if limit is None else limit)
+    classes = deviation_classes(deviation, tolerance)
+    colours[classes == ABOVE] = ABOVE_COLOUR
+    colours[classes == BELOW] = BELOW_COLOUR
+    return colours
+
+
+def class_counts(deviation, tolerance):
+    """(points below -tolerance, points above +tolerance)."""
+    classes = deviation_classes(deviation, tolerance)
+    return int(np.count_nonzero(classes == BELOW)), int(np.count_nonzero(classes == ABOVE))

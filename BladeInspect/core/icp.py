@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import bias_take_up
+from . import background, bias_take_up
 from .errors import InputError
 from .weights import normalised_weights
 from .transforms import make_transform, rotation_from_vector, rotation_matrix_from_quaternion
@@ -530,6 +530,7 @@ def icp(points, snr, closest_fn, init, options=None, weight_model=None, beams=No
     stopped = ""
     started = time.monotonic()
     while iterations < options.max_iter:
+        background.tick()    # a GUI's event loop turns between iterations
         if options.time_limit_s is not None \
                 and time.monotonic() - started >= options.time_limit_s:
             stopped = "time limit"

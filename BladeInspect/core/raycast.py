@@ -25,12 +25,11 @@ as misses (or hits) differently from the exact surface: a scanning sensor never 
 
 import threading
 from collections import OrderedDict
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from . import bspline
+from . import background, bspline
 from .closest import point_in_domain
 from .errors import InputError
 from .trim import bucket_pairs, csr
@@ -619,8 +618,8 @@ def _chunks(n):
 
 def _run(work, items):
     if len(items) > 1 and THREADS > 1:
-        with ThreadPoolExecutor(max_workers=THREADS) as pool:
-            return list(pool.map(work, items))
+        # Waiting, this thread lets a GUI's event loop turn (core.background).
+        return background.pool_map(work, items, THREADS)
     return [work(x) for x in items]
 
 

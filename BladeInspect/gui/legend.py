@@ -1,6 +1,7 @@
 """The deviation legend drawn over the 3D view: a colour bar with its tick values, in screen
 space (its own orthographic camera), left out of the scene's bounding box so "fit all" frames
-the blade, not the legend. It draws the values and colours the DeviationMap object computed."""
+the blade, not the legend; above and below the bar, a swatch for each out-of-tolerance class
+with its count. It draws the values and colours the DeviationMap object computed."""
 from pivy import coin
 
 from .i18n import translate
@@ -15,6 +16,9 @@ LABEL_WIDTH = 0.25
 # character (FreeCAD's SoText2 font, measured generously) plus a margin in pixels.
 CHAR_EM = 0.7
 MARGIN_PX = 6
+# The class swatches: their height and their gap from the bar, in view coordinates.
+SWATCH_H = 0.05
+SWATCH_GAP = 0.03
 
 
 def _skip_bounding_group():
@@ -26,9 +30,11 @@ def _skip_bounding_group():
     return node
 
 
-def legend_node(values, colours, title=None, font_size=14):
+def legend_node(values, colours, title=None, font_size=14, above=None, below=None):
     """values (ascending, mm) with their colours (r, g, b in 0..1) -> a Coin node to add to a
-    view provider's root; ``title`` default "Deviation [mm]", translated."""
+    view provider's root; ``title`` default "Deviation [mm]", translated. ``above``,
+    ``below``: (label, colour) of the out-of-tolerance classes, drawn as swatches over and
+    under the bar (the node's ``class_labels`` lists their labels)."""
     if title is None:
         title = translate("BladeInspect", "Deviation [mm]")
     group = _skip_bounding_group()
@@ -66,10 +72,17 @@ def legend_node(values, colours, title=None, font_size=14):
     digits = 3 if max(abs(v) for v in values) < 1.0 else 2
     labels = ["%+.*f" % (digits, v) if abs(v) > 1e-12 else "%.*f" % (digits, 0.0)
               for v in values]
-    backing, corners = _backing((x0 - 0.015, BAR_Y[0] - 0.06),
-                                (x1 + LABEL_WIDTH, BAR_Y[1] + 0.12))
-    # Each text's start (view x) and length in characters: the backing must reach past both.
-    texts = [(x1 + 0.01, max(len(label) for label in labels)), (x0, len(title))]
+    swatches = [(y, label, colour) for y, cls in
+                ((BAR_Y[1] + SWATCH_GAP, above), (BAR_Y[0] - SWATCH_GAP - SWATCH_H, below))
+                if cls is not None for label, colour in (cls,)]
+    group.class_labels = [label for _, label, _ in swatches]
+    extra = SWATCH_GAP + SWATCH_H if swatches else 0.0
+    title_y = BAR_Y[1] + 0.06 + extra
+    backing, corners = _backing((x0 - 0.015, BAR_Y[0] - 0.06 - extra),
+                                (x1 + LABEL_WIDTH, BAR_Y[1] + 0.12 + extra))
+    # Each text's start (view x) and length in characters: the backing must reach past all.
+    texts = [(x1 + 0.01, max(len(label) for label in labels + group.class_labels)),
+             (x0, len(title))]
     group.fit_backing = _backing_fitter(corners, texts, font_size, x1 + LABEL_WIDTH)
     fit = coin.SoCallback()
     fit.setCallback(group.fit_backing)
@@ -91,6 +104,8 @@ def legend_node(values, colours, title=None, font_size=14):
     faces.coordIndex.setValues(0, len(index), index)
     faces.materialIndex.setValues(0, len(index), index)
     hud.addChild(faces)
+    for y, _, colour in swatches:
+        hud.addChild(_swatch((x0, y), (x1, y + SWATCH_H), colour))
 
     overall = coin.SoMaterialBinding()
     overall.value = coin.SoMaterialBinding.OVERALL
@@ -103,7 +118,9 @@ def legend_node(values, colours, title=None, font_size=14):
     hud.addChild(font)
     for label, y in zip(labels, ys):
         hud.addChild(_text((x1 + 0.01, y - 0.015, 0.0), label))
-    hud.addChild(_text((x0, BAR_Y[1] + 0.06, 0.0), title))
+    for y, label, _ in swatches:
+        hud.addChild(_text((x1 + 0.01, y + 0.5 * SWATCH_H - 0.015, 0.0), label))
+    hud.addChild(_text((x0, title_y, 0.0), title))
     return group
 
 
@@ -151,6 +168,25 @@ def _backing(lower_left, upper_right):
     face.numVertices.setValue(4)
     sep.addChild(face)
     return sep, coords
+
+
+def _swatch(lower_left, upper_right, colour):
+    """A filled rectangle of one colour."""
+    sep = coin.SoSeparator()
+    binding = coin.SoMaterialBinding()
+    binding.value = coin.SoMaterialBinding.OVERALL
+    sep.addChild(binding)
+    base = coin.SoBaseColor()
+    base.rgb = tuple(colour)
+    sep.addChild(base)
+    (xa, ya), (xb, yb) = lower_left, upper_right
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, 4, [(xa, ya, 0.0), (xb, ya, 0.0), (xb, yb, 0.0), (xa, yb, 0.0)])
+    sep.addChild(coords)
+    face = coin.SoFaceSet()
+    face.numVertices.setValue(4)
+    sep.addChild(face)
+    return sep
 
 
 def _text(position, text):

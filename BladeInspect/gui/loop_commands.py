@@ -4,7 +4,13 @@ function as the command line (run_inspect, run_calibration, section_table, run_s
 through gui.progress.run, and stores the outcome with the app layer's builders, so a failure
 or a cancel leaves the document as it was. Inspect and the simulation test bed run as console
 lines (app.actions.inspect and app.actions.simulate through commands.run_action), which a
-recorded macro replays."""
+recorded macro replays.
+
+An inspection cancelled or failed after it measured something keeps its checkpoint; the
+Inspect panel then offers to resume it (INTERRUPTED), as the command line's --resume does. A
+checkpoint in a temporary folder (an unsaved document) lives only while it can be resumed: a
+new inspection begun instead, or the end of the session, deletes it."""
+import atexit
 import contextlib
 import os
 import shutil
@@ -38,6 +44,9 @@ LAST_RIG_FILE = [None]
 # Callables told of each plan once it is drawn, before its paths run: listener(plan, obj).
 # Tests photograph the view there.
 PLAN_LISTENERS = []
+# The inspection the Inspect panel offers to resume, or None: {"out_dir", "document",
+# "nominal" (names), "options" (Inspect.start's), "temporary" (True: delete when dropped)}.
+INTERRUPTED = [None]
 
 
 @contextlib.contextmanager
@@ -73,6 +82,32 @@ def output_folder(doc, kind):
         os.makedirs(base, exist_ok=True)
         return tempfile.mkdtemp(prefix=kind + "-", dir=base)
     return tempfile.mkdtemp(prefix="bladeinspect-%s-" % kind)
+
+
+def is_temporary(folder):
+    return os.path.commonpath([os.path.abspath(folder), tempfile.gettempdir()]) == \
+        tempfile.gettempdir()
+
+
+def interrupted_for(nominal_obj):
+    """The interrupted inspection of ``nominal_obj`` the Inspect panel offers, or None."""
+    held = INTERRUPTED[0]
+    if held is None or nominal_obj is None:
+        return None
+    if (held["document"], held["nominal"]) != (nominal_obj.Document.Name, nominal_obj.Name) \
+            or not os.path.isdir(held["out_dir"]):
+        return None
+    return held
+
+
+def drop_interrupted():
+    """Forget the interrupted inspection; its folder goes when it is a temporary one."""
+    held, INTERRUPTED[0] = INTERRUPTED[0], None
+    if held is not None and held["temporary"]:
+        shutil.rmtree(os.path.dirname(held["out_dir"]), ignore_errors=True)
+
+
+atexit.register(drop_interrupted)
 
 
 def _hide_measured_frame(measurement):
@@ -140,6 +175,32 @@ class InspectPanel(taskpanels.FormPanel):
         self.layout.addRow(self.fit)
         self.layout.addRow(taskpanels.wrapped_label(translate("BladeInspect", "Rig: %s") % (
             RIG.spec if RIG.connected else translate("BladeInspect", "simulated (none connected)"))))
+        self.interrupted = interrupted_for(find_nominal())
+        self.resume = QtGui.QCheckBox(translate("BladeInspect",
+                                                "Resume the interrupted inspection"))
+        self.resume.setVisible(self.interrupted is not None)
+        if self.interrupted is not None:
+            self.resume.setToolTip(translate(
+                "BladeInspect", "Continue the inspection that was cancelled or failed, with "
+                "its options, from what it measured (kept in %s); unchecked: a new inspection "
+                "replaces it") % self.interrupted["out_dir"])
+            self.resume.setChecked(True)
+        self.resume.toggled.connect(self._resume_toggled)
+        self.layout.insertRow(0, self.resume)   # first: what OK will do
+        self._resume_toggled(self.resume.isChecked())
+
+    def _resume_toggled(self, checked):
+        """A resumed inspection keeps its own options: shown, and not editable."""
+        if checked and self.interrupted is not None:
+            saved = self.interrupted["options"]
+            self.heights.setText(saved["heights_text"])
+            self.tolerance.setValue(saved["tolerance"])
+            self.seed.setValue(saved["seed"])
+            self.rig_file.setText(saved["rig_file"] or "")
+            self.airfoil.setChecked(saved["airfoil"])
+        for widget in (self.heights, self.tolerance, self.seed, self.rig_file, self.airfoil,
+                       self.fit):
+            widget.setEnabled(not checked)
 
     def validate(self):
         def rig_file():
@@ -152,6 +213,8 @@ class InspectPanel(taskpanels.FormPanel):
         return all(checks)
 
     def options(self):
+        if self.resume.isChecked() and self.interrupted is not None:
+            return dict(self.interrupted["options"], resume=True)
         return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
                      "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None,
                      "airfoil": self.airfoil.isChecked()},
@@ -234,24 +297,39 @@ class Inspect(Command):
 
     panel = InspectPanel
 
-    def start(self, heights_text, tolerance, seed, rig_file=None, **fit):
+    def start(self, heights_text, tolerance, seed, rig_file=None, resume=False, **fit):
         try:
             heights = contracts.parse_section_heights(heights_text, "section heights")
         except InputError as exc:
             progress.report_error(translate("BladeInspect", "Inspect"), str(exc))
             return None
+        options = dict(fit, heights_text=heights_text, tolerance=tolerance, seed=seed,
+                       rig_file=rig_file)
         summary = self.inspect(find_nominal(), heights, tolerance, seed, rig_file,
-                               **fit)
+                               resume=resume, panel_options=options, **fit)
         if summary is not None:
             self.show(summary)
         return summary
 
-    def inspect(self, nominal_obj, heights, tolerance, seed, rig_file=None, **fit):
+    def inspect(self, nominal_obj, heights, tolerance, seed, rig_file=None, resume=False,
+                panel_options=None, **fit):
         """app.actions.inspect on the nominal with the connected rig (else the simulated one),
-        the fit ``fit`` chooses; the plan drawn as it is made. Returns run_inspect's summary
-        with the new objects under "objects", or None."""
+        the fit ``fit`` chooses; the plan drawn as it is made. ``resume``: continue the
+        interrupted inspection (INTERRUPTED) in its folder; otherwise a new folder, and an
+        interrupted inspection is dropped. ``panel_options``: the panel's values, kept to
+        resume with when this run is interrupted. Returns run_inspect's summary with the new
+        objects under "objects", or None."""
         doc = nominal_obj.Document
-        out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
+        held = interrupted_for(nominal_obj) if resume else None
+        if resume and held is None:
+            progress.report_error(translate("BladeInspect", "Inspect"), translate(
+                "BladeInspect", "no interrupted inspection of %s to resume") % nominal_obj.Label)
+            return None
+        if held is not None:
+            out_dir = held["out_dir"]
+        else:
+            drop_interrupted()
+            out_dir = os.path.join(output_folder(doc, "inspections"), "inspection")
 
         drawn = {}
 
@@ -263,21 +341,23 @@ class Inspect(Command):
             for listener in PLAN_LISTENERS:
                 listener(plan, obj)
 
+        if held is not None:
+            fit = dict(fit, resume=True)
         summary = commands.run_action(
             translate("BladeInspect", "Inspect"), "inspect", doc.Name, nominal_obj.Name, out_dir,
             tuple(float(h) for h in heights), float(tolerance), int(seed), rig_file=rig_file,
             on_plan=draw, rig=RIG.rig, **fit)
         if summary is None and os.path.exists(os.path.join(out_dir, "scan.json")):
-            # A rig that failed mid-run leaves what it measured as a checkpoint.
-            FreeCAD.Console.PrintWarning(translate(
-                "BladeInspect",
-                "BladeInspect: the measured sections are kept in %s; "
-                "'./bladeinspect inspect --resume --out %s' with the same CAD, rig and options "
-                "continues the inspection") % (out_dir, out_dir) + "\n")
+            # A cancel, or a rig that failed mid-run, leaves what it measured as a checkpoint.
+            self.keep_interrupted(nominal_obj, out_dir, held, panel_options)
         elif summary is None:
-            # Bad input or a cancel: run_inspect wrote nothing, the folder made for it is empty.
+            # Bad input or a cancel before any measurement: nothing to resume, the folder
+            # made for it goes.
+            INTERRUPTED[0] = None
             shutil.rmtree(os.path.dirname(out_dir), ignore_errors=True)
         else:
+            INTERRUPTED[0] = None
+            summary["resumed"] = held is not None
             _hide_measured_frame(summary["objects"]["measurement"])
             if drawn["plan"].ViewObject is not None:
                 # The paths ran; drawn over the deviation map they would hide its colours.
@@ -286,12 +366,28 @@ class Inspect(Command):
             analysis = summary["objects"].get("airfoil")
             for obj in analysis.Group if analysis is not None else ():
                 if obj.ViewObject is not None:
-                    # Red camber lines over the deviation map would read as deviations; the
-                    # Model tree shows them on demand.
+                    # The deviation map comes first; the camber lines and edge circles (thin,
+                    # grey) are shown on demand from the Model tree.
                     obj.ViewObject.Visibility = False
             doc.recompute()
             commands.fit_view()
         return summary
+
+    @staticmethod
+    def keep_interrupted(nominal_obj, out_dir, held, panel_options):
+        """Remember the interrupted inspection for the panel to resume, and say so."""
+        options = held["options"] if held is not None else dict(panel_options or {})
+        temporary = is_temporary(out_dir)
+        INTERRUPTED[0] = {"out_dir": out_dir, "document": nominal_obj.Document.Name,
+                          "nominal": nominal_obj.Name, "options": options,
+                          "temporary": temporary}
+        text = translate("BladeInspect", "What was measured is kept in %s. Run Inspect again "
+                         "with 'Resume the interrupted inspection' checked to continue from "
+                         "there.") % out_dir
+        if temporary:
+            text += " " + translate("BladeInspect", "The folder is temporary: a new inspection "
+                                    "begun instead, or closing FreeCAD, deletes it.")
+        progress.report_note(translate("BladeInspect", "Inspect"), text)
 
     @staticmethod
     def show(summary):
@@ -303,6 +399,9 @@ class Inspect(Command):
                     tables.tr), 1e3 * summary["pose_uncertainty_mm"],
                    1e3 * summary["uncertainty_after_blind_mm"],
                    summary["objects"]["registration"].WeightsUsed or "-", summary["out_dir"]))
+        if summary.get("resumed"):
+            note = translate("BladeInspect", "Resumed from the interrupted inspection's "
+                             "checkpoint.") + " " + note
         return _show_table(
             translate("BladeInspect", "Inspection: Table 2 at the nominal sections"),
             summary["sections"], note, summary["result"].fit_sensitivity,

@@ -2,14 +2,20 @@
 processed between the pipeline's progress reports, and every user error shown as a FreeCAD
 message (and a non-modal dialog) rather than a traceback.
 
-The work runs in the GUI thread: FreeCAD documents and OpenCASCADE are not thread-safe, and the
-pipeline reports progress often enough for the window to stay responsive."""
+The work runs in the GUI thread, since FreeCAD documents, Coin and OpenCASCADE are not
+thread-safe; its long pure computations (the report's pages, the airfoil characteristics'
+draws, the final fit: numpy, scipy and matplotlib only) go to a worker thread through
+core.background while this module's waiter keeps the event loop turning, so the window
+redraws and Cancel answers within a fraction of a second in every stage."""
+import threading
+import time
 import traceback
 
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
+from ..core import background
 from ..core.errors import Cancelled, InputError
 from .i18n import translate
 
@@ -19,6 +25,10 @@ LAST_TRACEBACK = [None]
 SHOW_DIALOGS = True
 _busy = []
 _open_boxes = []
+# How long a cancelled worker is given to reach its next check before the job is dropped, s.
+CANCEL_GRACE_S = 0.3
+# The event loop's turn in a long loop of the GUI thread comes after this long, s.
+PUMP_S = 0.05
 
 
 def busy():
@@ -33,6 +43,17 @@ def show_modeless(box):
     box.finished.connect(lambda *_: _open_boxes.remove(box))
     _open_boxes.append(box)
     box.show()
+
+
+def report_note(title, text):
+    """A message the user should read that is not an error (what a cancel left, how to go on)."""
+    MESSAGES.append((title, text))
+    FreeCAD.Console.PrintWarning("BladeInspect: %s: %s\n" % (title, text))
+    if SHOW_DIALOGS and FreeCAD.GuiUp:
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Information,
+                                translate("BladeInspect", "BladeInspect: %s") % title, text,
+                                QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
+        show_modeless(box)
 
 
 def report_error(title, text):
@@ -63,19 +84,52 @@ class StatusProgress:
         self.status.addPermanentWidget(self.bar)
         self.status.addPermanentWidget(self.button)
         self.messages = []
+        self.gui_thread = threading.current_thread()
+        self._pending = None    # the latest report from a worker thread, shown by wait_for
+        self._pumped = time.perf_counter()
         self.show(0.0, translate("BladeInspect", "starting"))
 
     def cancel(self):
         self.cancelled = True
+
+    def pump(self):
+        """core.background's pump: the event loop turned if it waited PUMP_S, and a cancel
+        raised, from the long loops that stay in the GUI thread."""
+        if threading.current_thread() is not self.gui_thread:
+            return
+        now = time.perf_counter()
+        if now - self._pumped >= PUMP_S:
+            self._pumped = now
+            QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 20)
+        if self.cancelled:
+            raise Cancelled("%s cancelled" % self.title)
+
+    def wait_for(self, thread, stop):
+        """core.background's waiter: the event loop turns (the worker's reports shown) until
+        ``thread`` ends; on Cancel the worker is told to stop and the job ends at once."""
+        while thread.is_alive():
+            QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+            pending, self._pending = self._pending, None
+            if pending is not None:
+                self.show(*pending)
+            if self.cancelled:
+                stop.set()
+                thread.join(CANCEL_GRACE_S)
+                raise Cancelled("%s cancelled" % self.title)
+            thread.join(0.02)
 
     def show(self, fraction, message):
         self.bar.setValue(int(round(1000 * min(max(fraction, 0.0), 1.0))))
         self.messages.append((fraction, message))
         self.status.showMessage("%s: %s" % (self.title, message))
         QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+        self._pumped = time.perf_counter()
 
     def __call__(self, fraction, message):
-        self.show(fraction, message)
+        if threading.current_thread() is self.gui_thread:
+            self.show(fraction, message)
+        else:
+            self._pending = (fraction, message)   # Qt widgets belong to the GUI thread
         if self.cancelled:
             raise Cancelled("%s cancelled" % self.title)
 
@@ -91,6 +145,8 @@ def run(title, job):
     cancelled or failed (the failure already reported to the user)."""
     progress = StatusProgress(title)
     _busy.append(title)
+    previous_waiter = background.set_waiter(progress.wait_for)
+    previous_pump = background.set_pump(progress.pump)
     try:
         value = job(progress)
         progress.status.showMessage(translate("BladeInspect", "%s: done") % title, 5000)
@@ -110,6 +166,8 @@ def run(title, job):
                                                      "report view's log)")
                      % (type(exc).__name__, exc))
     finally:
+        background.set_waiter(previous_waiter)
+        background.set_pump(previous_pump)
         _busy.remove(title)
         progress.close()
     return None

@@ -8,6 +8,7 @@ import textwrap
 
 import numpy as np
 
+from ..core import background
 from . import airfoil_values as values
 from . import characteristic_names
 from .report_table import TableStyle, html_table, img_tag, mpl, pdf_table, png_bytes
@@ -170,6 +171,7 @@ def add_pages(pdf, parts, table):
         pdf.savefig(fig)
         plt.close(fig)
         pages += 2
+        background.check()    # a cancelled report stops between sections
     if stage.lean_bow is not None:
         fig = figure_span(stage)
         parts += ["<h3>Shift and twist along the span</h3>",

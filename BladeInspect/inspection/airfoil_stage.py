@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import airfoil as kernel
+from ..core import background
 from ..core import contracts
 from ..core import decision as decision_mod
 from ..core.atomic_file import atomic_write
@@ -382,6 +383,7 @@ def _refused(plane, reason, nominal_values=None, le_rule=None):
 
 def _section(nominal, plane, opts, result, rng, counted=None, task=None, take_up=None):
     from ..cad.airfoil_sections import NotAirfoilSection, airfoil_section
+    background.tick()    # a GUI's event loop turns between the sections
     blade, roles = _blade_faces(nominal)
     try:
         xy, frame = airfoil_section(nominal.shape, plane.origin, plane.normal, opts.engine_axis,
@@ -389,8 +391,10 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None, take_up
                                     blade_faces=blade, face_roles=roles)
         hint = None if plane.le_hint_3d is None else frame.to_2d(plane.le_hint_3d)[0]
         upstream = UPSTREAM_2D if opts.definition.le_rule == "engine-axis" else None
-        nom = nominal_characteristics(xy, opts.definition, hint, upstream,
-                                      None if task is None else task.nominal)
+        # The kernel's work (numpy and scipy only) runs beside the GUI's event loop; the cut
+        # above, an OpenCASCADE call, stays in this thread.
+        nom = background.run(lambda: nominal_characteristics(
+            xy, opts.definition, hint, upstream, None if task is None else task.nominal))
     except NotAirfoilSection as exc:
         return _refused(plane, str(exc))
     except InputError as exc:
@@ -425,8 +429,8 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None, take_up
         refused.notes = sr.notes + refused.notes
         return refused
     try:
-        ch, fit, cont, ordered, noise = measure_at(result.points_cad[idx], result.normal[idx],
-                                                    frame, nom, opts)
+        ch, fit, cont, ordered, noise = background.run(lambda: measure_at(
+            result.points_cad[idx], result.normal[idx], frame, nom, opts))
     except InputError as exc:
         sr.notes.append("measured: %s" % exc)
         return sr
@@ -440,11 +444,13 @@ def _section(nominal, plane, opts, result, rng, counted=None, task=None, take_up
     block["measured"] = measured_values
     measurement = SectionMeasurement(result, idx, frame, nom, ch, fit, noise, measured_values)
     if task is not None:    # task-specific uncertainty (inspection.airfoil_task)
-        sr.task_u = airfoil_task.section_uncertainty(task, sr, measurement, opts, rng)
+        sr.task_u = background.run(
+            lambda: airfoil_task.section_uncertainty(task, sr, measurement, opts, rng))
     elif opts.draws:
-        block["uncertainty"] = refit_uncertainty(measurement, opts, rng)
+        block["uncertainty"] = background.run(
+            lambda: refit_uncertainty(measurement, opts, rng))
         if take_up is not None and block["uncertainty"] is not None:
-            _add_size_take_up(sr, measurement, take_up, opts)
+            background.run(lambda: _add_size_take_up(sr, measurement, take_up, opts))
     return sr
 
 

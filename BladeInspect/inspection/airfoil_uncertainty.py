@@ -21,6 +21,7 @@ inspection.airfoil_task.TASK_MODEL_VERSION with it.
 import numpy as np
 
 from ..core import airfoil as kernel
+from ..core import background
 from ..core import transforms as tf
 from ..core import uncertainty_model
 from ..core.errors import InputError
@@ -115,6 +116,7 @@ def refit_uncertainty(m, opts, rng, draws_sd=None):
     axis_fields, axis_chol = _calibration_model(result, idx, opts, sensor)
     draws = []
     for _ in range(max(int(opts.draws), 2)):
+        background.check()    # a cancelled job stops between draws
         d = chol @ rng.standard_normal(6)
         R = tf.rotation_from_vector(d[3:])
         moved = (smooth3 - centre) @ R.T + centre + d[:3]

@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 
+from ..core import background
 from ..core import decision as decision_mod
 from ..core import transforms as tf
 from ..core.errors import InputError
@@ -202,8 +203,9 @@ def add_to_sensitivity(doc, stage, result, opts):
                 continue
             idx = section_points(r.plane, stage.counted)
             try:
-                ch, fit, cont, _, noise = measure_at(view.points_cad[idx], view.normal[idx],
-                                                      r.frame, r.nominal, quiet)
+                # numpy and scipy only: beside a GUI's event loop (core.background)
+                ch, fit, cont, _, noise = background.run(lambda: measure_at(
+                    view.points_cad[idx], view.normal[idx], r.frame, r.nominal, quiet))
             except InputError:
                 continue
             b = {"label": r.block["label"], "nominal": dict(r.block["nominal"]),

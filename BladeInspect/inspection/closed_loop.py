@@ -646,7 +646,10 @@ def _loop(phase, run):
     result.warnings += result.planning_notes
     # planned_rows drops the section column (raster lines are not the nominal planes), so the
     # table takes the points within its band of each plane.
+    progress(0.8, "section table and verdict")
     table, verdict = _judge_after_blind(run, result, n_blind, n_measured, span_axis)
+    if run.options.airfoil is not None:
+        progress(0.82, "airfoil characteristics")
     _add_airfoil(run, result, table, verdict)
     timing["sections"] = time.perf_counter() - t0
 

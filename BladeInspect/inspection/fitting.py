@@ -20,6 +20,7 @@ from typing import Optional
 
 import numpy as np
 
+from ..core import background
 from ..core import decision as decision_mod
 from ..core import fits
 from ..core import stats as stats_mod
@@ -494,6 +495,7 @@ def sensitivity(runs, result, table, tolerance, choice, judge_options=None,
     judge_options = dict(judge_options or {}, decision_rule=choice.decision_rule)
     columns = {}
     for objective, run in runs.runs.items():
+        background.tick()    # a GUI's event loop turns between the objectives' verdicts
         deviation = runs.start_deviation if run is None else run.distances
         view = dataclasses.replace(result, deviation=np.asarray(deviation))
         verdict = judge(view, table, tolerance=tolerance, **judge_options)

@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from ..core import colourmap, contracts
+from ..core import background, colourmap, contracts
 from ..core import stats as stats_mod
 from . import airfoil_stage as airfoil_mod
 from . import airfoil_report
@@ -410,7 +410,14 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
         with pipeline.AtomicOutput(out) as output:
             return write_report(output, result, nominal, sections, verdict, tolerance,
                                 magnification=magnification, title=title)
-    output = out
+    # Pages drawn with numpy and matplotlib alone: beside the GUI's event loop (a minute of
+    # drawing for a blade of many sections), stopping between pages on a cancel.
+    return background.run(lambda: _write_report(out, result, sections, verdict, tolerance,
+                                                magnification, title))
+
+
+def _write_report(output, result, sections, verdict, tolerance, magnification, title):
+    """write_report's files into the open AtomicOutput ``output``."""
     plt, _, _ = mpl()
     from matplotlib.backends.backend_pdf import PdfPages
     table = sections
@@ -467,17 +474,13 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
         pdf_table(fig, [0.06, 0.05, 0.88, max(0.1, y - 0.1)], ["Quantity", "Value"], p_rows,
                   TableStyle(7.5, cell_loc="left", col_widths=[0.45, 0.55]),
                   title="Pose and its uncertainty")
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        n_pages += _page(pdf, plt, fig)
 
         n_pages += _add_fit_pages(pdf, plt, result, verdict)
 
         fig = figure_views(result, table, tolerance)
         parts += ["<h2>Deviation map</h2>", img_tag(png_bytes(fig), "deviation map, three views")]
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        n_pages += _page(pdf, plt, fig)
 
         fig = figure_histogram(result, band_edges)
         png = png_bytes(fig)
@@ -488,9 +491,7 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
                       result.deviation_stats["pct_within_1sigma"],
                       result.deviation_stats["pct_within_3sigma"],
                       result.deviation_stats["std"], result.deviation_stats["mean"])]
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        n_pages += _page(pdf, plt, fig)
 
         fig = plt.figure(figsize=(11.69, 8.27))
         pdf_table(fig, [0.03, 0.52, 0.94, 0.42], s_header, s_rows or [["-"] * len(s_header)],
@@ -504,9 +505,7 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
         if table.cmm_source:
             notes.append(sections_mod.CMM_COMPENSATION_NOTE)
         fig.text(0.03, 0.02, "\n".join(notes), fontsize=7, wrap=True)
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        n_pages += _page(pdf, plt, fig)
 
         parts += ["<h2>Section profile errors (Table 2)</h2>", html_table(s_header, s_rows),
                   "<p class='note'>%s</p>" % html.escape(notes[0])]
@@ -517,9 +516,7 @@ def write_report(out, result, nominal, sections, verdict, tolerance, magnificati
             fig = figure_section(sec, result, tolerance, magnification=magnification)
             parts += ["<h3>Section %s</h3>" % html.escape(sec.label),
                       img_tag(png_bytes(fig), "section %s whisker plot" % sec.label)]
-            pdf.savefig(fig, dpi=PDF_DPI)
-            plt.close(fig)
-            n_pages += 1
+            n_pages += _page(pdf, plt, fig)
         n_pages += airfoil_report.add_pages(pdf, parts, table)
         meta = pdf.infodict()
         meta["Title"] = title
@@ -540,10 +537,16 @@ def _add_fit_pages(pdf, plt, result, verdict):
     """The PDF pages of the fit and its sensitivity (inspection.fit_report); their count."""
     n_pages = 0
     for fig in fit_report.pdf_pages(plt, result, verdict):
-        pdf.savefig(fig, dpi=PDF_DPI)
-        plt.close(fig)
-        n_pages += 1
+        n_pages += _page(pdf, plt, fig)
     return n_pages
+
+
+def _page(pdf, plt, fig):
+    """``fig`` saved as the PDF's next page and closed; a cancel stops the report here."""
+    pdf.savefig(fig, dpi=PDF_DPI)
+    plt.close(fig)
+    background.check()
+    return 1
 
 
 # ---------------------------------------------------------------- the `report` command

@@ -41,6 +41,7 @@ from typing import Optional
 
 import numpy as np
 
+from ..core import background
 from ..core import bias_take_up as core_take_up
 from ..core import icp as core_icp
 from ..core import uncertainty_model
@@ -371,6 +372,7 @@ def worst_terms(result, candidates, model=None, left_out=None):
         usable[:] = True
     candidates, dev, noise = candidates[usable], dev[usable], noise[usable]
     worst = int(candidates[np.argmax(np.abs(dev))])
+    background.tick()    # a GUI's event loop turns between the sections' worst points
     terms = {k: float(v[0]) for k, v in standard_terms(result, worst, model).items()}
     censored = (None if left_out is None or not len(left_out) else
                 censored_worst_terms(result, worst, candidates, left_out, model))

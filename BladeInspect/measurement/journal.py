@@ -24,6 +24,7 @@ import os
 
 import numpy as np
 
+from ..core import background
 from ..core.errors import InputError
 from ..rig.base import Readings
 
@@ -91,6 +92,7 @@ class JournaledRig:
             if hasattr(self.rig, "set_pass_index"):
                 self.rig.set_pass_index(self._next_index)
             self._next_index = None
+        background.tick()    # a GUI's event loop turns between the passes
         start = float(self.rig.elapsed_s)
         readings = self.rig.scan_path(path_xyz, angle_deg)
         self._append(readings, float(self.rig.elapsed_s) - start)

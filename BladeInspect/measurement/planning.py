@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core import background
 from ..core import span as span_mod
 from ..core import transforms as tf
 from ..core.errors import DeviceError, InputError
@@ -283,6 +284,7 @@ def nominal_section(nominal, plane_point, plane_normal, spacing, edge_densify=No
                          "point spacing" % np.round(o, 3).tolist())
     p = np.vstack(pts)
     for _ in range(SECTION_PROJECTIONS):
+        background.tick()    # a GUI's event loop turns between the projections
         res = nominal.signed_distance(p)
         off_plane = (res.closest - o) @ n
         if np.max(np.abs(off_plane)) < SECTION_TOLERANCE_MM:
@@ -414,6 +416,7 @@ def _check_views(works, nominal, table_to_cad, kinematics, sensor, samples_table
     samples_m = {}
     for work in works:
         for row in work.chosen:
+            background.tick()    # a GUI's event loop turns between the views
             cand = np.flatnonzero(work.cosines[row] >= usable)
             if len(cand) == 0:
                 continue

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 from scipy.interpolate import BSpline
 
+from ..core import background
 from ..core.errors import InputError
 from ..rig.kinematics import RigKinematics
 
@@ -598,6 +599,7 @@ class ScanStrategy:
         open_ends = [True, True]
         extension = [self.options.extension_mm, self.options.extension_mm]
         for _ in range(self.options.max_passes):
+            background.tick()    # a GUI's event loop turns between the passes
             curve, _ = fit_stage_profile(x_all, z_all, max_incidence_deg=max_incidence)  # step 3
             lo = -extension[0] if open_ends[0] else 0.0
             hi = curve.length + (extension[1] if open_ends[1] else 0.0)

@@ -54,6 +54,16 @@
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/viewproviders.py"/>
+        <source>&lt; %+.3f: %d points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/viewproviders.py"/>
+        <source>&gt; %+.3f: %d points</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>A letter (x, y, z, -x, ...) or a vector</source>
         <translation type="unfinished"></translation>
@@ -189,11 +199,6 @@
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <source>BladeInspect: rig connected (%s)</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../../BladeInspect/gui/loop_commands.py"/>
-        <source>BladeInspect: the measured sections are kept in %s; './bladeinspect inspect --resume --out %s' with the same CAD, rig and options continues the inspection</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -380,6 +385,11 @@ mm</source>
         <location filename="../../BladeInspect/gui/commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Connect rig</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Continue the inspection that was cancelled or failed, with its options, from what it measured (kept in %s); unchecked: a new inspection replaces it</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
@@ -883,6 +893,16 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Resume the interrupted inspection</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>Resumed from the interrupted inspection's checkpoint.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Rig</source>
         <translation type="unfinished"></translation>
@@ -1202,6 +1222,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>The folder is temporary: a new inspection begun instead, or closing FreeCAD, deletes it.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/gui/tables.py"/>
         <source>The measured value</source>
         <translation type="unfinished"></translation>
@@ -1342,6 +1367,11 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>What was measured is kept in %s. Run Inspect again with 'Resume the interrupted inspection' checked to continue from there.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../../BladeInspect/inspection/characteristic_names.py"/>
         <source>Where the largest inscribed circle lies, % of the chord from the LE</source>
         <translation type="unfinished"></translation>
@@ -1412,6 +1442,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>least-squares: the robust ICP's pose; minimax: minimum zone; tolerance: largest margin inside the tolerance; datum: the CAD's datum faces</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>no interrupted inspection of %s to resume</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
