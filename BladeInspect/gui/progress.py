@@ -47,22 +47,19 @@ def show_modeless(box):
 
 def report_note(title, text):
     """A message the user should read that is not an error (what a cancel left, how to go on)."""
-    MESSAGES.append((title, text))
-    FreeCAD.Console.PrintWarning("BladeInspect: %s: %s\n" % (title, text))
-    if SHOW_DIALOGS and FreeCAD.GuiUp:
-        box = QtGui.QMessageBox(QtGui.QMessageBox.Information,
-                                translate("BladeInspect", "BladeInspect: %s") % title, text,
-                                QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
-        show_modeless(box)
+    _report(title, text, FreeCAD.Console.PrintWarning, QtGui.QMessageBox.Information)
 
 
 def report_error(title, text):
+    _report(title, text, FreeCAD.Console.PrintError, QtGui.QMessageBox.Warning)
+
+
+def _report(title, text, console, icon):
     MESSAGES.append((title, text))
-    FreeCAD.Console.PrintError("BladeInspect: %s: %s\n" % (title, text))
+    console("BladeInspect: %s: %s\n" % (title, text))
     if SHOW_DIALOGS and FreeCAD.GuiUp:
-        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning,
-                                translate("BladeInspect", "BladeInspect: %s") % title, text,
-                                QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
+        box = QtGui.QMessageBox(icon, translate("BladeInspect", "BladeInspect: %s") % title,
+                                text, QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
         show_modeless(box)
 
 
