@@ -1,5 +1,5 @@
 """The frame the robust fit chose, as a term of the airfoil angles' U (core.frame_shift,
-inspection.airfoil_stage.fit_frame).
+inspection.airfoil_frame).
 
 A prism of a corpus profile (bench/corpus) twisted 0.3 deg at the tip, its exact signed
 distance from the dense profile. The robust fit is stood in for by the least-squares fit of
@@ -24,6 +24,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(HERE), "bench"))
 from corpus import all_cases, truth  # noqa: E402
 
 from BladeInspect.core.frame_shift import least_squares_shift  # noqa: E402
+from BladeInspect.inspection import airfoil_frame  # noqa: E402
 from BladeInspect.inspection import airfoil_stage as stage  # noqa: E402
 
 TIP_DEG = 0.3
@@ -113,23 +114,51 @@ class StageTerm(_TwistedPrism, unittest.TestCase):
     def _frame(self, counted):
         d, normal = self.prism(self.at_fit)
         result = _Result(self.at_fit, normal, d, self.inlier, snr=self.w)
-        return stage.fit_frame(result, counted, (0.0, 0.0, 1.0))
+        return airfoil_frame.fit_frame(result, counted, (0.0, 0.0, 1.0))
+
+    def _section(self, u):
+        plane = stage.Plane(label="1", origin=np.array([0.0, 0.0, 30.0]),
+                            normal=np.array([0.0, 0.0, 1.0]), height_pct=50.0)
+        sr = stage.SectionResult(plane=plane, frame=None, nominal=None)
+        sr.block = {"uncertainty": dict(u)}
+        return sr
 
     def test_the_turn_is_added_to_the_angles_u(self):
         frame = self._frame(np.ones(len(self.inlier), bool))
         self.assertIsNotNone(frame)
-        turn = frame[0]
+        turn = frame["turn_deg"]
         u = {"stagger_deg": 0.001, "twist_deg": 0.0005, "inlet_angle_deg": 0.01,
              "outlet_angle_deg": 0.02, "chord_mm": 0.003}
-        sr = stage.SectionResult(plane=None, frame=None, nominal=None)
-        sr.block = {"uncertainty": dict(u)}
-        stage._add_fit_frame(sr, frame)
+        sr = self._section(u)
+        airfoil_frame.add_fit_frame(sr, frame, 0.0, (0.0, 0.0, 1.0))
         block = sr.block
-        for key in stage.FRAME_ANGLES:
+        for key in airfoil_frame.FRAME_ANGLES:
             self.assertAlmostEqual(block["uncertainty"][key], u[key] + abs(turn) / 2, places=12)
             self.assertAlmostEqual(block["uncertainty_fit_frame"][key], abs(turn), places=12)
         self.assertEqual(block["uncertainty"]["chord_mm"], u["chord_mm"])
         self.assertIn("%+.4f" % turn, sr.notes[-1])
+
+    def test_a_twisted_blade_adds_its_twist_rate_times_the_move_along_the_span(self):
+        # a made-up frame: no turn, the part moved 0.05 mm along the span; a blade twisting
+        # 0.2 deg/mm then reads every section 0.01 deg turned
+        frame = {"turn_deg": 0.0, "move_mm": 0.05, "dw": np.zeros(3),
+                 "dt": np.array([0.0, 0.0, 0.05]), "c": np.zeros(3), "left_out": 10,
+                 "share": 0.1}
+        sr = self._section({"stagger_deg": 0.001})
+        airfoil_frame.add_fit_frame(sr, frame, 0.2, (0.0, 0.0, 1.0))
+        self.assertAlmostEqual(sr.block["uncertainty_fit_frame"]["stagger_deg"], 0.01,
+                               places=12)
+
+    def test_twist_rates_from_the_nominal_staggers(self):
+        results = []
+        for z, stagger in ((10.0, -30.0), (30.0, -26.0), (50.0, -22.0)):
+            sr = stage.SectionResult(plane=stage.Plane(
+                label="s", origin=np.array([1.0, 2.0, z]), normal=np.array([0.0, 0.0, 1.0]),
+                height_pct=z), frame=None, nominal=None)
+            sr.block = {"nominal": {"stagger_deg": stagger}}
+            results.append(sr)
+        np.testing.assert_allclose(airfoil_frame.twist_rates(results, (0, 0, 1)), 0.2)
+        self.assertEqual(airfoil_frame.twist_rates(results[:1], (0, 0, 1)), [0.0])
 
     def test_no_term_when_the_left_out_points_are_not_counted(self):
         # isolated rejections (not in measured_surface's groups) are not counted: no frame

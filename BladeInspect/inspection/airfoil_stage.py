@@ -22,10 +22,9 @@ from ..core import background
 from ..core import contracts
 from ..core import decision as decision_mod
 from ..core.atomic_file import atomic_write
-from ..core.frame_shift import least_squares_shift
 from ..core.errors import InputError
 from ..measurement.planning import blade_faces
-from . import airfoil_task
+from . import airfoil_frame, airfoil_task
 from . import uncertainty as uncertainty_mod
 from .airfoil_measure import SectionMeasurement, measure_at, section_points
 from . import airfoil_uncertainty
@@ -40,11 +39,6 @@ DEFAULT_DRAWS = 12
 # Fewer measured points than this in a section: no measured characteristics (a profile needs
 # both edges and both sides).
 MIN_SECTION_POINTS = 60
-# Beyond these, the frame the robust fit chose is noted on every section (fit_frame_note):
-# the least-squares frame of every counted point turned about the span, or any point moved.
-FRAME_TURN_DEG = 0.002
-FRAME_MOVE_MM = 0.002
-FRAME_ANGLES = ("stagger_deg", "twist_deg", "inlet_angle_deg", "outlet_angle_deg")
 # A section whose measured points leave a stretch of the nominal profile longer than this
 # share of its perimeter without a point is refused: the profile fitted to them would close
 # the stretch by a guess (a scan of the blade alone where the cut is closed by a hub, or of one
@@ -476,53 +470,6 @@ def _add_size_take_up(sr, measurement, take_up, opts):
                take_up.pose_motion_mm, ", ".join(grown)))
 
 
-def fit_frame(result, counted, span_axis):
-    """(turn deg, move mm, points left out, their share) when the points the robust fit left
-    out as regions that deviate (``counted`` and not inliers: measured_surface's grouped
-    rejections) would move the frame: aligned to all the counted points (core.frame_shift),
-    the part turns about the span by more than FRAME_TURN_DEG or moves a point by more than
-    FRAME_MOVE_MM. Else None. On a stator twisted 0.3 deg at the tip the fit left out 10 % of
-    the points and stood 0.015 deg from the least-squares frame, 15 times the stagger's U."""
-    if result is None or counted is None or not len(counted):
-        return None
-    inlier = np.asarray(result.inlier, dtype=bool)
-    left_out = counted & ~inlier
-    if not left_out.any():
-        return None
-    weights = np.ones(len(inlier)) if result.snr is None else \
-        np.asarray(result.snr, dtype=float) / np.nanmean(result.snr)
-    dw, dt, c = least_squares_shift(result.points_cad, result.normal, result.deviation,
-                                    weights, counted, inlier)
-    axis = np.asarray(span_axis, dtype=float)
-    turn = float(np.degrees(dw @ (axis / np.linalg.norm(axis))))
-    moved = dt + np.cross(dw, result.points_cad[counted] - c)
-    move = float(np.sqrt((moved ** 2).sum(axis=1)).max())
-    if abs(turn) <= FRAME_TURN_DEG and move <= FRAME_MOVE_MM:
-        return None
-    return turn, move, int(left_out.sum()), float(left_out.mean())
-
-
-def _add_fit_frame(sr, frame):
-    """The frame's turn as a systematic term of the section's angles' U (added linearly, as
-    the size take-up: uncertainty_fit_frame), and a note naming what else the frame moves."""
-    turn, move, n_left, share = frame
-    block = sr.block
-    text = ("measured: the fit left out %d points (%.1f %%) in regions that deviate; aligned "
-            "to every point measured, the part would turn %+.4f\u00b0 about the span and its "
-            "points move up to %.4f mm. " % (n_left, 100.0 * share, turn, move))
-    if block.get("uncertainty") is not None:
-        term = {key: abs(turn) for key in FRAME_ANGLES}
-        block["uncertainty"], block["uncertainty_fit_frame"], _ = \
-            airfoil_uncertainty.add_take_up(block["uncertainty"], term, COVERAGE_FACTOR)
-        text += ("U of the stagger, twist and the inlet and outlet angles holds that turn; "
-                 "the axial chord and the section's position are read in the fitted frame "
-                 "and may be off by up to that move beyond U")
-    else:
-        text += ("Stagger, twist, the inlet and outlet angles, the axial chord and the "
-                 "section's position are read in the fitted frame and may be off by that much")
-    sr.notes.append(text)
-
-
 def measured_surface(result):
     """Mask of the points the characteristics are measured from: the fit's inliers and every
     point the robust fit rejected that lies in a group (verdict.MIN_SPOT_POINTS or more linked
@@ -588,10 +535,12 @@ def run_stage(nominal, planes, opts=None, result=None, span_axis=None):
     take_up = None if opts.draws == 0 or task is not None else \
         airfoil_uncertainty.size_take_up_model(result, nominal)
     results = [_section(nominal, p, opts, result, rng, counted, task, take_up) for p in planes]
-    frame = fit_frame(result, counted, span_axis)
-    for r in results:
-        if frame is not None and r.measured is not None:
-            _add_fit_frame(r, frame)
+    frame = airfoil_frame.fit_frame(result, counted, span_axis)
+    if frame is not None:
+        rates = airfoil_frame.twist_rates(results, span_axis)
+        for r, rate in zip(results, rates):
+            if r.measured is not None:
+                airfoil_frame.add_fit_frame(r, frame, rate, span_axis)
     if task is not None and not task.made:
         task.finish()    # written (atomically) to its file, or kept in memory
     if opts.decision_rule not in decision_mod.RULES:
