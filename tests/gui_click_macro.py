@@ -117,6 +117,10 @@ def run():
         Gui.Selection.addSelection(state["blade"])
         panel = open_input_panel("BladeInspect_Inspect", loop_commands.InspectPanel)
         check("inspect: input panel open", panel is not None)
+        check("inspect: the panel names the selected CAD it will inspect against",
+              panel is not None and panel.nominal.currentText() == state["blade"].Label
+              and panel.nominal.currentData() == state["blade"].Name,
+              None if panel is None else panel.nominal.currentText())
         panel.heights.setText("50")
         panel.airfoil.setChecked(False)
         result = click_ok_expecting("inspect", taskpanels.TablePanel, "click_inspect_result")

@@ -13,7 +13,7 @@ from tests.helpers import GuiMacroChecks
 class TestClickedResultPanels(GuiMacroChecks, unittest.TestCase):
     MACRO = "gui_click_macro.py"
     TIMEOUT_S = 900   # a bound for a hung GUI on a loaded machine, not a speed requirement
-    MIN_CHECKS = 12
+    MIN_CHECKS = 13
     LOG_NAME = "freecad-click.log"
     CHECKS_NAME = "checks-click.json"
 

@@ -29,7 +29,7 @@ from ..inspection.report import section_rows
 from ..measurement.calibration import DEFAULT_DIAMETER, run_calibration
 from ..rig.kinematics import read_rig_file
 from . import commands, progress, tables, taskpanels
-from .command_base import Command, find_nominal, find_registration
+from .command_base import Command, find_nominal, find_registration, nominals_of
 from .i18n import QT_TRANSLATE_NOOP, translate
 from .session import RIG
 
@@ -141,9 +141,17 @@ class InspectPanel(taskpanels.FormPanel):
     """Nominal section heights, tolerance, seed, the rig calibration file and the fit."""
     title = QT_TRANSLATE_NOOP("BladeInspect", "Inspect")
 
-    def __init__(self, on_accept):
+    def __init__(self, on_accept, nominals=None, nominal=None):
         super().__init__()
         self.on_accept = on_accept
+        nominal = nominal or find_nominal()
+        if nominals is None:
+            nominals = nominals_of(FreeCAD.ActiveDocument) if FreeCAD.ActiveDocument else []
+        self.nominal = self.add_row(
+            QT_TRANSLATE_NOOP("BladeInspect", "Nominal CAD"),
+            taskpanels.object_combo(nominals, nominal),
+            QT_TRANSLATE_NOOP("BladeInspect", "The CAD the rig's part is inspected against (the "
+                              "selected one when a CAD is selected)"))
         self.heights = self.add_row(
             QT_TRANSLATE_NOOP("BladeInspect", "Section heights (%)"),
             QtGui.QLineEdit(", ".join("%g" % h for h in contracts.SECTION_HEIGHTS_PCT)),
@@ -175,7 +183,7 @@ class InspectPanel(taskpanels.FormPanel):
         self.layout.addRow(self.fit)
         self.layout.addRow(taskpanels.wrapped_label(translate("BladeInspect", "Rig: %s") % (
             RIG.spec if RIG.connected else translate("BladeInspect", "simulated (none connected)"))))
-        self.interrupted = interrupted_for(find_nominal())
+        self.interrupted = interrupted_for(nominal)
         self.resume = QtGui.QCheckBox(translate("BladeInspect",
                                                 "Resume the interrupted inspection"))
         self.resume.setVisible(self.interrupted is not None)
@@ -198,8 +206,8 @@ class InspectPanel(taskpanels.FormPanel):
             self.seed.setValue(saved["seed"])
             self.rig_file.setText(saved["rig_file"] or "")
             self.airfoil.setChecked(saved["airfoil"])
-        for widget in (self.heights, self.tolerance, self.seed, self.rig_file, self.airfoil,
-                       self.fit):
+        for widget in (self.nominal, self.heights, self.tolerance, self.seed, self.rig_file,
+                       self.airfoil, self.fit):
             widget.setEnabled(not checked)
 
     def validate(self):
@@ -207,15 +215,21 @@ class InspectPanel(taskpanels.FormPanel):
             path = self.rig_file.text().strip()
             if path:
                 read_rig_file(path)
-        checks = [self.check(self.heights, lambda: contracts.parse_section_heights(
+        def chosen():
+            if self.nominal.currentData() is None:
+                raise InputError(translate("BladeInspect", "No nominal CAD in the document"))
+        checks = [self.check(self.nominal, chosen),
+                  self.check(self.heights, lambda: contracts.parse_section_heights(
             self.heights.text(), translate("BladeInspect", "Section heights"))),
             self.check(self.rig_file, rig_file)]
         return all(checks)
 
     def options(self):
+        nominal = self.nominal.currentData()
         if self.resume.isChecked() and self.interrupted is not None:
-            return dict(self.interrupted["options"], resume=True)
-        return dict({"heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
+            return dict(self.interrupted["options"], resume=True, nominal=nominal)
+        return dict({"nominal": nominal,
+                     "heights_text": self.heights.text(), "tolerance": self.tolerance.value(),
                      "seed": self.seed.value(), "rig_file": self.rig_file.text().strip() or None,
                      "airfoil": self.airfoil.isChecked()},
                     **self.fit.values())
@@ -297,7 +311,12 @@ class Inspect(Command):
 
     panel = InspectPanel
 
-    def start(self, heights_text, tolerance, seed, rig_file=None, resume=False, **fit):
+    def Activated(self):
+        FreeCADGui.Control.showDialog(self.panel(
+            self.start, nominals=nominals_of(FreeCAD.ActiveDocument), nominal=find_nominal()))
+
+    def start(self, heights_text, tolerance, seed, rig_file=None, resume=False, nominal=None,
+              **fit):
         try:
             heights = contracts.parse_section_heights(heights_text, "section heights")
         except InputError as exc:
@@ -305,7 +324,9 @@ class Inspect(Command):
             return None
         options = dict(fit, heights_text=heights_text, tolerance=tolerance, seed=seed,
                        rig_file=rig_file)
-        summary = self.inspect(find_nominal(), heights, tolerance, seed, rig_file,
+        nominal_obj = (FreeCAD.ActiveDocument.getObject(nominal)
+                       if nominal and FreeCAD.ActiveDocument else None) or find_nominal()
+        summary = self.inspect(nominal_obj, heights, tolerance, seed, rig_file,
                                resume=resume, panel_options=options, **fit)
         if summary is not None:
             self.show(summary)

@@ -693,6 +693,7 @@ mm</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>No nominal CAD in the document</source>
         <translation type="unfinished"></translation>
@@ -709,6 +710,7 @@ mm</source>
     </message>
     <message>
         <location filename="../../BladeInspect/gui/commands.py"/>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>Nominal CAD</source>
         <translation type="unfinished"></translation>
@@ -1184,6 +1186,11 @@ mm</source>
     <message>
         <location filename="../../BladeInspect/gui/taskpanels.py"/>
         <source>The CAD the points are registered to (the selected one when a CAD is selected)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../../BladeInspect/gui/loop_commands.py"/>
+        <source>The CAD the rig's part is inspected against (the selected one when a CAD is selected)</source>
         <translation type="unfinished"></translation>
     </message>
     <message>
