@@ -105,6 +105,16 @@ def task_button(which=QtGui.QDialogButtonBox.Ok):
     return None
 
 
+def mouse_click(widget):
+    """A left mouse press and release at the widget's centre, as a user's click
+    (QTest.mouseClick's events; FreeCAD's PySide has no QtTest)."""
+    centre = QtCore.QPointF(widget.rect().center())
+    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
+                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
+        QtGui.QApplication.sendEvent(widget, QtGui.QMouseEvent(
+            kind, centre, QtCore.Qt.LeftButton, buttons, QtCore.Qt.NoModifier))
+
+
 def click_task_button(which=QtGui.QDialogButtonBox.Ok):
     """Click the task panel's button as a user does: a left mouse press and release at its
     centre (QTest.mouseClick's events; FreeCAD's PySide has no QtTest), so FreeCAD's task view
@@ -112,12 +122,7 @@ def click_task_button(which=QtGui.QDialogButtonBox.Ok):
     button = task_button(which)
     if button is None:
         raise AssertionError("the task view shows no %r button" % which)
-    centre = QtCore.QPointF(button.rect().center())
-    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
-                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        event = QtGui.QMouseEvent(kind, centre, QtCore.Qt.LeftButton, buttons,
-                                  QtCore.Qt.NoModifier)
-        QtGui.QApplication.sendEvent(button, event)
+    mouse_click(button)
 
 
 def wait_until(condition, timeout_s):

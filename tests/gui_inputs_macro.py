@@ -14,6 +14,7 @@ import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
+from tests.gui_harness import mouse_click as click  # noqa: E402
 from tests.gui_harness import (OUT, ReportWatch, active_panel, check,  # noqa: E402
                                click_ok_and_wait, click_task_button, run_scenario, settle,
                                start_workbench, step, wait_until, window_shot)
@@ -22,14 +23,6 @@ from tests.gui_harness import (OUT, ReportWatch, active_panel, check,  # noqa: E
 COMBO_WIDTH = 230
 RESULT_WAIT_S = 5
 
-
-def click(widget):
-    """A left mouse press and release at the widget's centre, as a user's click."""
-    centre = QtCore.QPointF(widget.rect().center())
-    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
-                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        QtGui.QApplication.sendEvent(widget, QtGui.QMouseEvent(
-            kind, centre, QtCore.Qt.LeftButton, buttons, QtCore.Qt.NoModifier))
 
 
 def open_panel(command, kind):

@@ -17,6 +17,7 @@ import FreeCADGui as Gui
 from PySide import QtCore, QtGui
 
 sys.path.insert(0, os.environ["BI_REPO"])
+from tests.gui_harness import mouse_click  # noqa: E402
 from tests.gui_harness import (OUT, STEPS, ReportWatch, active_panel, check,  # noqa: E402
                                click_ok_and_wait, click_task_button, run_scenario,
                                settle, start_workbench,
@@ -87,13 +88,6 @@ def cancel_button():
             return button
     return None
 
-
-def mouse_click(widget):
-    centre = QtCore.QPointF(widget.rect().center())
-    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
-                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        QtGui.QApplication.sendEvent(widget, QtGui.QMouseEvent(
-            kind, centre, QtCore.Qt.LeftButton, buttons, QtCore.Qt.NoModifier))
 
 
 def temp_folders():
